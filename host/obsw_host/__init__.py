@@ -1,0 +1,1 @@
+"""obsw host side (CPython only): OBC runtime, ground segment, drivers, CLI and simulators."""

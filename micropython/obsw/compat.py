@@ -34,6 +34,9 @@ else:
         return ((end - start + _TICKS_HALF) & _TICKS_MAX) - _TICKS_HALF
 
 
+# The wrap period of ticks_ms: 2**30 on boards and here, 2**62 on the 64-bit unix port.
+TICKS_PERIOD = ticks_add(0, -1) + 1
+
 if hasattr(time, "monotonic"):
     monotonic = time.monotonic
 else:

@@ -1,0 +1,15 @@
+"""pytest configuration shared by every test directory."""
+
+import os
+
+from hypothesis import HealthCheck, settings
+
+# One profile for the whole suite: enough examples to find codec bugs, bounded so that
+# tools/test stays within its time budget on a 2-core machine.
+settings.register_profile(
+    "obsw",
+    max_examples=int(os.environ.get("OBSW_HYPOTHESIS_EXAMPLES", "200")),
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.load_profile("obsw")

@@ -68,6 +68,10 @@ def crc_accelerator(width, poly, init, reflect, xorout):
     """
     if MICROPYTHON:
         return None
+    if (width, poly, reflect, xorout) == (16, 0x1021, False, 0):
+        import binascii  # CPython's crc_hqx is this CRC family, C-fast and always present
+
+        return binascii.crc_hqx
     try:
         import crcmod
     except ImportError:

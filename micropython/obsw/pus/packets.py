@@ -1,0 +1,237 @@
+"""What PUS-C TC and TM packets share: PUS version, errors, request IDs, length and PEC checks."""
+
+from obsw.compat import const
+from obsw.crc import crc16_ccitt
+from obsw.pus.config import DEFAULT
+from obsw.spp import SEQ_UNSEGMENTED, TYPE_TC, FieldRangeError, SppError, Struct
+
+PUS_VERSION = const(2)  # TC and TM packet PUS version number of PUS-C
+
+# acknowledgement flags of a TC secondary header: which successful steps to report
+ACK_NONE = const(0)
+ACK_ACCEPTANCE = const(1)
+ACK_START = const(2)
+ACK_PROGRESS = const(4)
+ACK_COMPLETION = const(8)
+ACK_ALL = const(15)
+
+_HDR = Struct(">HHH")
+_PEC = Struct(">H")
+_PEC_PACK = _PEC.pack
+_WORDS = Struct(">HH")
+
+
+class PusError(SppError):
+    """A PUS packet that cannot be accepted.
+
+    ``packet_id`` and ``sequence_control`` are the primary header words when they were
+    readable (None otherwise), so a failed acceptance report can still name the request.
+    """
+
+    def __init__(self, msg, packet_id=None, sequence_control=None):
+        super().__init__(msg)
+        self.packet_id = packet_id
+        self.sequence_control = sequence_control
+
+    @property
+    def apid(self):
+        return None if self.packet_id is None else self.packet_id & 0x7FF
+
+    def request_id(self):
+        """The RequestId of the offending packet, or None if its header was not readable."""
+        if self.packet_id is None:
+            return None
+        return RequestId.from_words(self.packet_id, self.sequence_control)
+
+
+class PusLengthError(PusError):
+    """Packet length inconsistent: ``expected`` and ``actual`` octets."""
+
+    def __init__(self, msg, expected, actual, packet_id=None, sequence_control=None):
+        super().__init__(msg, packet_id, sequence_control)
+        self.expected = expected
+        self.actual = actual
+
+
+class PusCrcError(PusError):
+    """Packet error control mismatch: ``expected`` as computed, ``actual`` as received."""
+
+    def __init__(self, what, expected, actual, packet_id, sequence_control):
+        super().__init__(
+            "%s packet error control 0x%04x, computed 0x%04x" % (what, actual, expected),
+            packet_id,
+            sequence_control,
+        )
+        self.expected = expected
+        self.actual = actual
+
+
+class PusVersionError(PusError):
+    """A TC or TM packet PUS version number other than 2 (PUS-C)."""
+
+    def __init__(self, what, version, packet_id, sequence_control):
+        super().__init__(
+            "%s packet PUS version %d, expected %d" % (what, version, PUS_VERSION),
+            packet_id,
+            sequence_control,
+        )
+        self.version = version
+
+
+class PusHeaderError(PusError):
+    """A header field value this decoder cannot take (``field``, ``expected``, ``actual``)."""
+
+    def __init__(self, what, field, expected, actual, packet_id=None, sequence_control=None):
+        super().__init__(
+            "%s %s %s, expected %s" % (what, field, actual, expected),
+            packet_id,
+            sequence_control,
+        )
+        self.field = field
+        self.expected = expected
+        self.actual = actual
+
+
+class RequestId:
+    """The request identifier service 1 reports carry: a TC's first two header words."""
+
+    __slots__ = ("packet_id", "sequence_control")
+
+    def __init__(self, apid, seq_count, seq_flags=SEQ_UNSEGMENTED, packet_type=TYPE_TC, sec=1):
+        self.packet_id = (packet_type << 12) | ((1 if sec else 0) << 11) | apid
+        self.sequence_control = (seq_flags << 14) | seq_count
+
+    @classmethod
+    def from_words(cls, packet_id, sequence_control):
+        r = object.__new__(cls)
+        r.packet_id = packet_id
+        r.sequence_control = sequence_control
+        return r
+
+    version = property(lambda self: self.packet_id >> 13)
+    packet_type = property(lambda self: (self.packet_id >> 12) & 1)
+    sec_header_flag = property(lambda self: (self.packet_id >> 11) & 1)
+    apid = property(lambda self: self.packet_id & 0x7FF)
+    seq_flags = property(lambda self: self.sequence_control >> 14)
+    seq_count = property(lambda self: self.sequence_control & 0x3FFF)
+
+    def pack(self):
+        return _WORDS.pack(self.packet_id, self.sequence_control)
+
+    @classmethod
+    def unpack(cls, buf, offset=0):
+        if len(buf) - offset < 4:
+            raise PusLengthError(
+                "request ID too short: %d bytes, needs 4" % (len(buf) - offset),
+                4,
+                len(buf) - offset,
+            )
+        return cls.from_words(*_WORDS.unpack_from(buf, offset))
+
+    def __eq__(self, other):
+        return (
+            isinstance(other, RequestId)
+            and self.packet_id == other.packet_id
+            and self.sequence_control == other.sequence_control
+        )
+
+    def __hash__(self):
+        return (self.packet_id << 16) | self.sequence_control
+
+    def __repr__(self):
+        return "RequestId(apid=%d, seq_count=%d, flags=%d, type=%d)" % (
+            self.apid,
+            self.seq_count,
+            self.seq_flags,
+            self.packet_type,
+        )
+
+
+def _range(field, value, maximum):
+    if not isinstance(value, int) or value < 0 or value > maximum:
+        raise FieldRangeError(field, value, maximum)
+
+
+def _check_common(p):
+    _range("APID", p.apid, 0x7FF)
+    _range("sequence count", p.seq_count, 0x3FFF)
+    _range("sequence flags", p.seq_flags, 3)
+    _range("service type", p.service, 255)
+    _range("message subtype", p.subtype, 255)
+
+
+def _frame(what, buf, offset, config, exact, type_id, min_size):
+    """Check everything up to the PEC; return (packet_id, seq_control, end, data_end)."""
+    n = len(buf) - offset
+    if n < 6:
+        raise PusLengthError(
+            "%s packet too short: %d bytes, primary header needs 6" % (what, n), 6, n
+        )
+    pid, psc, dlen = _HDR.unpack_from(buf, offset)
+    total = dlen + 7
+    if pid & 0xF800 != type_id:
+        if pid >> 13:
+            raise PusHeaderError(what, "packet version number", 0, pid >> 13, pid, psc)
+        if (pid ^ type_id) & 0x1000:
+            raise PusHeaderError(what, "packet type", type_id >> 12 & 1, pid >> 12 & 1, pid, psc)
+        raise PusHeaderError(what, "secondary header flag", 1, 0, pid, psc)
+    if total > n or (exact and total != n):
+        raise PusLengthError(
+            "%s packet is %d bytes, packet data length field says %d" % (what, n, total),
+            total,
+            n,
+            pid,
+            psc,
+        )
+    if total < min_size:
+        raise PusLengthError(
+            "%s packet too short: %d bytes, secondary header and PEC need %d"
+            % (what, total, min_size),
+            min_size,
+            total,
+            pid,
+            psc,
+        )
+    if total > config.max_packet_size:
+        raise PusLengthError(
+            "%s packet of %d bytes exceeds the mission maximum %d"
+            % (what, total, config.max_packet_size),
+            config.max_packet_size,
+            total,
+            pid,
+            psc,
+        )
+    end = offset + total
+    if config.pec:
+        if crc16_ccitt(buf if exact else memoryview(buf)[offset:end]) != 0:
+            got = _PEC.unpack_from(buf, end - 2)[0]
+            computed = crc16_ccitt(memoryview(buf)[offset : end - 2])
+            raise PusCrcError(what, computed, got, pid, psc)
+        return pid, psc, end, end - 2
+    return pid, psc, end, end
+
+
+def _int(buf, offset, size):
+    return int.from_bytes(bytes(buf[offset : offset + size]), "big") if size else 0
+
+
+def failure_code(error):
+    """The service 1 acceptance failure code (obsw.pus.messages) for a decode error."""
+    if isinstance(error, PusCrcError):
+        return 2  # FAILURE_INCORRECT_CHECKSUM
+    if isinstance(error, PusLengthError):
+        return 1  # FAILURE_INVALID_LENGTH
+    if isinstance(error, (PusVersionError, PusHeaderError)):
+        return 6  # FAILURE_UNSUPPORTED_HEADER
+    return 5  # FAILURE_ILLEGAL_APP_DATA
+
+
+def unpack_packet(buf, config=DEFAULT):
+    """A PusTc or PusTm, chosen by the packet type bit of the primary header."""
+    if len(buf) >= 1 and buf[0] & 0x10:
+        from obsw.pus.tc import PusTc
+
+        return PusTc.unpack(buf, config)
+    from obsw.pus.tm import PusTm
+
+    return PusTm.unpack(buf, config)

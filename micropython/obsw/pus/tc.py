@@ -1,0 +1,204 @@
+"""PUS-C telecommand packets (ECSS-E-ST-70-41C 7.4.3): TC secondary header, app data, PEC."""
+
+from obsw.compat import const
+from obsw.crc import crc16_ccitt
+from obsw.pus.config import DEFAULT
+from obsw.pus.packets import (
+    _PEC_PACK,
+    ACK_ALL,
+    PUS_VERSION,
+    PusVersionError,
+    RequestId,
+    _check_common,
+    _frame,
+    _int,
+    _range,
+)
+from obsw.spp import SEQ_UNSEGMENTED, TYPE_TC, FieldRangeError
+
+_TC_ID = const(0x1800)  # version 0, type 1 (TC), secondary header flag 1
+
+
+class PusTc:
+    """A PUS-C telecommand: primary header, TC secondary header, application data, PEC."""
+
+    __slots__ = (
+        "apid",
+        "service",
+        "subtype",
+        "data",
+        "seq_count",
+        "ack",
+        "source_id",
+        "seq_flags",
+        "config",
+    )
+    packet_type = TYPE_TC
+
+    def __init__(
+        self,
+        apid,
+        service,
+        subtype,
+        data=b"",
+        seq_count=0,
+        ack=ACK_ALL,
+        source_id=0,
+        seq_flags=SEQ_UNSEGMENTED,
+        config=DEFAULT,
+    ):
+        self.apid = apid
+        self.service = service
+        self.subtype = subtype
+        self.data = data  # application data
+        self.seq_count = seq_count  # packet sequence count or packet name
+        self.ack = ack
+        self.source_id = source_id
+        self.seq_flags = seq_flags
+        self.config = config
+
+    @property
+    def packet_id(self):
+        return _TC_ID | self.apid
+
+    @property
+    def sequence_control(self):
+        return (self.seq_flags << 14) | self.seq_count
+
+    @property
+    def message_type(self):
+        return (self.service, self.subtype)
+
+    def request_id(self):
+        return RequestId.from_words(_TC_ID | self.apid, (self.seq_flags << 14) | self.seq_count)
+
+    def pack(self):
+        c = self.config
+        data = self.data
+        apid = self.apid
+        src = self.source_id
+        count = self.seq_count
+        flags = self.seq_flags
+        ack = self.ack
+        svc = self.service
+        sub = self.subtype
+        # one cheap test for every field; negative values shift to -1 and fail it too
+        if apid >> 11 or count >> 14 or flags >> 2 or ack >> 4 or (svc | sub) >> 8 or src < 0:
+            self._check(c)
+        if src > c.source_id_max:
+            self._check(c)
+        total = c.tc_min_size + len(data)
+        if total > c.max_packet_size:
+            raise FieldRangeError("TC packet length", total, c.max_packet_size)
+        s = c.tc_struct
+        if s is not None:
+            head = s.pack(
+                _TC_ID | apid, (flags << 14) | count, total - 7, 0x20 | ack, svc, sub, src
+            )
+        else:
+            head = c.tc_common.pack(
+                _TC_ID | apid, (flags << 14) | count, total - 7, 0x20 | ack, svc, sub
+            )
+            if c.source_id_size:
+                head += src.to_bytes(c.source_id_size, "big")
+            if c.tc_spare:
+                head += bytes(c.tc_spare)
+        if c.pec:
+            head += data
+            return head + _PEC_PACK(crc16_ccitt(head))
+        return head + data
+
+    def _check(self, c):
+        _check_common(self)
+        _range("acknowledgement flags", self.ack, 15)
+        _range("source ID", self.source_id, c.source_id_max)
+
+    @classmethod
+    def unpack(cls, buf, config=DEFAULT):
+        """Decode a buffer holding exactly one TC; raises a PusError subclass if malformed."""
+        s = config.tc_struct
+        n = len(buf)
+        if s is not None and n >= config.tc_min_size:
+            # fast path for a well-formed packet; anything odd goes the careful way below
+            pid, psc, dlen, b0, svc, sub, src = s.unpack_from(buf, 0)
+            if (
+                pid & 0xF800 == _TC_ID
+                and dlen + 7 == n
+                and b0 & 0xF0 == 0x20
+                and n <= config.max_packet_size
+            ):
+                if config.pec:
+                    ok = crc16_ccitt(buf) == 0
+                    end = n - 2
+                else:
+                    ok = True
+                    end = n
+                if ok:
+                    data = buf[config.tc_data_offset : end]
+                    return cls(
+                        pid & 0x7FF,
+                        svc,
+                        sub,
+                        data if data.__class__ is bytes else bytes(data),
+                        psc & 0x3FFF,
+                        b0 & 15,
+                        src,
+                        psc >> 14,
+                        config,
+                    )
+        return cls._decode(buf, 0, config, True)[0]
+
+    @classmethod
+    def unpack_from(cls, buf, offset=0, config=DEFAULT):
+        """Decode the TC at ``offset``; returns ``(tc, end_offset)``."""
+        return cls._decode(buf, offset, config, False)
+
+    @classmethod
+    def _decode(cls, buf, offset, config, exact):
+        pid, psc, end, data_end = _frame(
+            "TC", buf, offset, config, exact, _TC_ID, config.tc_min_size
+        )
+        s = config.tc_struct
+        if s is not None:
+            b0, svc, sub, src = s.unpack_from(buf, offset)[3:]
+        else:
+            b0, svc, sub = config.tc_common.unpack_from(buf, offset)[3:]
+            src = _int(buf, offset + 9, config.source_id_size)
+        if b0 >> 4 != PUS_VERSION:
+            raise PusVersionError("TC", b0 >> 4, pid, psc)
+        tc = cls(
+            pid & 0x7FF,
+            svc,
+            sub,
+            bytes(buf[offset + config.tc_data_offset : data_end]),
+            psc & 0x3FFF,
+            b0 & 15,
+            src,
+            psc >> 14,
+            config,
+        )
+        return tc, end
+
+    def __eq__(self, other):
+        return (
+            isinstance(other, PusTc)
+            and self.apid == other.apid
+            and self.service == other.service
+            and self.subtype == other.subtype
+            and bytes(self.data) == bytes(other.data)
+            and self.seq_count == other.seq_count
+            and self.ack == other.ack
+            and self.source_id == other.source_id
+            and self.seq_flags == other.seq_flags
+        )
+
+    def __repr__(self):
+        return "PusTc(TC[%d,%d], apid=%d, seq=%d, ack=0x%x, source=%d, %d bytes)" % (
+            self.service,
+            self.subtype,
+            self.apid,
+            self.seq_count,
+            self.ack,
+            self.source_id,
+            len(self.data),
+        )

@@ -1,0 +1,269 @@
+"""PUS-C telemetry packets (ECSS-E-ST-70-41C 7.4.2): TM secondary header, source data, PEC."""
+
+from obsw.compat import const
+from obsw.crc import crc16_ccitt
+from obsw.pus.config import DEFAULT
+from obsw.pus.packets import (
+    _PEC_PACK,
+    PUS_VERSION,
+    PusHeaderError,
+    PusVersionError,
+    _check_common,
+    _frame,
+    _int,
+    _range,
+)
+from obsw.spp import SEQ_UNSEGMENTED, TYPE_TM, FieldRangeError
+from obsw.timecode import TimeCodeError
+
+_TM_ID = const(0x0800)  # version 0, type 0 (TM), secondary header flag 1
+
+
+class PusTm:
+    """A PUS-C telemetry packet: primary header, TM secondary header, source data, PEC.
+
+    ``time`` is the tuple the configured time code packs, e.g. ``(coarse, fine)`` for CUC;
+    None packs as all zeros.
+    """
+
+    __slots__ = (
+        "apid",
+        "service",
+        "subtype",
+        "data",
+        "seq_count",
+        "message_counter",
+        "destination_id",
+        "time",
+        "time_ref",
+        "seq_flags",
+        "config",
+    )
+    packet_type = TYPE_TM
+
+    def __init__(
+        self,
+        apid,
+        service,
+        subtype,
+        data=b"",
+        seq_count=0,
+        message_counter=0,
+        destination_id=0,
+        time=None,
+        time_ref=0,
+        seq_flags=SEQ_UNSEGMENTED,
+        config=DEFAULT,
+    ):
+        self.apid = apid
+        self.service = service
+        self.subtype = subtype
+        self.data = data  # source data
+        self.seq_count = seq_count
+        self.message_counter = message_counter
+        self.destination_id = destination_id
+        self.time = time
+        self.time_ref = time_ref  # spacecraft time reference status
+        self.seq_flags = seq_flags
+        self.config = config
+
+    @property
+    def packet_id(self):
+        return _TM_ID | self.apid
+
+    @property
+    def sequence_control(self):
+        return (self.seq_flags << 14) | self.seq_count
+
+    @property
+    def message_type(self):
+        return (self.service, self.subtype)
+
+    def _check(self, c):
+        _check_common(self)
+        _range("time reference status", self.time_ref, 15)
+        _range("message type counter", self.message_counter, c.message_counter_max)
+        _range("destination ID", self.destination_id, c.destination_id_max)
+        tf = c.time_fields
+        if tf is not None and self.time is not None:
+            _range("time coarse", self.time[0], (1 << tf[0]) - 1)
+            _range("time fine", self.time[1], (1 << tf[1]) - 1)
+
+    def pack(self):
+        c = self.config
+        data = self.data
+        apid = self.apid
+        count = self.seq_count
+        flags = self.seq_flags
+        ref = self.time_ref
+        svc = self.service
+        sub = self.subtype
+        cnt = self.message_counter
+        dest = self.destination_id
+        if apid >> 11 or count >> 14 or flags >> 2 or ref >> 4 or (svc | sub) >> 8:
+            self._check(c)
+        if cnt < 0 or dest < 0 or cnt > c.message_counter_max or dest > c.destination_id_max:
+            self._check(c)
+        total = c.tm_min_size + len(data)
+        if total > c.max_packet_size:
+            raise FieldRangeError("TM packet length", total, c.max_packet_size)
+        s = c.tm_struct
+        t = self.time
+        if s is not None:
+            if t is None:
+                coarse = fine = 0
+            else:
+                coarse, fine = t
+                tf = c.time_fields
+                if (coarse >> tf[0]) | (fine >> tf[1]):
+                    self._check(c)
+            head = s.pack(
+                _TM_ID | apid,
+                (flags << 14) | count,
+                total - 7,
+                0x20 | ref,
+                svc,
+                sub,
+                cnt,
+                dest,
+                coarse,
+                fine,
+            )
+        else:
+            head = c.tc_common.pack(
+                _TM_ID | apid, (flags << 14) | count, total - 7, 0x20 | ref, svc, sub
+            )
+            if c.message_counter_size:
+                head += cnt.to_bytes(c.message_counter_size, "big")
+            if c.destination_id_size:
+                head += dest.to_bytes(c.destination_id_size, "big")
+            code = c.time
+            if code is not None:
+                try:
+                    head += code.pack(*t) if t is not None else code.pack_seconds(0)
+                except TimeCodeError as e:
+                    raise FieldRangeError("time", t, code.size) from e
+            if c.tm_spare:
+                head += bytes(c.tm_spare)
+        if c.pec:
+            head += data
+            return head + _PEC_PACK(crc16_ccitt(head))
+        return head + data
+
+    @classmethod
+    def unpack(cls, buf, config=DEFAULT):
+        """Decode a buffer holding exactly one TM; raises a PusError subclass if malformed."""
+        s = config.tm_struct
+        n = len(buf)
+        if s is not None and n >= config.tm_min_size:
+            # fast path for a well-formed packet; anything odd goes the careful way below
+            pid, psc, dlen, b0, svc, sub, cnt, dest, coarse, fine = s.unpack_from(buf, 0)
+            if (
+                pid & 0xF800 == _TM_ID
+                and dlen + 7 == n
+                and b0 & 0xF0 == 0x20
+                and n <= config.max_packet_size
+            ):
+                if config.pec:
+                    ok = crc16_ccitt(buf) == 0
+                    end = n - 2
+                else:
+                    ok = True
+                    end = n
+                if ok:
+                    data = buf[config.tm_data_offset : end]
+                    return cls(
+                        pid & 0x7FF,
+                        svc,
+                        sub,
+                        data if data.__class__ is bytes else bytes(data),
+                        psc & 0x3FFF,
+                        cnt,
+                        dest,
+                        (coarse, fine),
+                        b0 & 15,
+                        psc >> 14,
+                        config,
+                    )
+        return cls._decode(buf, 0, config, True)[0]
+
+    @classmethod
+    def unpack_from(cls, buf, offset=0, config=DEFAULT):
+        """Decode the TM at ``offset``; returns ``(tm, end_offset)``."""
+        return cls._decode(buf, offset, config, False)
+
+    @classmethod
+    def _decode(cls, buf, offset, config, exact):
+        pid, psc, end, data_end = _frame(
+            "TM", buf, offset, config, exact, _TM_ID, config.tm_min_size
+        )
+        s = config.tm_struct
+        if s is not None:
+            b0, svc, sub, cnt, dest, coarse, fine = s.unpack_from(buf, offset)[3:]
+            t = (coarse, fine)
+        else:
+            b0, svc, sub = config.tc_common.unpack_from(buf, offset)[3:]
+            pos = offset + 9
+            cnt = _int(buf, pos, config.message_counter_size)
+            pos += config.message_counter_size
+            dest = _int(buf, pos, config.destination_id_size)
+            pos += config.destination_id_size
+            t = None
+            if config.time is not None:
+                try:
+                    t = config.time.unpack(buf, pos)
+                except TimeCodeError as e:
+                    raise PusHeaderError(
+                        "TM", "time field", config.time, str(e), pid, psc
+                    ) from None
+        if b0 >> 4 != PUS_VERSION:
+            raise PusVersionError("TM", b0 >> 4, pid, psc)
+        tm = cls(
+            pid & 0x7FF,
+            svc,
+            sub,
+            bytes(buf[offset + config.tm_data_offset : data_end]),
+            psc & 0x3FFF,
+            cnt,
+            dest,
+            t,
+            b0 & 15,
+            psc >> 14,
+            config,
+        )
+        return tm, end
+
+    def __eq__(self, other):
+        return (
+            isinstance(other, PusTm)
+            and self.apid == other.apid
+            and self.service == other.service
+            and self.subtype == other.subtype
+            and bytes(self.data) == bytes(other.data)
+            and self.seq_count == other.seq_count
+            and self.message_counter == other.message_counter
+            and self.destination_id == other.destination_id
+            and _time(self) == _time(other)
+            and self.time_ref == other.time_ref
+            and self.seq_flags == other.seq_flags
+        )
+
+    def __repr__(self):
+        return "PusTm(TM[%d,%d], apid=%d, seq=%d, counter=%d, dest=%d, time=%r, %d bytes)" % (
+            self.service,
+            self.subtype,
+            self.apid,
+            self.seq_count,
+            self.message_counter,
+            self.destination_id,
+            self.time,
+            len(self.data),
+        )
+
+
+def _time(tm):
+    t = tm.time
+    if t is None:
+        return None
+    t = tuple(t)
+    return None if not any(t) else t

@@ -1,0 +1,188 @@
+"""`obsw pluto`: check a PLUTO procedure at load time, or dry-run it against a simulated system."""
+
+import json
+import sys
+
+from obsw.pluto.interp import Procedure, load
+from obsw.pluto.lexer import PlutoError, line_col
+from obsw.pluto.system import SimulatedSystem, run_virtual
+from obsw.pluto.units import Quantity
+
+_KEYWORDS = {
+    "set": "assignment",
+    "if": "if",
+    "case": "in case",
+    "while": "while",
+    "repeat": "repeat",
+    "for": "for",
+    "wait": "wait",
+    "par": "in parallel",
+    "log": "log",
+    "inform": "inform user",
+    "ctx": "in the context of",
+}
+_TYPES = {"real": "r", "float": "r", "double": "r", "bool": "b", "boolean": "b", "str": "s",
+          "string": "s", "int": "i", "integer": "i", "uint": "u", "unsigned": "u"}  # fmt: skip
+
+
+def add_parser(sub):
+    p = sub.add_parser("pluto", help="check or dry-run PLUTO procedures", description=__doc__)
+    s = p.add_subparsers(dest="action", metavar="ACTION")
+    s.required = True
+    c = s.add_parser("check", help="load-time check (syntax, references, types)")
+    c.add_argument("file", help="procedure text")
+    c.add_argument("--sdb", help="spacecraft database JSON: check system references")
+    c.add_argument("--system", help="simulated system JSON: check system references")
+    c.set_defaults(func=check_cmd)
+    r = s.add_parser("run", help="run against a simulated system on a virtual clock")
+    r.add_argument("file", help="procedure text")
+    r.add_argument("--system", help="simulated system JSON (parameters, activities, events)")
+    r.add_argument("--arg", action="append", default=[], metavar="NAME=VALUE",
+                   help="procedure argument (value as JSON, else text)")  # fmt: skip
+    r.add_argument("-q", "--quiet", action="store_true", help="do not print each statement")
+    r.set_defaults(func=run_cmd)
+
+
+def _type_code(t):
+    # SDB types: uint8..uint64, int8..int64, float32/64, bool, string, enum8/16, or names
+    t = str(t or "").lower()
+    for prefix, code in (("float", "r"), ("uint", "i"), ("int", "i"), ("bool", "b")):
+        if t.startswith(prefix):
+            return code
+    return _TYPES.get(t, "?")
+
+
+class SdbResolver:
+    """Answers the checker's questions from a spacecraft database JSON: components with their
+    parameters (attributes), operations and events, as dicts or lists of dicts with "name"."""
+
+    def __init__(self, sdb):
+        self.known = {}
+        comps = sdb.get("components", sdb)
+        if isinstance(comps, list):
+            comps = {c["name"]: c for c in comps}
+        for cname, comp in comps.items():
+            for key, kind in (("parameters", "parameter"), ("attributes", "parameter"),
+                              ("operations", "activity"), ("activities", "activity"),
+                              ("events", "event")):  # fmt: skip
+                items = comp.get(key, {})
+                if isinstance(items, list):
+                    items = {(i["name"] if isinstance(i, dict) else i): i for i in items}
+                for name, info in items.items():
+                    info = info if isinstance(info, dict) else {}
+                    code = _type_code(info.get("type"))
+                    self.known["%s of %s" % (name, cname)] = (kind, code, info.get("unit"))
+
+    def describe(self, path):
+        return self.known.get(path)
+
+
+def _read(path):
+    with open(path) as f:
+        return f.read()
+
+
+def _errors(e):
+    return getattr(e, "errors", None) or [e]
+
+
+def check_cmd(args):
+    resolver = None
+    if args.sdb:
+        resolver = SdbResolver(json.loads(_read(args.sdb)))
+    elif args.system:
+        resolver = SimulatedSystem(json.loads(_read(args.system)))
+    try:
+        load(_read(args.file), resolver)
+    except PlutoError as e:
+        for x in _errors(e):
+            print("%s:%d:%d: %s: %s" % (args.file, x.line, x.col, x.kind, x.msg))
+        return 1
+    print("%s: ok" % args.file)
+    return 0
+
+
+def describe(s):
+    """One line naming a statement, for the statement-by-statement printout."""
+    k = s[0]
+    if k in ("conf", "init"):
+        return ("initiate and confirm " if k == "conf" else "initiate ") + s[2][0][5]
+    if k == "op":
+        return "operation " + s[2][5]
+    if k == "step":
+        return "initiate and confirm step " + s[2]
+    if k == "set":
+        return "%s := ..." % s[2][2][-1]
+    return _KEYWORDS.get(k, k)
+
+
+def _json_value(v):
+    if isinstance(v, Quantity):
+        return {"value": v.value, "unit": v.unit}
+    return v
+
+
+def dry_run(source, spec=None, arguments=None, on_statement=None):
+    """Check and run a procedure against a simulated system; returns the trace dict."""
+    sim = SimulatedSystem(spec or {})
+    trace = {
+        "accept": False,
+        "error": None,
+        "activity_calls": [],
+        "parameter_reads": [],
+        "events_raised": [],
+        "log": [],
+        "user_messages": [],
+        "user_prompts": [],
+        "step_status": {},
+        "status": None,
+        "end_time_s": 0,
+    }
+    try:
+        prog = load(source, sim if spec else None, arguments)
+    except PlutoError as e:
+        trace["error"] = {"kind": e.kind, "line": e.line, "message": e.msg}
+        return trace
+    trace["accept"] = True
+
+    def show(s):
+        if on_statement:
+            on_statement(sim.elapsed(), line_col(s[1])[0], describe(s))
+
+    proc = Procedure(prog, sim, arguments, trace=show)
+    proc.start(sim.now)
+    end = run_virtual(proc, sim)
+    trace.update(
+        activity_calls=sim.activity_calls,
+        parameter_reads=sim.parameter_reads,
+        events_raised=sim.events_raised,
+        log=sim.logs,
+        user_messages=sim.user_messages,
+        user_prompts=sim.user_prompts,
+        step_status=proc.step_status,
+        status=proc.outcome,
+        end_time_s=end - sim.start,
+    )
+    if proc.error:
+        trace["runtime_error"] = proc.error
+    return trace
+
+
+def _arg(text):
+    name, _, value = text.partition("=")
+    try:
+        return name.strip(), json.loads(value)
+    except ValueError:
+        return name.strip(), value
+
+
+def run_cmd(args):
+    spec = json.loads(_read(args.system)) if args.system else {}
+    arguments = dict(_arg(a) for a in args.arg)
+
+    def show(t, line, what):
+        print("t=%-8g line %-4d %s" % (t, line, what), file=sys.stderr)
+
+    trace = dry_run(_read(args.file), spec, arguments, None if args.quiet else show)
+    print(json.dumps(trace, indent=2, default=_json_value))
+    return 0 if trace["accept"] and trace["status"] == "confirmed" else 1

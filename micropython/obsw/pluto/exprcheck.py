@@ -1,0 +1,222 @@
+"""PLUTO load-time typing of expressions (the checker's base class).
+
+Types are (base, dims): base b Boolean, i integer, r real, s string, a absolute time,
+e enumerated, ? unknown (a system value the resolver cannot type); dims is the unit's
+dimension vector (numbers) or None. A relative time is ("r", TIME).
+"""
+
+from obsw.pluto import units
+from obsw.pluto.builtins import FUNCTIONS
+from obsw.pluto.lexer import PlutoError, line_col
+
+NONE = units.NONE
+TIME = units.TIME
+ANY = ("?", None)
+BOOL = ("b", None)
+STRING = ("s", None)
+ABS = ("a", None)
+RELT = ("r", TIME)
+
+
+class PlutoReferenceError(PlutoError):
+    kind = "unknown_reference"
+
+
+class PlutoTypeError(PlutoError):
+    kind = "type_error"
+
+
+def type_of_code(code, unit=None):
+    """Checker type of a declared type code ('b', 'i', 'u', 'r', 's', 'a', 'rt', '?')."""
+    if code == "rt":
+        return RELT
+    if code in ("i", "u", "r"):
+        return ("r" if code == "r" else "i", units.dims(unit) if unit else NONE)
+    if code in ("b", "s", "a"):
+        return (code, None)
+    return ANY
+
+
+def type_of_value(v):
+    if type(v) is bool:
+        return BOOL
+    if isinstance(v, int):
+        return ("i", NONE)
+    if isinstance(v, float):
+        return ("r", NONE)
+    if isinstance(v, str):
+        return STRING
+    if isinstance(v, units.Quantity):
+        return ("i" if isinstance(v.value, int) else "r", units.dims(v.unit))
+    if isinstance(v, units.AbsTime):
+        return ABS
+    return ANY
+
+
+def _show(t):
+    b, d = t
+    if b in "ir":
+        name = "integer" if b == "i" else "real"
+        if d == TIME:
+            return "relative time"
+        return name if d == NONE or d is None else name + " with units"
+    return {"b": "Boolean", "s": "string", "a": "absolute time", "e": "enumerated", "?": "?"}[b]
+
+
+def _num(t):
+    return t[0] in "ir?"
+
+
+class ExprChecker:
+    def fail(self, cls, msg, p):
+        self.errors.append(cls(msg, *line_col(p)))
+
+    # scopes: list of dicts, innermost last; entries ("v", key) ("ev", name) ("enum", values)
+    def want_bool(self, e, scopes, what):
+        t = self.expr(e, scopes)
+        if t[0] not in "b?":
+            self.fail(PlutoTypeError, "%s must be Boolean, found %s" % (what, _show(t)), e[1])
+
+    def want_rel(self, e, scopes, what):
+        t = self.expr(e, scopes)
+        if not (t[0] in "ir" and t[1] == TIME or t[0] == "?"):
+            self.fail(
+                PlutoTypeError, "%s must be a relative time (10 s), found %s" % (what, _show(t)),
+                e[1])  # fmt: skip
+
+    def expr(self, e, scopes):
+        k = e[0]
+        if k == "c":
+            return type_of_value(e[2])
+        if k == "r":
+            return self.ref(e, scopes)
+        if k == "subj":
+            return self.subj[-1] if self.subj else ANY
+        if k == "b":
+            return self.arith(e, self.expr(e[3], scopes), self.expr(e[4], scopes))
+        if k == "l":
+            self.want_bool(e[3], scopes, "the operand of " + e[2])
+            self.want_bool(e[4], scopes, "the operand of " + e[2])
+            return BOOL
+        if k == "u":
+            t = self.expr(e[3], scopes)
+            if e[2] == "NOT":
+                if t[0] not in "b?":
+                    self.fail(PlutoTypeError, "NOT needs a Boolean, found %s" % _show(t), e[1])
+                return BOOL
+            if not _num(t):
+                self.fail(PlutoTypeError, "sign needs a number, found %s" % _show(t), e[1])
+            return t
+        if k == "cmp":
+            self.comparable(e, self.expr(e[3], scopes), self.expr(e[4], scopes), e[2])
+            return BOOL
+        if k == "btw":
+            t = self.expr(e[2], scopes)
+            self.comparable(e, t, self.expr(e[3], scopes), "<")
+            self.comparable(e, t, self.expr(e[4], scopes), "<")
+            return BOOL
+        if k == "wi":
+            t = self.expr(e[2], scopes)
+            tol = type_of_value(e[3][2])
+            self.comparable(e, t, self.expr(e[5], scopes), "<")
+            if (
+                not _num(t)
+                or (e[4] and tol[1] != NONE)
+                or (not e[4] and tol[1] != NONE and t[0] != "?" and tol[1] != t[1])
+            ):
+                self.fail(PlutoTypeError, "within needs numbers with matching units", e[1])
+            return BOOL
+        if k == "in":
+            t = self.expr(e[2], scopes)
+            for x in e[3]:
+                self.comparable(e, t, self.expr(x, scopes), "=")
+            return BOOL
+        if k == "f":
+            return self.function(e, [self.expr(a, scopes) for a in e[3]])
+        if k == "ask":
+            self.expr(e[2], scopes)
+            if e[3] is not None:
+                self.expr(e[3], scopes)
+            t = e[4]
+            return ("e", None) if isinstance(t, tuple) else type_of_code(t or "s")
+        return ANY
+
+    def comparable(self, e, a, b, op):
+        if a[0] == "?" or b[0] == "?":
+            return
+        ok = True
+        if _num(a) and _num(b):
+            ok = a[1] == b[1] or a[1] == NONE or b[1] == NONE
+        elif a[0] in "se" and b[0] in "se":
+            ok = True
+        elif a[0] != b[0]:
+            ok = False
+        elif a[0] == "b" and op not in ("=", "!="):
+            ok = False
+        if not ok:
+            self.fail(PlutoTypeError, "cannot compare %s with %s" % (_show(a), _show(b)), e[1])
+
+    def arith(self, e, a, b):
+        op, p = e[2], e[1]
+        if a[0] == "?" or b[0] == "?":
+            return a if b[0] == "?" else b
+        if a[0] == "a" or b[0] == "a":
+            if op == "-" and a == ABS and b == ABS:
+                return RELT
+            if op in "+-" and a == ABS and b[0] in "ir" and b[1] == TIME:
+                return ABS
+            if op == "+" and b == ABS and a[0] in "ir" and a[1] == TIME:
+                return ABS
+            self.fail(PlutoTypeError, "cannot apply %s to %s and %s" % (op, _show(a), _show(b)), p)
+            return ANY
+        if not (_num(a) and _num(b)):
+            self.fail(PlutoTypeError, "cannot apply %s to %s and %s" % (op, _show(a), _show(b)), p)
+            return ANY
+        base = "i" if a[0] == "i" and b[0] == "i" and op != "/" else "r"
+        if op in "+-":
+            if a[1] != b[1]:
+                self.fail(PlutoTypeError, "cannot apply %s to values with different units" % op, p)
+            return (base, a[1])
+        if op == "**":
+            if b[1] != NONE:
+                self.fail(PlutoTypeError, "an exponent cannot have units", p)
+            if a[1] != NONE:
+                x = e[4]
+                if x[0] != "c" or type(x[2]) is not int:
+                    self.fail(PlutoTypeError, "units need a constant integer power", p)
+                    return ANY
+                return ("r", tuple(d * x[2] for d in a[1]))
+            return (base, NONE)
+        k = 1 if op == "*" else -1
+        return (base, tuple(a[1][i] + k * b[1][i] for i in range(8)))
+
+    def function(self, e, ts):
+        spec = FUNCTIONS.get(e[2])
+        if spec is None:
+            self.fail(PlutoReferenceError, "unknown function %s" % e[2], e[1])
+            return ANY
+        _, lo, hi, kinds, res = spec
+        if len(ts) < lo or (hi >= 0 and len(ts) > hi):
+            self.fail(PlutoTypeError, "%s takes %s arguments, got %d"
+                      % (e[2], lo if lo == hi else "%d or more" % lo, len(ts)), e[1])  # fmt: skip
+            return ANY
+        for i, t in enumerate(ts):
+            kind = kinds[min(i, len(kinds) - 1)] if kinds else "*"
+            if t[0] == "?" or kind == "*":
+                continue
+            ok = (
+                (kind == "N" and _num(t))
+                or (kind == "D" and _num(t) and t[1] == NONE)
+                or (kind == "S" and t[0] in "se")
+                or (kind == "A" and t[0] == "a")
+                or (kind == "R" and _num(t) and t[1] == TIME)
+            )
+            if not ok:
+                self.fail(PlutoTypeError, "argument %d of %s is %s" % (i + 1, e[2], _show(t)),
+                          e[1])  # fmt: skip
+        first = ts[0] if ts else ANY
+        if res == "=":
+            return first
+        if res == "i=":
+            return ("i", first[1] if first[0] != "?" else NONE)
+        return type_of_code(res)

@@ -1,0 +1,169 @@
+"""PLUTO lexer: words, numbers, strings, time literals and operators, each with line and column."""
+
+from obsw.pluto.units import UnitError, parse_iso
+
+# Token kinds
+WORD = "w"
+NUM = "n"
+STR = "s"
+OP = "o"
+ABST = "t"  # absolute time literal, value in seconds since the Unix epoch
+RELT = "r"  # colon-form relative time literal (d:hh:mm:ss[:fff]), value in seconds
+EOF = "e"
+
+_OPS2 = (":=", "**", "<=", ">=", "!=")
+_OPS1 = "=<>+-*/(),;:[].^%"
+
+
+class PlutoError(ValueError):
+    """A procedure rejected at load time; ``kind`` is syntax_error, unknown_reference or
+    type_error, ``line`` and ``col`` count from 1."""
+
+    kind = "error"
+
+    def __init__(self, msg, line=0, col=0):
+        super().__init__(msg)
+        self.msg = msg
+        self.line = line
+        self.col = col
+
+    def __str__(self):
+        return "line %d, column %d: %s" % (self.line, self.col, self.msg)
+
+
+class PlutoSyntaxError(PlutoError):
+    kind = "syntax_error"
+
+
+def pos(line, col):
+    return (line << 12) | (col if col < 4096 else 4095)
+
+
+def line_col(p):
+    return p >> 12, p & 4095
+
+
+def _isword(c):
+    return c.isalpha() or c == "_"
+
+
+def tokenize(src):
+    """List of (kind, value, pos) tuples ending with an EOF token; raises PlutoSyntaxError."""
+    out = []
+    i, n = 0, len(src)
+    line, start = 1, 0
+    after_num = False
+    seen = {}  # one string object per distinct word keeps the token list small
+    while i < n:
+        c = src[i]
+        if c == "\n":
+            line, start, i = line + 1, i + 1, i + 1
+            after_num = False
+            continue
+        if c in " \t\r\f":
+            i += 1
+            after_num = False
+            continue
+        p = pos(line, i - start + 1)
+        if c == "/" and src[i + 1 : i + 2] == "/":
+            while i < n and src[i] != "\n":
+                i += 1
+            continue
+        if c.isdigit():
+            i = _number(src, i, n, out, p)
+            after_num = True
+            continue
+        if _isword(c):
+            j = i + 1
+            if after_num:  # "10s", "1d2h": a unit glued to its number holds letters only
+                while j < n and src[j].isalpha():
+                    j += 1
+            else:
+                while j < n and (src[j].isalpha() or src[j].isdigit() or src[j] == "_"):
+                    j += 1
+            w = src[i:j]
+            out.append((WORD, seen.setdefault(w, w), p))
+            i = j
+            after_num = False
+            continue
+        after_num = False
+        if c == '"':
+            j = i + 1
+            buf = []
+            while j < n and src[j] != '"':
+                if src[j] == "\\" and j + 1 < n:
+                    j += 1
+                if src[j] == "\n":
+                    break
+                buf.append(src[j])
+                j += 1
+            if j >= n or src[j] != '"':
+                raise PlutoSyntaxError("unterminated string", *line_col(p))
+            out.append((STR, "".join(buf), p))
+            i = j + 1
+            continue
+        two = src[i : i + 2]
+        if two in _OPS2:
+            out.append((OP, two, p))
+            i += 2
+            continue
+        if c in _OPS1:
+            out.append((OP, c, p))
+            i += 1
+            continue
+        raise PlutoSyntaxError("unexpected character %r" % c, *line_col(p))
+    out.append((EOF, None, pos(line, i - start + 1)))
+    return out
+
+
+def _digits(src, i, n):
+    j = i
+    while j < n and src[j].isdigit():
+        j += 1
+    return j
+
+
+def _number(src, i, n, out, p):
+    if src[i] == "0" and src[i + 1 : i + 2] in ("x", "X"):
+        j = i + 2
+        while j < n and src[j] in "0123456789abcdefABCDEF":
+            j += 1
+        if j == i + 2:
+            raise PlutoSyntaxError("hexadecimal constant needs digits", *line_col(p))
+        out.append((NUM, int(src[i + 2 : j], 16), p))
+        return j
+    j = _digits(src, i, n)
+    if src[j : j + 1] == "-" and j - i == 4 and src[j + 1 : j + 2].isdigit():
+        k = j + 1
+        while k < n and (src[k].isdigit() or src[k] in "-:.TZ"):
+            k += 1
+        try:
+            out.append((ABST, parse_iso(src[i:k]), p))
+        except UnitError:
+            raise PlutoSyntaxError("malformed absolute time %r" % src[i:k], *line_col(p)) from None
+        return k
+    if src[j : j + 1] == ":" and src[j + 1 : j + 3].isdigit() and src[j + 3 : j + 4] == ":":
+        k = j
+        while k < n and (src[k].isdigit() or src[k] in ":."):
+            k += 1
+        parts = src[i:k].split(":")
+        if len(parts) not in (4, 5):
+            raise PlutoSyntaxError("malformed relative time %r" % src[i:k], *line_col(p))
+        v = int(parts[0]) * 86400 + int(parts[1]) * 3600 + int(parts[2]) * 60 + int(parts[3])
+        if len(parts) == 5 and parts[4]:
+            v += int(parts[4]) / 10 ** len(parts[4])
+        out.append((RELT, v, p))
+        return k
+    real = False
+    if src[j : j + 1] == "." and src[j + 1 : j + 2].isdigit():
+        j = _digits(src, j + 1, n)
+        real = True
+    if src[j : j + 1] in ("e", "E"):
+        k = j + 1
+        if src[k : k + 1] in ("+", "-"):
+            k += 1
+        if src[k : k + 1].isdigit():
+            j = _digits(src, k, n)
+            real = True
+    out.append((NUM, float(src[i:j]) if real else int(src[i:j]), p))
+    return j

@@ -1,5 +1,6 @@
 """The one module that knows which interpreter runs: const, clocks and optional accelerators."""
 
+import struct
 import sys
 import time
 
@@ -50,6 +51,30 @@ else:
             _mono[0] += time.ticks_diff(now, last)
         _mono[1] = now
         return _mono[0] / 1000
+
+
+if hasattr(struct, "Struct"):
+    Struct = struct.Struct  # the C implementation, faster where it exists
+else:
+
+    class Struct:
+        """``struct.Struct`` for interpreters that lack it (MicroPython)."""
+
+        def __init__(self, fmt):
+            self.format = fmt
+            self.size = struct.calcsize(fmt)
+
+        def pack(self, *values):
+            return struct.pack(self.format, *values)
+
+        def pack_into(self, buf, offset, *values):
+            struct.pack_into(self.format, buf, offset, *values)
+
+        def unpack(self, buf):
+            return struct.unpack(self.format, buf)
+
+        def unpack_from(self, buf, offset=0):
+            return struct.unpack_from(self.format, buf, offset)
 
 
 def sleep(seconds):

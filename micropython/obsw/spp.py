@@ -1,8 +1,6 @@
 """CCSDS Space Packet Protocol (133.0-B-2): headers, packets, counts, idle packets, streams."""
 
-import struct
-
-from obsw.compat import const
+from obsw.compat import Struct, const
 
 PACKET_VERSION = const(0)  # the only packet version number 133.0-B-2 defines ('000')
 TYPE_TM = const(0)
@@ -19,29 +17,6 @@ MAX_PACKET_SIZE = const(65542)  # 6-octet header + up to 65536 octets of packet 
 
 _HDR_FMT = ">HHH"
 
-
-class Struct:
-    """``struct.Struct`` where the interpreter has it, an equivalent wrapper where it does not."""
-
-    def __init__(self, fmt):
-        self.format = fmt
-        self.size = struct.calcsize(fmt)
-
-    def pack(self, *values):
-        return struct.pack(self.format, *values)
-
-    def pack_into(self, buf, offset, *values):
-        struct.pack_into(self.format, buf, offset, *values)
-
-    def unpack(self, buf):
-        return struct.unpack(self.format, buf)
-
-    def unpack_from(self, buf, offset=0):
-        return struct.unpack_from(self.format, buf, offset)
-
-
-if hasattr(struct, "Struct"):
-    Struct = struct.Struct  # noqa: F811 - the C implementation is faster where it exists
 
 _HEADER = Struct(_HDR_FMT)
 

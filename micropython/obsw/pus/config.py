@@ -1,6 +1,6 @@
 """PUS-C mission parameters: which optional packet fields exist and their sizes."""
 
-from obsw.spp import Struct
+from obsw.compat import Struct
 from obsw.timecode import Cuc
 
 _INT_FMT = {1: "B", 2: "H", 4: "I"}

@@ -1,9 +1,9 @@
 """What PUS-C TC and TM packets share: PUS version, errors, request IDs, length and PEC checks."""
 
-from obsw.compat import const
+from obsw.compat import Struct, const
 from obsw.crc import crc16_ccitt
 from obsw.pus.config import DEFAULT
-from obsw.spp import SEQ_UNSEGMENTED, TYPE_TC, FieldRangeError, SppError, Struct
+from obsw.spp import SEQ_UNSEGMENTED, TYPE_TC, FieldRangeError, SppError
 
 PUS_VERSION = const(2)  # TC and TM packet PUS version number of PUS-C
 

@@ -1,9 +1,8 @@
 """Queue and node from asyncio tasks, on CPython and on MicroPython (whose asyncio has no
 Queue)."""
 
-import unittest
-
 import asyncio
+import unittest
 
 from obsw.il.interface import DATA, Attribute, Event, Interface, Operation
 from obsw.il.node import Node

@@ -1,6 +1,34 @@
-"""The demo: every capability of the system, simulated on one machine."""
+"""The demo: the system's capabilities, simulated on one machine, one section after another."""
+
+import importlib
+import sys
+import time
+
+# (title, module, function): each function takes `out` (a print-like callable), runs its part of
+# the system on this machine, prints what happens and cleans up after itself.
+SECTIONS = (("Interaction layer: a component in its own process", "obsw_host.il_demo", "run"),)
 
 
-def main():
-    print("obsw demo")
-    return 0
+def main(out=print):
+    failed = []
+    started = time.monotonic()
+    for n, (title, module, function) in enumerate(SECTIONS, 1):
+        out("")
+        out("=" * 78)
+        out("%d. %s" % (n, title))
+        out("=" * 78)
+        try:
+            getattr(importlib.import_module(module), function)(out=out)
+        except Exception as e:  # one broken section must not hide the others
+            failed.append(title)
+            out("!! section failed: %s: %s" % (type(e).__name__, e))
+    out("")
+    out(
+        "demo finished in %.1f s: %d sections, %d failed"
+        % (time.monotonic() - started, len(SECTIONS), len(failed))
+    )
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -6,7 +6,14 @@ import time
 
 # (title, module, function): each function takes `out` (a print-like callable), runs its part of
 # the system on this machine, prints what happens and cleans up after itself.
-SECTIONS = (("Interaction layer: a component in its own process", "obsw_host.il_demo", "run"),)
+SECTIONS = (
+    ("Interaction layer: a component in its own process", "obsw_host.il_demo", "run"),
+    (
+        "SpaceCAN: controller and responder on two redundant buses",
+        "obsw_host.spacecan.demo",
+        "run",
+    ),
+)
 
 
 def main(out=print):

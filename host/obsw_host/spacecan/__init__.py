@@ -1,0 +1,1 @@
+"""SpaceCAN on the host: python-can adapter, fault injection, frame monitor and the demo."""

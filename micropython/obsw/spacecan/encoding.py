@@ -1,0 +1,122 @@
+"""SpaceCAN value encodings (bool, i8..u64, f32, f64; big-endian), as named in node definitions."""
+
+import struct
+
+# name -> (struct code, size, signed); bool is handled by hand (MicroPython's struct has no '?')
+_TABLE = {
+    "bool": (None, 1, False),
+    "i8": ("b", 1, True),
+    "u8": ("B", 1, False),
+    "i16": ("h", 2, True),
+    "u16": ("H", 2, False),
+    "i32": ("i", 4, True),
+    "u32": ("I", 4, False),
+    "i64": ("q", 8, True),
+    "u64": ("Q", 8, False),
+    "f32": ("f", 4, False),
+    "f64": ("d", 8, False),
+}
+
+NAMES = tuple(_TABLE)
+
+
+class EncodingError(ValueError):
+    """An unknown encoding name, or a value that does not fit it."""
+
+    def __init__(self, msg, encoding=None, value=None):
+        super().__init__(msg)
+        self.encoding = encoding
+        self.value = value
+
+
+class DecodeError(ValueError):
+    """Too few bytes to decode a value."""
+
+    def __init__(self, encoding, needed, available):
+        super().__init__("%s value needs %d bytes, only %d left" % (encoding, needed, available))
+        self.encoding = encoding
+        self.needed = needed
+        self.available = available
+
+
+def parts(encoding):
+    """Split a (possibly comma separated) encoding into its known names."""
+    out = []
+    for name in encoding.split(","):
+        name = name.strip()
+        if name not in _TABLE:
+            raise EncodingError(
+                "unknown encoding %r, expected one of %s" % (name, ", ".join(NAMES)), name
+            )
+        out.append(name)
+    return out
+
+
+def check(encoding):
+    """Return encoding if every part is known, else raise EncodingError."""
+    if not isinstance(encoding, str):
+        raise EncodingError("encoding must be a string, got %r" % (encoding,), encoding)
+    parts(encoding)
+    return encoding
+
+
+def size(encoding):
+    """Encoded size in bytes."""
+    n = 0
+    for name in parts(encoding):
+        n += _TABLE[name][1]
+    return n
+
+
+def _encode_one(name, value):
+    code, width, signed = _TABLE[name]
+    if code is None:
+        if value is True or value is False or value in (0, 1):
+            return b"\x01" if value else b"\x00"
+        raise EncodingError("bool value must be True/False/0/1, got %r" % (value,), name, value)
+    if code in ("f", "d"):
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            raise EncodingError("%s value must be a number, got %r" % (name, value), name, value)
+        return struct.pack(">" + code, value)
+    if not isinstance(value, int) or isinstance(value, bool):
+        raise EncodingError("%s value must be an integer, got %r" % (name, value), name, value)
+    bits = width * 8
+    lo, hi = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
+    if value < lo or value > hi:
+        raise EncodingError(
+            "%s value out of range %d..%d: %d" % (name, lo, hi, value), name, value
+        )
+    return struct.pack(">" + code, value)
+
+
+def encode(encoding, value):
+    """Encode value; for a comma separated encoding value is a list or tuple of the same length."""
+    names = parts(encoding)
+    if len(names) == 1:
+        return _encode_one(names[0], value)
+    if not isinstance(value, (list, tuple)) or len(value) != len(names):
+        raise EncodingError(
+            "%s needs %d values, got %r" % (encoding, len(names), value), encoding, value
+        )
+    return b"".join(_encode_one(n, v) for n, v in zip(names, value))
+
+
+def _decode_one(name, buf, offset):
+    code, width, _ = _TABLE[name]
+    if len(buf) - offset < width:
+        raise DecodeError(name, width, len(buf) - offset)
+    if code is None:
+        return buf[offset] != 0, offset + 1
+    return struct.unpack_from(">" + code, buf, offset)[0], offset + width
+
+
+def decode(encoding, buf, offset=0):
+    """Decode one value at offset; return (value, next offset). Lists give a tuple value."""
+    names = parts(encoding)
+    if len(names) == 1:
+        return _decode_one(names[0], buf, offset)
+    values = []
+    for n in names:
+        v, offset = _decode_one(n, buf, offset)
+        values.append(v)
+    return tuple(values), offset

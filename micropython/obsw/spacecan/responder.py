@@ -1,0 +1,392 @@
+"""SpaceCAN responder (node 1..127): services 1, 3, 8, 17, 20 and bus failover by heartbeat.
+
+Sans-I/O, the same interface as the controller: `receive(bus, can_id, data, now)`,
+`poll(now)` at `next_deadline()`, `take_frames()`, `take_events()`. Both buses are received;
+replies go out on the bus the request came in on, periodic reports on the active bus.
+"""
+
+from obsw.spacecan import encoding as enc
+from obsw.spacecan import events as ev
+from obsw.spacecan import packets as pk
+from obsw.spacecan.fragment import MAX_PACKET_SIZE, Reassembler, split
+from obsw.spacecan.ids import (
+    BUS_A,
+    ID_HEARTBEAT,
+    ID_REP,
+    ID_REQ,
+    ID_SCET,
+    ID_SYNC,
+    ID_UTC,
+    bus_name,
+    check_node_id,
+)
+from obsw.spacecan.redundancy import BusHealth, HeartbeatMonitor
+from obsw.spacecan.timeframes import FrameLengthError, ScetTime, UtcTime
+
+_MIN_HK_INTERVAL = 0.01
+
+
+class _Reject(Exception):
+    """A request the responder refuses: answered with (1,2)."""
+
+    def __init__(self, reason):
+        super().__init__(reason)
+        self.reason = reason
+
+
+class Responder:
+    """A SpaceCAN responder node serving its NodeDefinition.
+
+    Application hooks (all optional): `on_function(function_id, args) -> bool` (False or an
+    exception gives (1,8)); `on_parameters_set(values) -> bool` vetoes a (20,3);
+    `on_raw(data, bus)` gets REQ frames in raw data mode (`use_packets=False`).
+    """
+
+    def __init__(
+        self,
+        node_id,
+        nodedef,
+        heartbeat_period=0.5,
+        max_miss_heartbeat=3,
+        max_bus_switch=False,
+        follow_heartbeat=True,
+        reassembly_timeout=0.5,
+        use_packets=True,
+        bus=BUS_A,
+    ):
+        self.node_id = check_node_id(node_id)
+        self.nodedef = nodedef
+        self.monitor = HeartbeatMonitor(
+            heartbeat_period, max_miss_heartbeat, max_bus_switch, follow_heartbeat, bus
+        )
+        self.use_packets = use_packets
+        self.health = [BusHealth(0), BusHealth(1)]
+        self.reassembler = Reassembler(reassembly_timeout)
+        self.counters = {
+            "rx": 0,
+            "tx": 0,
+            "requests": 0,
+            "rejected": 0,
+            "ignored": 0,
+            "bad_frames": 0,
+        }
+        self.scet = None
+        self.utc = None
+        self.on_function = None
+        self.on_parameters_set = None
+        self.on_raw = None
+        self._req_id = ID_REQ + node_id
+        self._rep_id = ID_REP + node_id
+        self._frames = []
+        self._events = []
+        self._hk_due = {}  # report id -> next due time (None: set at the next poll)
+        self._started = False
+        for rid, r in nodedef.reports.items():
+            if r.enabled:
+                self._hk_due[rid] = None
+        self._handlers = {
+            (pk.SERVICE_TEST, pk.PING): self._ping,
+            (pk.SERVICE_PARAMETER, pk.PARAM_REQUEST): self._param_request,
+            (pk.SERVICE_PARAMETER, pk.PARAM_SET): self._param_set,
+            (pk.SERVICE_HOUSEKEEPING, pk.HK_ENABLE): self._hk_enable,
+            (pk.SERVICE_HOUSEKEEPING, pk.HK_DISABLE): self._hk_disable,
+            (pk.SERVICE_HOUSEKEEPING, pk.HK_ONE_SHOT): self._hk_one_shot,
+            (pk.SERVICE_FUNCTION, pk.FUNCTION_PERFORM): self._function,
+        }
+
+    @classmethod
+    def from_config(cls, config, nodedef, **kw):
+        """Build from a spacecan responder JSON dict (interface and channels are the driver's)."""
+        return cls(
+            config["node_id"],
+            nodedef,
+            heartbeat_period=config.get("heartbeat_period", 0.5),
+            max_miss_heartbeat=config.get("max_miss_heartbeat", 3),
+            max_bus_switch=config.get("max_bus_switch", False),
+            use_packets=config.get("use_packets", True),
+            **kw,
+        )
+
+    @property
+    def active(self):
+        return self.monitor.active
+
+    # -- sans-I/O interface --------------------------------------------------------------------
+
+    def start(self, now):
+        self._started = True
+        self.monitor.start(now)
+        for rid in self._hk_due:
+            if self._hk_due[rid] is None:
+                self._hk_due[rid] = now + self._interval(rid)
+
+    def _interval(self, rid):
+        return max(self.nodedef.reports[rid].interval, _MIN_HK_INTERVAL)
+
+    def take_frames(self):
+        out = self._frames
+        self._frames = []
+        return out
+
+    def take_events(self):
+        out = self._events
+        self._events = []
+        return out
+
+    def _emit(self, kind, now, **fields):
+        self._events.append(ev.Event(kind, now, **fields))
+
+    def tx_error(self, bus, now):
+        h = self.health[bus]
+        h.tx_failed(now)
+        self._emit(ev.TX_ERROR, now, bus=bus, count=h.errors_since_rx)
+
+    def receive(self, bus, can_id, data, now):
+        """A frame arrived on bus (0 = A, 1 = B)."""
+        if not self._started:
+            self.start(now)
+        if can_id == self._req_id:
+            self._count_rx(bus, now)
+            if not self.use_packets:
+                if self.on_raw is not None:
+                    self.on_raw(bytes(data), bus)
+                return
+            packet = self.reassembler.push(can_id | (bus << 11), data, now)
+            if packet is not None:
+                self._serve(packet, bus, now)
+        elif can_id == ID_HEARTBEAT:
+            if len(data):
+                self._bad(bus, can_id, now, FrameLengthError("heartbeat", 0, len(data)))
+                return
+            self._count_rx(bus, now)
+            self.health[bus].heartbeats += 1
+            self.health[bus].last_heartbeat = now
+            old = self.monitor.active
+            reason = self.monitor.heartbeat(bus, now)
+            if reason is not None:
+                self._emit(ev.BUS_SWITCHED, now, old=old, new=self.monitor.active, reason=reason)
+        elif can_id == ID_SYNC:
+            if len(data):
+                self._bad(bus, can_id, now, FrameLengthError("sync", 0, len(data)))
+                return
+            self._count_rx(bus, now)
+            self._emit(ev.SYNC, now, bus=bus)
+        elif can_id == ID_SCET or can_id == ID_UTC:
+            try:
+                t = ScetTime.unpack(data) if can_id == ID_SCET else UtcTime.unpack(data)
+            except ValueError as e:
+                self._bad(bus, can_id, now, e)
+                return
+            self._count_rx(bus, now)
+            if can_id == ID_SCET:
+                self.scet = t
+                self._emit(ev.SCET, now, bus=bus, value=t)
+            else:
+                self.utc = t
+                self._emit(ev.UTC, now, bus=bus, value=t)
+        else:
+            self.counters["ignored"] += 1
+
+    def _count_rx(self, bus, now):
+        self.counters["rx"] += 1
+        self.health[bus].received(now)
+
+    def _bad(self, bus, can_id, now, error):
+        self.counters["bad_frames"] += 1
+        self.health[bus].bad_frames += 1
+        self._emit(ev.FRAME_ERROR, now, bus=bus, can_id=can_id, error=str(error))
+
+    def poll(self, now):
+        """Heartbeat deadline, periodic housekeeping and fragment expiry."""
+        if not self._started:
+            self.start(now)
+        old = self.monitor.active
+        reason = self.monitor.poll(now)
+        if reason is not None:
+            self._emit(ev.BUS_SWITCHED, now, old=old, new=self.monitor.active, reason=reason)
+        self.reassembler.expire(now)
+        for rid in self._hk_due:
+            due = self._hk_due[rid]
+            interval = self._interval(rid)
+            if due is None:
+                self._hk_due[rid] = now + interval
+            elif now >= due:
+                self._reply(
+                    self.monitor.active,
+                    pk.SERVICE_HOUSEKEEPING,
+                    pk.HK_REPORT,
+                    pk.pack_hk(self.nodedef, rid),
+                )
+                due += interval
+                self._hk_due[rid] = due if due > now else now + interval
+
+    def next_deadline(self):
+        best = self.monitor.next_deadline()
+        t = self.reassembler.next_deadline()
+        if t is not None and (best is None or t < best):
+            best = t
+        for due in self._hk_due.values():
+            if due is not None and (best is None or due < best):
+                best = due
+        return best
+
+    def bus_status(self, now):
+        """Both buses' health as seen from this node, the active one marked."""
+        window = self.monitor.window() or 2.0
+        return [h.report(now, window, h.bus == self.monitor.active) for h in self.health]
+
+    def switch_bus(self, now, bus=None, reason="command"):
+        """Make bus (default: the other one) active, e.g. on the application's own judgement."""
+        old = self.monitor.active
+        new = (1 - old) if bus is None else bus
+        if new == old:
+            return False
+        self.monitor._switch(new, now)
+        self._emit(ev.BUS_SWITCHED, now, old=old, new=new, reason=reason)
+        return True
+
+    # -- application side ----------------------------------------------------------------------
+
+    def set_value(self, key, value):
+        """Set a parameter's current value by id or name (checked against its encoding)."""
+        p = self.nodedef.parameter(key)
+        if p is None:
+            raise KeyError(key)
+        enc.encode(p.encoding, value)
+        p.value = value
+
+    def get_value(self, key):
+        p = self.nodedef.parameter(key)
+        if p is None:
+            raise KeyError(key)
+        return p.value
+
+    def send_raw(self, data, bus=None):
+        """Raw data mode: one REP frame of up to 8 bytes."""
+        if len(data) > 8:
+            raise ValueError("raw frame data is at most 8 bytes, got %d" % len(data))
+        self._tx(self.monitor.active if bus is None else bus, bytes(data))
+
+    # -- services ------------------------------------------------------------------------------
+
+    def _tx(self, bus, data):
+        self._frames.append((bus, self._rep_id, data))
+        self.health[bus].sent()
+        self.counters["tx"] += 1
+
+    def _reply(self, bus, service, subtype, data=b""):
+        for frame in split(bytes((service, subtype)) + data):
+            self._tx(bus, frame)
+
+    def _verify(self, bus, subtype, service, req_subtype):
+        self._reply(bus, pk.SERVICE_VERIFICATION, subtype, bytes((service, req_subtype)))
+
+    def _serve(self, packet, bus, now):
+        self.counters["requests"] += 1
+        if len(packet) < 2:
+            self.counters["rejected"] += 1
+            self._emit(
+                ev.REQUEST_REJECTED, now, service=None, subtype=None, reason="packet under 2 bytes"
+            )
+            return
+        service = packet[0]
+        subtype = packet[1]
+        handler = self._handlers.get((service, subtype))
+        try:
+            if handler is None:
+                raise _Reject("service (%d,%d) not supported" % (service, subtype))
+            handler(bus, service, subtype, packet[2:], now)
+        except _Reject as e:
+            self.counters["rejected"] += 1
+            self._verify(bus, pk.ACCEPT_FAIL, service, subtype)
+            self._emit(ev.REQUEST_REJECTED, now, service=service, subtype=subtype, reason=e.reason)
+        except ValueError as e:
+            self.counters["rejected"] += 1
+            self._verify(bus, pk.ACCEPT_FAIL, service, subtype)
+            self._emit(ev.REQUEST_REJECTED, now, service=service, subtype=subtype, reason=str(e))
+
+    def _ping(self, bus, service, subtype, data, now):
+        self._verify(bus, pk.ACCEPT_OK, service, subtype)
+        self._reply(bus, pk.SERVICE_TEST, pk.PING_REPORT)
+        self._verify(bus, pk.COMPLETE_OK, service, subtype)
+
+    def _param_request(self, bus, service, subtype, data, now):
+        ids = pk.unpack_ids(data)
+        size = 3
+        for pid in ids:
+            p = self.nodedef.parameters.get(pid)
+            if p is None:
+                raise _Reject("unknown parameter %d" % pid)
+            size += 1 + p.size
+        if size > MAX_PACKET_SIZE:
+            raise _Reject("report of %d bytes exceeds %d" % (size, MAX_PACKET_SIZE))
+        pairs = [(pid, self.nodedef.parameters[pid].value) for pid in ids]
+        report = pk.pack_values(self.nodedef, pairs)
+        self._verify(bus, pk.ACCEPT_OK, service, subtype)
+        self._reply(bus, pk.SERVICE_PARAMETER, pk.PARAM_REPORT, report)
+        self._verify(bus, pk.COMPLETE_OK, service, subtype)
+
+    def _param_set(self, bus, service, subtype, data, now):
+        values = dict(pk.unpack_values(self.nodedef, data))
+        self._verify(bus, pk.ACCEPT_OK, service, subtype)
+        ok = True
+        if self.on_parameters_set is not None:
+            try:
+                ok = self.on_parameters_set(values) is not False
+            except Exception:  # the application's failure is reported, never raised into the loop
+                ok = False
+        if ok:
+            for pid in values:
+                self.nodedef.parameters[pid].value = values[pid]
+        self._emit(ev.PARAMETERS_SET, now, values=values, ok=ok)
+        self._verify(bus, pk.COMPLETE_OK if ok else pk.COMPLETE_FAIL, service, subtype)
+
+    def _report_ids(self, data):
+        ids = pk.unpack_ids(data)
+        if not ids:
+            raise _Reject("no report ids")
+        for rid in ids:
+            if rid not in self.nodedef.reports:
+                raise _Reject("unknown report %d" % rid)
+        return ids
+
+    def _hk_enable(self, bus, service, subtype, data, now):
+        ids = self._report_ids(data)
+        self._verify(bus, pk.ACCEPT_OK, service, subtype)
+        for rid in ids:
+            self.nodedef.reports[rid].enabled = True
+            if rid not in self._hk_due:
+                self._hk_due[rid] = now + self._interval(rid)
+        self._emit(ev.HK_CHANGED, now, report_ids=ids, enabled=True)
+        self._verify(bus, pk.COMPLETE_OK, service, subtype)
+
+    def _hk_disable(self, bus, service, subtype, data, now):
+        ids = self._report_ids(data)
+        self._verify(bus, pk.ACCEPT_OK, service, subtype)
+        for rid in ids:
+            self.nodedef.reports[rid].enabled = False
+            self._hk_due.pop(rid, None)
+        self._emit(ev.HK_CHANGED, now, report_ids=ids, enabled=False)
+        self._verify(bus, pk.COMPLETE_OK, service, subtype)
+
+    def _hk_one_shot(self, bus, service, subtype, data, now):
+        ids = self._report_ids(data)
+        self._verify(bus, pk.ACCEPT_OK, service, subtype)
+        for rid in ids:
+            self._reply(bus, pk.SERVICE_HOUSEKEEPING, pk.HK_REPORT, pk.pack_hk(self.nodedef, rid))
+        self._verify(bus, pk.COMPLETE_OK, service, subtype)
+
+    def _function(self, bus, service, subtype, data, now):
+        fid, args = pk.unpack_function(self.nodedef, data)
+        self._verify(bus, pk.ACCEPT_OK, service, subtype)
+        ok = True
+        if self.on_function is not None:
+            try:
+                ok = self.on_function(fid, args) is not False
+            except Exception:  # the application's failure is reported, never raised into the loop
+                ok = False
+        self._emit(ev.FUNCTION_CALL, now, function_id=fid, args=args, ok=ok)
+        self._verify(bus, pk.COMPLETE_OK if ok else pk.COMPLETE_FAIL, service, subtype)
+
+    def describe_bus(self):
+        return bus_name(self.monitor.active)

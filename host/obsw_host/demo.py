@@ -8,11 +8,8 @@ import time
 # the system on this machine, prints what happens and cleans up after itself.
 SECTIONS = (
     ("Interaction layer: a component in its own process", "obsw_host.il_demo", "run"),
-    (
-        "SpaceCAN: controller and responder on two redundant buses",
-        "obsw_host.spacecan.demo",
-        "run",
-    ),
+    ("SpaceCAN: a controller and a node on two buses", "obsw_host.spacecan.demo", "run"),
+    ("Space data link: CLTUs and TM frames on two UARTs", "obsw_host.frames.demo", "run"),
 )
 
 

@@ -1,0 +1,145 @@
+"""`obsw frames`: the frame processor on two UARTs, CLTU and TM frame tools, the link demo."""
+
+import binascii
+import json
+
+
+def add_parser(sub):
+    p = sub.add_parser(
+        "frames", help="CCSDS TC/TM frames, CLTUs, frame processor", description=__doc__
+    )
+    s = p.add_subparsers(dest="action", metavar="ACTION")
+    s.required = True
+
+    proc = s.add_parser("processor", help="run the frame processor on two serial ports")
+    proc.add_argument("--uart-a", required=True, help="first link (serial device)")
+    proc.add_argument("--uart-b", required=True, help="second, hot-redundant link")
+    proc.add_argument("--scid", type=lambda v: int(v, 0), default=0x2A, help="spacecraft id")
+    proc.add_argument("--baudrate", type=int, default=115200)
+    proc.add_argument("--host", default="127.0.0.1", help="where the application processes are")
+    proc.add_argument("--port-base", type=int, default=5000, help="TC packets go to base+APID")
+    proc.add_argument("--tm-port", type=int, default=4999, help="UDP port receiving TM packets")
+    proc.add_argument("--frame-length", type=int, default=256, help="TM frame length")
+    proc.add_argument("--essential-map", type=int, default=None, help="MAP ID of HPCs")
+    proc.add_argument("--duration", type=float, default=None, help="stop after N seconds")
+    proc.set_defaults(func=processor)
+
+    cltu = s.add_parser("cltu", help="encode or decode a CLTU")
+    cs = cltu.add_subparsers(dest="cltu_action", metavar="ACTION")
+    cs.required = True
+    enc = cs.add_parser("encode", help="CLTU of a TC frame (hex)")
+    enc.add_argument("hex")
+    enc.add_argument("--randomize", action="store_true", help="apply the TC randomizer")
+    enc.set_defaults(func=cltu_encode)
+    dec = cs.add_parser("decode", help="TC frame (JSON) from a CLTU (hex)")
+    dec.add_argument("hex")
+    dec.add_argument("--randomize", action="store_true", help="remove the TC randomizer")
+    dec.set_defaults(func=cltu_decode)
+
+    tm = s.add_parser("tm", help="decode a TM frame")
+    ts = tm.add_subparsers(dest="tm_action", metavar="ACTION")
+    ts.required = True
+    tdec = ts.add_parser("decode", help="TM frame (hex, ASM and randomization optional)")
+    tdec.add_argument("hex")
+    tdec.add_argument("--randomized", action="store_true", help="frame is TM-randomized")
+    tdec.set_defaults(func=tm_decode)
+
+    demo = s.add_parser("demo", help="ground and frame processor over two pseudo-UARTs")
+    demo.set_defaults(func=run_demo)
+
+
+def _hex(text):
+    return binascii.unhexlify("".join(text.split()))
+
+
+def processor(args):
+    from obsw_host.frames.processor import FrameProcessorHost
+
+    host = FrameProcessorHost(
+        args.uart_a,
+        args.uart_b,
+        args.scid,
+        host=args.host,
+        port_base=args.port_base,
+        tm_port=args.tm_port,
+        tm_frame_length=args.frame_length,
+        essential_map=args.essential_map,
+    )
+    for link in host.links:
+        link.port.baudrate = args.baudrate
+    print("frame processor: %s + %s, TC to UDP %s:%d+APID, TM on UDP %d" % (
+        args.uart_a, args.uart_b, args.host, args.port_base, host.tm_port))  # fmt: skip
+    try:
+        host.run(duration=args.duration)
+    finally:
+        print(json.dumps(host.core.counters))
+        host.close()
+    return 0
+
+
+def cltu_encode(args):
+    from obsw.frames.cltu import encode
+
+    print(binascii.hexlify(encode(_hex(args.hex), args.randomize)).decode())
+    return 0
+
+
+def _frame_json(frame):
+    return {
+        "type": frame.type_name,
+        "scid": frame.scid,
+        "vcid": frame.vcid,
+        "seq": frame.seq,
+        "data": binascii.hexlify(frame.data).decode(),
+    }
+
+
+def cltu_decode(args):
+    from obsw.frames.cltu import decode
+    from obsw.frames.errors import FrameError
+    from obsw.frames.tc import TcFrame
+
+    try:
+        data, fixed = decode(_hex(args.hex), args.randomize)
+        frame = TcFrame.unpack(data, trailing=True)
+    except FrameError as e:
+        raise SystemExit("obsw frames cltu decode: %s" % e) from None
+    out = _frame_json(frame)
+    out["corrected_bits"] = fixed
+    print(json.dumps(out))
+    return 0
+
+
+def tm_decode(args):
+    from obsw.frames.asm import ASM
+    from obsw.frames.errors import FrameError
+    from obsw.frames.randomizer import randomize_tm
+    from obsw.frames.tm import TmFrame
+    from obsw.frames.tm_demux import PacketExtractor
+
+    raw = _hex(args.hex)
+    if raw[:4] == ASM:
+        raw = raw[4:]
+    if args.randomized:
+        raw = randomize_tm(raw)
+    try:
+        frame = TmFrame.unpack(raw)
+    except FrameError as e:
+        raise SystemExit("obsw frames tm decode: %s" % e) from None
+    out = {
+        "scid": frame.scid,
+        "vcid": frame.vcid,
+        "mc_count": frame.mc_count,
+        "vc_count": frame.vc_count,
+        "first_header_pointer": frame.fhp,
+        "ocf": None if frame.ocf is None else binascii.hexlify(frame.ocf).decode(),
+        "packets": [binascii.hexlify(p).decode() for p in PacketExtractor().feed(frame)],
+    }
+    print(json.dumps(out))
+    return 0
+
+
+def run_demo(args):
+    from obsw_host.frames import demo
+
+    return demo.run()

@@ -1,0 +1,1 @@
+"""CCSDS space data link: TC and TM frames, CLTU with BCH, COP-1, ASM, randomizer, processor."""

@@ -1,0 +1,60 @@
+"""Errors raised by the frame decoders: narrow ValueError subclasses that carry what they saw."""
+
+
+class FrameError(ValueError):
+    """Base of every decode error in obsw.frames."""
+
+
+class FrameTooShortError(FrameError):
+    """Fewer bytes than the structure needs."""
+
+    def __init__(self, what, needed, got):
+        super().__init__("%s too short: %d bytes, needs %d" % (what, got, needed))
+        self.what = what
+        self.needed = needed
+        self.got = got
+
+
+class FrameLengthError(FrameError):
+    """A length field or a configured length that does not match the bytes."""
+
+    def __init__(self, what, expected, got):
+        super().__init__("%s length: %d bytes, expected %d" % (what, got, expected))
+        self.what = what
+        self.expected = expected
+        self.got = got
+
+
+class FrameHeaderError(FrameError):
+    """A header field with a value the standard (or this channel's configuration) rules out."""
+
+    def __init__(self, field, value, expected):
+        super().__init__("%s is %r, expected %s" % (field, value, expected))
+        self.field = field
+        self.value = value
+        self.expected = expected
+
+
+class FecfError(FrameError):
+    """Frame error control field does not match the CRC-16 of the frame."""
+
+    def __init__(self, received, computed):
+        super().__init__("FECF is 0x%04X, frame CRC is 0x%04X" % (received, computed))
+        self.received = received
+        self.computed = computed
+
+
+class CltuError(FrameError):
+    """A CLTU without start or tail sequence, or with an uncorrectable codeblock."""
+
+    def __init__(self, msg, block=None):
+        super().__init__(msg)
+        self.block = block
+
+
+class ControlCommandError(FrameError):
+    """A Type-BC frame whose data is neither Unlock nor Set V(R)."""
+
+    def __init__(self, data):
+        super().__init__("control command %r is neither Unlock nor Set V(R)" % (bytes(data),))
+        self.data = bytes(data)

@@ -1,0 +1,205 @@
+"""The frame processor: TC from two hot-redundant links in, packets routed by APID; TM out.
+
+Sans-I/O: the host hands it the bytes read from each link with the time, and writes the CADUs
+it returns to both links. Routing and the essential-command sink are callables.
+"""
+
+from obsw.frames.asm import cadu
+from obsw.frames.cltu import CltuDecoder
+from obsw.frames.dedup import Deduplicator
+from obsw.frames.errors import FecfError, FrameError
+from obsw.frames.farm import ACCEPT, Farm1
+from obsw.frames.tc import TYPE_BC, Reassembler, Segment, TcFrame, frame_length
+from obsw.frames.tm_mux import TmMultiplexer, TmVirtualChannel
+
+COUNTERS = (
+    "cltus",
+    "corrected_bits",
+    "cltus_aborted",
+    "bad_fecf",
+    "invalid_frames",
+    "duplicates",
+    "accepted",
+    "discarded",
+    "packets_routed",
+    "packets_invalid",
+    "essential",
+    "tm_packets",
+    "tm_dropped",
+    "tm_frames",
+)
+
+
+def split_packets(data):
+    """Space packets laid end to end in ``data``; returns (packets, leftover byte count)."""
+    out = []
+    i = 0
+    n = len(data)
+    while n - i >= 7:
+        size = ((data[i + 4] << 8) | data[i + 5]) + 7
+        if i + size > n:
+            break
+        out.append(bytes(data[i : i + size]))
+        i += size
+    return out, n - i
+
+
+class FrameProcessor:
+    """TC transfer frames in (CLTUs on links 0 and 1), TM transfer frames out.
+
+    ``route(apid, packet)`` receives every telecommand packet; ``essential(unit)`` receives
+    what arrives on MAP ``essential_map`` instead (high priority commands). TM packets go in
+    with ``send_packet`` and come out of ``tm_output`` as CADUs for both links.
+    """
+
+    def __init__(
+        self,
+        scid,
+        route,
+        essential=None,
+        essential_map=None,
+        tc_vcids=(0,),
+        segment_header=True,
+        tc_randomized=False,
+        tm_frame_length=256,
+        tm_channels=None,
+        tm_vc_of_apid=None,
+        tm_randomize=True,
+        farm_window=10,
+        dedup_window=2.0,
+        clcw_period=1.0,
+    ):
+        self.scid = scid
+        self.route = route
+        self.essential = essential
+        self.essential_map = essential_map
+        self.segment_header = segment_header
+        self.tm_randomize = tm_randomize
+        self.clcw_period = clcw_period
+        self.farms = {}
+        self._reassembly = {}
+        for v in tc_vcids:
+            self.farms[v] = Farm1(v, farm_window)
+            self._reassembly[v] = Reassembler()
+        self._farm_list = [self.farms[v] for v in sorted(self.farms)]
+        self._ocf_next = 0
+        self.decoders = [CltuDecoder(tc_randomized), CltuDecoder(tc_randomized)]
+        self.dedup = Deduplicator(dedup_window)
+        if tm_channels is None:
+            tm_channels = [TmVirtualChannel(0, 1, name="realtime")]
+        self.mux = TmMultiplexer(scid, tm_frame_length, tm_channels, self._ocf)
+        self.tm_vc_of_apid = tm_vc_of_apid or {}
+        self.tm_default_vcid = self.mux.channels[-1].vcid if tm_channels else 0
+        self.counters = {}
+        for name in COUNTERS:
+            self.counters[name] = 0
+        self._report = True  # send a CLCW soon
+        self._last_tm = None
+
+    def _count(self, name, n=1):
+        self.counters[name] += n
+
+    # -- telecommand ------------------------------------------------------------------------
+
+    def receive(self, link, data, now):
+        """Bytes read from link 0 or 1."""
+        dec = self.decoders[link]
+        before = (dec.corrected, dec.aborted)
+        for block_data in dec.feed(data):
+            self._count("cltus")
+            self.on_frame_data(link, block_data, now)
+        self._count("corrected_bits", dec.corrected - before[0])
+        self._count("cltus_aborted", dec.aborted - before[1])
+
+    def on_frame_data(self, link, data, now):
+        """The data of one decoded CLTU (frame plus fill)."""
+        try:
+            n = frame_length(data)
+            frame = TcFrame.unpack(data, trailing=True)
+        except FecfError:
+            self._count("bad_fecf")
+            return
+        except FrameError:
+            self._count("invalid_frames")
+            return
+        farm = self.farms.get(frame.vcid)
+        if frame.scid != self.scid or farm is None or frame.frame_type == 1:
+            self._count("invalid_frames")
+            return
+        if self.dedup.duplicate(bytes(data[:n]), link, now):
+            self._count("duplicates")
+            return
+        self._report = True
+        if farm.on_frame(frame) != ACCEPT:
+            self._count("discarded")
+            return
+        self._count("accepted")
+        while True:
+            accepted = farm.take()
+            if accepted is None:
+                break
+            if accepted.frame_type != TYPE_BC:
+                self._deliver(accepted)
+
+    def _deliver(self, frame):
+        data = frame.data
+        if self.segment_header:
+            try:
+                seg = Segment.unpack(data)
+            except FrameError:
+                self._count("packets_invalid")
+                return
+            if self.essential_map is not None and seg.map_id == self.essential_map:
+                unit = self._reassembly[frame.vcid].push(seg)
+                if unit is not None:
+                    self._count("essential")
+                    if self.essential is not None:
+                        self.essential(unit)
+                return
+            data = self._reassembly[frame.vcid].push(seg)
+            if data is None:
+                return
+        packets, leftover = split_packets(data)
+        if leftover:
+            self._count("packets_invalid")
+        for p in packets:
+            self._count("packets_routed")
+            self.route(((p[0] & 7) << 8) | p[1], p)
+
+    # -- telemetry --------------------------------------------------------------------------
+
+    def _ocf(self):
+        if not self._farm_list:
+            return None
+        farm = self._farm_list[self._ocf_next % len(self._farm_list)]
+        self._ocf_next += 1
+        return farm.clcw().pack()
+
+    def send_packet(self, packet, vcid=None):
+        """Queue a TM packet on its virtual channel (by APID unless ``vcid`` is given)."""
+        if vcid is None:
+            apid = ((packet[0] & 7) << 8) | packet[1] if len(packet) >= 2 else 0
+            vcid = self.tm_vc_of_apid.get(apid, self.tm_default_vcid)
+        if self.mux.channel(vcid).push(packet):
+            self._count("tm_packets")
+            return True
+        self._count("tm_dropped")
+        return False
+
+    def tm_output(self, now, flush=True):
+        """CADUs to write to both links: full frames by priority, then (with ``flush``) the
+        rest padded with idle data, and an idle frame with the CLCW when one is due."""
+        out = []
+        while True:
+            f = self.mux.frame(flush)
+            if f is None:
+                break
+            out.append(f)
+        due = self._report or self._last_tm is None or now - self._last_tm >= self.clcw_period
+        if not out and due:
+            out.append(self.mux.frame(False, True))
+        if out:
+            self._report = False
+            self._last_tm = now
+        self._count("tm_frames", len(out))
+        return [cadu(f.pack(), self.tm_randomize) for f in out]

@@ -175,6 +175,7 @@ def test_cop1_delivers_every_frame_once_in_order(seed, loss, dup, clcw_loss, reo
     delivered, uplink, downlink = [], [], []
     newest = -1
     now = 0.0
+    sent = 0  # frames put on the uplink so far
     for step in range(40000):
         now += 0.05
         if todo and fop.ready:
@@ -183,9 +184,14 @@ def test_cop1_delivers_every_frame_once_in_order(seed, loss, dup, clcw_loss, reo
             if rng.randrange(100) < loss:
                 continue
             for _ in range(1 + (rng.randrange(100) < dup)):
-                uplink.insert(len(uplink) - rng.randint(0, min(reorder, len(uplink))), fr)
+                # a frame overtakes at most `reorder` frames sent before it: the link reorders
+                # but does not hold a frame back indefinitely, which COP-1 assumes (a frame older
+                # than FARM's negative window would rightly cause Lockout)
+                sent += 1
+                uplink.append((sent - rng.randint(0, reorder), sent, fr))
+        uplink.sort(key=lambda e: e[:2])
         for _ in range(min(3, len(uplink))):
-            fa.on_frame(uplink.pop(0))
+            fa.on_frame(uplink.pop(0)[2])
             while (got := fa.take()) is not None:
                 delivered.append(got.data)
             if rng.randrange(100) >= clcw_loss:

@@ -7,6 +7,7 @@ import time
 # (title, module, function): each function takes `out` (a print-like callable), runs its part of
 # the system on this machine, prints what happens and cleans up after itself.
 SECTIONS = (
+    ("PUS monitoring & control: ground and onboard over UDP", "obsw_host.pus.demo", "run"),
     ("Interaction layer: a component in its own process", "obsw_host.il_demo", "run"),
     ("SpaceCAN: a controller and a node on two buses", "obsw_host.spacecan.demo", "run"),
     ("Space data link: CLTUs and TM frames on two UARTs", "obsw_host.frames.demo", "run"),

@@ -1,0 +1,1 @@
+"""PUS on the host: the on-board process on UDP, the ground process and its scripting API."""

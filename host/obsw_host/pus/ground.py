@@ -1,0 +1,234 @@
+"""The ground application process on the host: service users over UDP, and a scripting API.
+
+    from obsw_host.pus.ground import Ground
+    with Ground(sdb) as ground:               # talks to 127.0.0.1:5000 + the sdb's 'pus' APID
+        tx = ground.ping()                    # a Transaction: tx.ok, tx.reply, tx.verification()
+        hk = ground.housekeeping(1)           # {'sid': 1, 'values': {'SolarPanel.angle': 0.0, ..}}
+        ground.set_parameter("SolarPanel.speed", 7.5)
+        ground.get_parameters("SolarPanel.speed")   # {'SolarPanel.speed': 7.5}
+
+Each call sends its TC and waits (driving the socket) until the completion report, a
+failure report or the timeout; every packet in either direction can be shown on ``log``.
+"""
+
+import select
+import socket
+
+from obsw.il.clock import REAL_CLOCK
+from obsw.pus.services.s03_housekeeping import HousekeepingUser
+from obsw.pus.services.s05_events import EventUser
+from obsw.pus.services.s09_time import TimeUser
+from obsw.pus.services.s17_test import ServiceTestUser
+from obsw.pus.services.s20_parameters import ParameterUser
+from obsw.pus.user import UserProcess
+
+from obsw_host.pus import text
+from obsw_host.pus.onboard import port_for
+
+
+class PusTimeout(TimeoutError):
+    """No completion (or failure) report within the timeout; ``transaction`` has the rest."""
+
+    def __init__(self, tx, timeout):
+        super().__init__(
+            "TC[%d,%d] seq %d: no completion report within %ss (reports so far: %s)"
+            % (tx.tc.service, tx.tc.subtype, tx.tc.seq_count, timeout, tx.verification())
+        )
+        self.transaction = tx
+
+
+class Ground:
+    """Service users of the ground segment on one UDP socket (see the module text)."""
+
+    def __init__(
+        self,
+        sdb=None,
+        *,
+        apid=None,
+        target=None,
+        host="127.0.0.1",
+        timeout=2.0,
+        source_id=None,
+        log=None,
+    ):
+        self.sdb = sdb
+        self.apid = apid if apid is not None else (sdb.apid("pus") if sdb else 10)
+        self.target = target or (host, port_for(self.apid))
+        self.timeout = timeout
+        self.log = log  # callable(str) shown every packet, or None
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.bind((self.target[0], 0))
+        if source_id is None:
+            source_id = sdb.apids.get("ground", 0) if sdb else 0
+        self.proc = UserProcess(self._send, REAL_CLOCK, source_id=source_id)
+        self.proc.listeners.append(self._show)
+        self.received = []  # (tm, decoded) of TM no request asked for (events, periodic HK)
+        self.keep_unsolicited = 1000
+        reg = self.proc.register
+        self.test = reg(ServiceTestUser())
+        self.time = reg(TimeUser())
+        if sdb is not None:
+            types = lambda pid: sdb.parameter(pid).type  # noqa: E731
+            names = lambda pid: sdb.parameter(pid).qualified  # noqa: E731
+            ids = lambda key: sdb.parameter(key).id  # noqa: E731
+            self.hk = reg(HousekeepingUser(types, names, sdb.housekeeping))
+            self.events = reg(EventUser(sdb.event))
+            self.params = reg(ParameterUser(types, names, ids))
+        else:
+            self.hk = self.events = self.params = None
+
+    # -------------------------------------------------------------------------- I/O
+
+    def _send(self, raw):
+        self.sock.sendto(raw, self.target)
+
+    def _show(self, tm, decoded, tx):
+        if tx is None and tm.service != 1:
+            self.received.append((tm, decoded))
+            if len(self.received) > self.keep_unsolicited:
+                del self.received[0]
+        if self.log is not None:
+            self.log(text.tm_line(tm, decoded))
+
+    def send(self, apid, service, subtype, data=b"", expect=None, ack=None):
+        """Send a raw TC through the user process; returns its Transaction."""
+        from obsw.pus.packets import ACK_ALL
+
+        tx = self.proc.send(apid, service, subtype, data, expect, ACK_ALL if ack is None else ack)
+        if self.log is not None:
+            self.log(text.tc_line(tx.tc))
+        return tx
+
+    def poll(self, timeout=0.0):
+        """Receive and decode TM for up to ``timeout`` seconds; returns how many came."""
+        n = 0
+        wait = timeout
+        while True:
+            r, _, _ = select.select([self.sock], [], [], wait)
+            if not r:
+                return n
+            try:
+                data = self.sock.recv(65536)
+            except OSError:
+                return n
+            self.proc.receive(data)
+            n += 1
+            wait = 0
+
+    def wait(self, tx, timeout=None, raise_on_timeout=True):
+        """Drive the socket until ``tx`` is done; returns ``tx``."""
+        timeout = self.timeout if timeout is None else timeout
+        deadline = REAL_CLOCK.now() + timeout
+        while not tx.done:
+            left = deadline - REAL_CLOCK.now()
+            if left <= 0:
+                if raise_on_timeout:
+                    raise PusTimeout(tx, timeout)
+                return tx
+            self.poll(left)
+        return tx
+
+    def _issue(self, tx, timeout=None):
+        if self.log is not None:
+            self.log(text.tc_line(tx.tc))
+        return self.wait(tx, timeout)
+
+    # -------------------------------------------------------------------------- scripting
+
+    def ping(self, apid=None, timeout=None):
+        """TC[17,1] are-you-alive; returns the Transaction (``tx.reply`` is TM[17,2])."""
+        return self._issue(self.test.ping(self.apid if apid is None else apid), timeout)
+
+    def connection_test(self, target, apid=None, timeout=None):
+        """TC[17,3]: ask the process whether on-board process ``target`` answers."""
+        return self._issue(
+            self.test.connection_test(self.apid if apid is None else apid, target), timeout
+        )
+
+    def housekeeping(self, sid, apid=None, timeout=None):
+        """TC[3,27] one-shot report of structure ``sid``; ``tx.reply['values']`` by name."""
+        return self._issue(self.hk.one_shot(self._apid(apid), [sid]), timeout)
+
+    def hk_structures(self, sids, apid=None, timeout=None):
+        """TC[3,9]; ``tx.replies`` holds one TM[3,10] per structure."""
+        return self._issue(self.hk.report_structures(self._apid(apid), sids), timeout)
+
+    def hk_properties(self, sids, apid=None, timeout=None):
+        """TC[3,33]; ``tx.reply['items']`` gives each structure's status and interval."""
+        return self._issue(self.hk.report_properties(self._apid(apid), sids), timeout)
+
+    def create_hk(self, sid, interval, parameters, apid=None, timeout=None):
+        """TC[3,1]: a new structure of parameters (names or IDs), disabled."""
+        pids = [self.sdb.parameter(p).id for p in parameters]
+        return self._issue(self.hk.create(self._apid(apid), sid, interval, pids), timeout)
+
+    def delete_hk(self, sids, apid=None, timeout=None):
+        return self._issue(self.hk.delete(self._apid(apid), sids), timeout)
+
+    def enable_hk(self, sids, apid=None, timeout=None):
+        return self._issue(self.hk.enable(self._apid(apid), sids), timeout)
+
+    def disable_hk(self, sids, apid=None, timeout=None):
+        return self._issue(self.hk.disable(self._apid(apid), sids), timeout)
+
+    def set_hk_interval(self, sid, interval, apid=None, timeout=None):
+        """TC[3,31]: ``interval`` in cycles of the on-board activity loop."""
+        return self._issue(self.hk.modify_interval(self._apid(apid), {sid: interval}), timeout)
+
+    def get_parameters(self, *keys, apid=None, timeout=None):
+        """TC[20,1]; ``tx.reply['values']`` maps names to values."""
+        return self._issue(self.params.report(self._apid(apid), keys), timeout)
+
+    def set_parameter(self, key, value, apid=None, timeout=None):
+        """TC[20,3] for one parameter (name or ID)."""
+        return self.set_parameters({key: value}, apid, timeout)
+
+    def set_parameters(self, values, apid=None, timeout=None):
+        return self._issue(self.params.set(self._apid(apid), values), timeout)
+
+    def _event_ids(self, keys):
+        return [self.sdb.event(k).id for k in keys]
+
+    def enable_events(self, keys, apid=None, timeout=None):
+        return self._issue(self.events.enable(self._apid(apid), self._event_ids(keys)), timeout)
+
+    def disable_events(self, keys, apid=None, timeout=None):
+        return self._issue(self.events.disable(self._apid(apid), self._event_ids(keys)), timeout)
+
+    def disabled_events(self, apid=None, timeout=None):
+        """TC[5,7]; ``tx.reply['ids']`` lists the disabled event IDs."""
+        return self._issue(self.events.report_disabled(self._apid(apid)), timeout)
+
+    def set_time_rate(self, exponent, apid=None, timeout=None):
+        """TC[9,1]: a time report every 2 ** exponent seconds."""
+        return self._issue(self.time.set_rate(self._apid(apid), exponent), timeout)
+
+    def wait_for(self, service, subtype, timeout=None, since=0):
+        """The next TM[service, subtype] no request asked for (an event, a periodic report),
+        as ``(tm, decoded)``, or None after ``timeout`` seconds. ``since`` skips the first
+        entries of ``received`` (pass ``len(ground.received)`` taken before the trigger)."""
+        timeout = self.timeout if timeout is None else timeout
+        deadline = REAL_CLOCK.now() + timeout
+        i = since
+        while True:
+            while i < len(self.received):
+                tm, decoded = self.received[i]
+                i += 1
+                if tm.service == service and tm.subtype == subtype:
+                    return tm, decoded
+            left = deadline - REAL_CLOCK.now()
+            if left <= 0:
+                return None
+            self.poll(min(left, 0.05))
+
+    def _apid(self, apid):
+        return self.apid if apid is None else apid
+
+    def close(self):
+        self.sock.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

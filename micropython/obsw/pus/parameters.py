@@ -1,0 +1,128 @@
+"""The parameter pool: PUS parameter values by id, cached from the interaction layer.
+
+Every attribute the spacecraft database maps to a parameter ID is subscribed to on the
+interaction layer node; each publication refreshes the cache, which is what housekeeping
+and service 20 read. Sets go through the node to the component (``aset`` from asyncio
+handlers, ``set`` from plain code), so the component stays the owner of its state.
+Parameters of no component (the process's own counters) are served by getter functions.
+"""
+
+from obsw.il.errors import InteractionError
+
+_ZERO = {1: False, 2: 0, 3: 0, 4: 0, 5: 0.0, 6: 0, 7: b"", 8: ""}
+
+
+class ParameterError(KeyError):
+    """An unknown parameter ID, or a set that is not allowed; ``pid`` names it."""
+
+    def __init__(self, msg, pid):
+        super().__init__(msg)
+        self.pid = pid
+
+
+class ParameterPool:
+    """Parameter values of ``sdb`` (see the module text); ``timeout`` bounds each call."""
+
+    def __init__(self, sdb, node=None, timeout=1.0):
+        self.sdb = sdb
+        self.node = node
+        self.timeout = timeout
+        self.values = {}  # pid -> last known value
+        self.updates = 0  # publications taken in
+        self.unbound = []  # qualified names that could not be subscribed to
+        self._getters = {}  # pid -> (getter, setter) of process-local parameters
+        self._by_topic = {}
+        self._subs = []
+        for p in sdb.parameters.values():
+            if p.component is not None:
+                self._by_topic[(p.component, p.name)] = p.id
+
+    def parameter(self, pid):
+        p = self.sdb.parameters.get(pid)
+        if p is None:
+            raise ParameterError("no parameter %r" % (pid,), pid)
+        return p
+
+    def __contains__(self, pid):
+        return pid in self.sdb.parameters
+
+    def type_of(self, pid):
+        """The packet field type of parameter ``pid`` (for deduced fields)."""
+        return self.parameter(pid).type
+
+    def provide(self, key, getter, setter=None):
+        """Serve a parameter of no component with ``getter()`` (and ``setter(value)``)."""
+        p = self.sdb.parameter(key)
+        self._getters[p.id] = (getter, setter)
+        return p.id
+
+    def bind(self):
+        """Subscribe to every component attribute on the node and read its current value."""
+        if self.node is None:
+            return 0
+        n = 0
+        self.unbound = []
+        for (comp, member), pid in self._by_topic.items():
+            name = comp + "." + member
+            try:
+                self._subs.append(self.node.subscribe(name, self._published, timeout=self.timeout))
+                self.values[pid] = self.node.get(name, timeout=self.timeout)
+                n += 1
+            except InteractionError:
+                self.unbound.append(name)
+        return n
+
+    def _published(self, pub):
+        pid = self._by_topic.get((pub.component, pub.member))
+        if pid is not None:
+            self.values[pid] = pub.value
+            self.updates += 1
+
+    def get(self, pid):
+        """The value of ``pid``: its getter's, the cached one, the default or zero."""
+        local = self._getters.get(pid)
+        if local is not None:
+            return local[0]()
+        v = self.values.get(pid)
+        if v is not None:
+            return v
+        p = self.parameter(pid)
+        if p.default is not None:
+            return p.default
+        return _ZERO.get(p.type.ptc, 0)
+
+    def _prepare(self, pid, value):
+        p = self.parameter(pid)
+        if not p.writable:
+            raise ParameterError("parameter %s is read-only" % p.qualified, pid)
+        p.type.check(value)
+        return p
+
+    def set(self, pid, value):
+        """Set ``pid`` through its component (blocking call on the node) or its setter."""
+        p = self._prepare(pid, value)
+        local = self._getters.get(pid)
+        if local is not None:
+            if local[1] is None:
+                raise ParameterError("parameter %s has no setter" % p.qualified, pid)
+            local[1](value)
+            return
+        if self.node is None or p.component is None:
+            self.values[pid] = value
+            return
+        self.node.set(p.qualified, value, timeout=self.timeout)
+        self.values[pid] = value
+
+    async def aset(self, pid, value):
+        """``set`` for asyncio handlers: a remote component is awaited, not polled."""
+        p = self._prepare(pid, value)
+        if self._getters.get(pid) is not None or self.node is None or p.component is None:
+            self.set(pid, value)
+            return
+        await self.node.aset(p.qualified, value, timeout=self.timeout)
+        self.values[pid] = value
+
+    def close(self):
+        for s in self._subs:
+            s.cancel()
+        self._subs = []

@@ -1,0 +1,144 @@
+"""ST[03]: every request, provider against user, periodic generation, persisted context."""
+
+import unittest
+
+from obsw.pus.parameters import ParameterPool
+from obsw.pus.services.s01_verification import FAILURE_REFUSED, FAILURE_UNKNOWN_ID
+from obsw.pus.services.s03_housekeeping import Housekeeping, HousekeepingUser
+from obsw.store import Store
+from pus_loop import APID, Loop, sdb
+from store_sim import SimFs
+
+
+def make(store=None):
+    db = sdb()
+    loop = Loop(store=store)
+    pool = ParameterPool(db)
+    pool.values.update({1: 12.5, 2: 3.0, 3: 2, 4: True, 5: "panel"})
+    hk = loop.app.register(Housekeeping(pool, db.housekeeping))
+    user = loop.ground.register(
+        HousekeepingUser(
+            lambda pid: db.parameter(pid).type,
+            lambda pid: db.parameter(pid).qualified,
+            db.housekeeping,
+        )
+    )
+    return loop, hk, user, pool
+
+
+class TestHousekeeping(unittest.TestCase):
+    def test_one_shot_report(self):
+        loop, hk, user, pool = make()
+        tx = loop.run(user.one_shot(APID, [1]))
+        self.assertTrue(tx.ok)
+        self.assertEqual(
+            tx.reply,
+            {"sid": 1, "values": {"Panel.angle": 12.5, "Panel.speed": 3.0, "Panel.mode": 2}},
+        )
+        self.assertEqual(loop.types(), [(1, 1), (1, 3), (3, 25), (1, 7)])
+
+    def test_create_report_structures_and_delete(self):
+        loop, hk, user, pool = make()
+        tx = loop.run(user.create(APID, 7, 3, [4, 5, 100]))
+        self.assertTrue(tx.ok)
+        tx = loop.run(user.report_structures(APID, [7, 1]))
+        self.assertEqual(len(tx.replies), 2)
+        self.assertEqual(
+            tx.replies[0],
+            {"sid": 7, "enabled": False, "interval": 3, "parameters": [4, 5, 100], "groups": []},
+        )
+        self.assertEqual(tx.replies[1]["parameters"], [1, 2, 3])
+        tx = loop.run(user.one_shot(APID, [7]))
+        self.assertEqual(
+            tx.reply["values"], {"Panel.deployed": True, "Panel.label": "panel", "count": 0}
+        )
+        tx = loop.run(user.delete(APID, [7]))
+        self.assertTrue(tx.ok)
+        self.assertEqual(sorted(hk.structures), [1])
+
+    def test_create_refusals(self):
+        loop, hk, user, pool = make()
+        for sid, interval, pids, code in (
+            (1, 3, [1], FAILURE_REFUSED),  # in use
+            (8, 0, [1], FAILURE_REFUSED),  # interval 0
+            (8, 1, [1, 999], FAILURE_UNKNOWN_ID),
+        ):
+            tx = loop.run(user.create(APID, sid, interval, pids))
+            self.assertEqual((tx.failure["stage"], tx.failure["code"]), (2, code))
+        self.assertEqual(sorted(hk.structures), [1])
+
+    def test_enable_disable_and_periodic_reports(self):
+        loop, hk, user, pool = make()
+        self.assertTrue(loop.run(user.enable(APID, [1])).ok)
+        for _ in range(6):
+            loop.app.tick()
+        loop.pump()
+        reports = loop.unsolicited(3, 25)
+        self.assertEqual(len(reports), 3)  # every 2 cycles
+        pool.values[1] = -4.0
+        loop.app.tick()
+        loop.app.tick()
+        loop.pump()
+        self.assertEqual(loop.unsolicited(3, 25)[-1]["values"]["Panel.angle"], -4.0)
+        self.assertTrue(loop.run(user.modify_interval(APID, {1: 4})).ok)
+        tx = loop.run(user.report_properties(APID, [1]))
+        self.assertEqual(tx.reply, {"items": [{"sid": 1, "enabled": True, "interval": 4}]})
+        before = len(loop.unsolicited(3, 25))
+        for _ in range(8):
+            loop.app.tick()
+        loop.pump()
+        self.assertEqual(len(loop.unsolicited(3, 25)) - before, 2)
+        tx = loop.run(user.delete(APID, [1]))
+        self.assertEqual(tx.failure["code"], FAILURE_REFUSED)  # still enabled
+        self.assertTrue(loop.run(user.disable(APID, [1])).ok)
+        before = len(loop.unsolicited(3, 25))
+        for _ in range(8):
+            loop.app.tick()
+        loop.pump()
+        self.assertEqual(len(loop.unsolicited(3, 25)), before)
+
+    def test_unknown_structures(self):
+        loop, hk, user, pool = make()
+        for tx in (
+            user.delete(APID, [9]),
+            user.enable(APID, [1, 9]),
+            user.disable(APID, [9]),
+            user.one_shot(APID, [9]),
+            user.report_structures(APID, [9]),
+            user.modify_interval(APID, {9: 2}),
+            user.report_properties(APID, [9]),
+        ):
+            loop.run(tx)
+            self.assertEqual(
+                (tx.failure["code"], tx.failure["data"]), (FAILURE_UNKNOWN_ID, b"\x00\x09")
+            )
+        self.assertFalse(hk.structures[1].enabled)
+
+    def test_report_of_an_unknown_structure_stays_raw(self):
+        loop, hk, user, pool = make()
+        user.structures.clear()
+        tx = loop.run(user.one_shot(APID, [1]))
+        self.assertEqual(tx.reply["sid"], 1)
+        self.assertEqual(len(tx.reply["raw"]), 9)
+
+    def test_context_survives_a_restart(self):
+        fs = SimFs()
+        loop, hk, user, pool = make(Store("/ctx", fs))
+        loop.run(user.create(APID, 5, 7, [2]))
+        loop.run(user.enable(APID, [5]))
+        loop.run(user.modify_interval(APID, {5: 9}))
+        loop2, hk2, user2, pool2 = make(Store("/ctx", fs))
+        self.assertEqual(sorted(hk2.structures), [1, 5])
+        s = hk2.structures[5]
+        self.assertEqual((s.interval, s.parameters, s.enabled), (9, [2], True))
+
+    def test_broken_context_is_ignored(self):
+        fs = SimFs()
+        Store("/ctx", fs).save("s03", [[5, 1, [999], True]])
+        loop, hk, user, pool = make(Store("/ctx", fs))
+        self.assertEqual(sorted(hk.structures), [1])
+        self.assertEqual(loop.app.counters["context_rejected"], 1)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -342,3 +342,11 @@ FAILURE_ILLEGAL_SUBTYPE = const(4)  # message subtype not supported by the servi
 FAILURE_ILLEGAL_APP_DATA = const(5)  # application data illegal or inconsistent
 # project-defined (the standard leaves further codes to the mission)
 FAILURE_UNSUPPORTED_HEADER = const(6)  # packet version, type, secondary header flag or PUS version
+# project-defined failure codes of start, progress and completion failures
+FAILURE_BUSY = const(7)  # too many requests in progress: the request was not taken
+FAILURE_EXECUTION = const(8)  # the handler failed unexpectedly (a defect, counted)
+FAILURE_UNKNOWN_ID = const(9)  # a structure, parameter or event ID the process does not know
+FAILURE_REFUSED = const(10)  # the request contradicts the current state (e.g. ID in use)
+FAILURE_TIMEOUT = const(11)  # the request did not finish in time and was aborted
+FAILURE_UNAVAILABLE = const(12)  # the component behind the request could not be reached
+FAILURE_COMPONENT = const(13)  # the component refused the request (its error in the data)

@@ -8,7 +8,14 @@ The user decodes the reports; the ground process matches them to its transaction
 
 from obsw.compat import const
 from obsw.pus.messages import (
+    FAILURE_BUSY,
+    FAILURE_COMPONENT,
+    FAILURE_EXECUTION,
     FAILURE_ILLEGAL_APP_DATA,
+    FAILURE_REFUSED,
+    FAILURE_TIMEOUT,
+    FAILURE_UNAVAILABLE,
+    FAILURE_UNKNOWN_ID,
     SERVICE_VERIFICATION,
     TM_VERIFY_ACCEPTANCE_FAILURE,
     TM_VERIFY_ACCEPTANCE_SUCCESS,
@@ -22,16 +29,6 @@ from obsw.pus.messages import (
 )
 from obsw.pus.packets import RequestId
 from obsw.pus.services.base import FAILURE_CODE, STEP_ID, Service, ServiceUser
-
-# Failure codes for start, progress and completion failures. ECSS-E-ST-70-41C leaves them to
-# the mission; the acceptance codes 0..6 are in obsw.pus.messages, these follow them.
-FAILURE_BUSY = const(7)  # too many requests in progress: the request was not taken
-FAILURE_EXECUTION = const(8)  # the handler failed unexpectedly (a defect, counted)
-FAILURE_UNKNOWN_ID = const(9)  # a structure, parameter or event ID the process does not know
-FAILURE_REFUSED = const(10)  # the request contradicts the current state (e.g. ID in use)
-FAILURE_TIMEOUT = const(11)  # the request did not finish in time and was aborted
-FAILURE_UNAVAILABLE = const(12)  # the component behind the request could not be reached
-FAILURE_COMPONENT = const(13)  # the component refused the request (its error in the data)
 
 FAILURE_NAMES = {
     0: "illegal APID",

@@ -41,6 +41,11 @@ def add_parser(sub):
                    help="procedure argument (value as JSON, else text)")  # fmt: skip
     r.add_argument("-q", "--quiet", action="store_true", help="do not print each statement")
     r.set_defaults(func=run_cmd)
+    e = s.add_parser("engine", help="serve the OBCP engine component in this process")
+    from obsw_host.obcp import add_arguments
+
+    add_arguments(e)
+    e.set_defaults(func=engine_cmd)
 
 
 def _type_code(t):
@@ -186,3 +191,9 @@ def run_cmd(args):
     trace = dry_run(_read(args.file), spec, arguments, None if args.quiet else show)
     print(json.dumps(trace, indent=2, default=_json_value))
     return 0 if trace["accept"] and trace["status"] == "confirmed" else 1
+
+
+def engine_cmd(args):
+    from obsw_host.obcp import run_args
+
+    return run_args(args)

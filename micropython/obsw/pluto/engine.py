@@ -1,0 +1,529 @@
+"""The OBCP engine: loaded PLUTO procedures, several running at once, as an IL component.
+
+Each loaded OBCP has a name, its source text and the checked program; activating it starts a
+``Procedure`` against a system of its own (a fork of the engine's ``IlSystem``). The engine
+never blocks: ``step(now)`` runs every procedure that is due for at most ``budget``
+statements and returns ``next_deadline()``; a host runs it from a loop or an asyncio task
+(``serve``), a board from its main loop. ``now`` is the procedure clock (seconds since the
+Unix epoch: ``wait until`` takes absolute times).
+
+States (as in PUS ST[18]): ``inactive`` (loaded), ``running``, ``suspended`` and ``stopping``
+(running to the end of the step it is in). Requests take effect between statements:
+``suspend`` at the next statement boundary, ``stop`` at the first boundary outside the steps
+executing when it was asked, ``abort`` at once (activities waited for are abandoned).
+
+The IL interface ``ENGINE`` declares the operations (load, unload, activate, stop, suspend,
+resume, abort, answer, status), the attributes ``obcps`` and ``states`` and the events
+(progress, outcome, failures, log lines and user messages, each with the OBCP's name).
+Operations refuse with ``ObcpError`` (a ``ComponentError`` whose ``code`` says why).
+"""
+
+from obsw.il.errors import ComponentError
+from obsw.il.interface import DATA, INFO, LOW, MEDIUM, Attribute, Event, Interface, Operation
+from obsw.pluto.interp import Procedure
+from obsw.pluto.interp import load as load_program
+from obsw.pluto.lexer import PlutoError, line_col
+from obsw.pluto.statements import ABORTED, Wait
+from obsw.pluto.units import Quantity
+
+INACTIVE = "inactive"
+RUNNING = "running"
+SUSPENDED = "suspended"
+STOPPING = "stopping"
+
+# why a request was refused (ObcpError.code)
+UNKNOWN_OBCP = "UNKNOWN_OBCP"
+ALREADY_LOADED = "ALREADY_LOADED"
+LOAD_FAILED = "LOAD_FAILED"
+BAD_NAME = "BAD_NAME"
+NO_ROOM = "NO_ROOM"
+NOT_INACTIVE = "NOT_INACTIVE"
+NOT_ACTIVE = "NOT_ACTIVE"
+NOT_RUNNING = "NOT_RUNNING"
+NOT_SUSPENDED = "NOT_SUSPENDED"
+NO_QUESTION = "NO_QUESTION"
+
+ENGINE = Interface(
+    "ObcpEngine",
+    0x18,
+    [
+        Attribute("obcps", 1, DATA, type="list", description="names of the loaded OBCPs"),
+        Attribute("states", 2, DATA, type="map", description="state of each loaded OBCP"),
+        Operation("load", 3, ("name", "source"), description="check and keep a procedure"),
+        Operation("unload", 4, ("name",), description="forget an inactive OBCP"),
+        Operation("activate", 5, ("name", "arguments"), description="start an OBCP"),
+        Operation("stop", 6, ("name",), description="end at the end of the current step"),
+        Operation("suspend", 7, ("name",), description="hold at the next statement"),
+        Operation("resume", 8, ("name",), description="continue a suspended OBCP"),
+        Operation("abort", 9, ("name",), description="end now, status aborted"),
+        Operation("answer", 10, ("name", "value"), description="answer an ask user"),
+        Operation("status", 11, ("name",), returns="map", description="one OBCP's status"),
+        Event("state_changed", 16, INFO, fields=("obcp", "state")),
+        Event("started", 17, INFO, fields=("obcp",)),
+        Event("step_status", 18, INFO, fields=("obcp", "step", "status")),
+        Event("finished", 19, INFO, fields=("obcp", "outcome", "error")),
+        Event("failed", 20, MEDIUM, fields=("obcp", "error")),
+        Event("log", 21, INFO, fields=("obcp", "text")),
+        Event("message", 22, INFO, fields=("obcp", "text")),
+        Event("raised", 23, LOW, fields=("obcp", "event")),
+        Event("question", 24, INFO, fields=("obcp", "text")),
+    ],
+    description="runs PLUTO on-board control procedures",
+)
+
+_OUTPUT_EVENTS = {"log": "log", "inform": "message", "ask": "question"}
+
+
+class ObcpError(ComponentError):
+    """A request the engine refuses; ``code`` is one of the module's reason names."""
+
+    def __init__(self, code, message, data=None):
+        super().__init__(code, message, data, ENGINE.name)
+
+
+class _Steps:
+    """A procedure's step statuses that report every change (the engine's progress events)."""
+
+    def __init__(self, engine, ob):
+        self._d = {}
+        self._engine = engine
+        self._ob = ob
+
+    def __setitem__(self, step, status):
+        self._d[step] = status
+        self._engine._emit("step_status", {"obcp": self._ob.name, "step": step, "status": status})
+
+    def __getitem__(self, step):
+        return self._d[step]
+
+    def __contains__(self, step):
+        return step in self._d
+
+    def __len__(self):
+        return len(self._d)
+
+    def get(self, step, default=None):
+        return self._d.get(step, default)
+
+    def items(self):
+        return self._d.items()
+
+    def copy(self):
+        return dict(self._d)
+
+
+class Obcp:
+    """One loaded procedure and, while active, its running ``Procedure``."""
+
+    def __init__(self, name, source, program, arguments):
+        self.name = name
+        self.source = source
+        self.program = program
+        self.arguments = arguments
+        self.state = INACTIVE
+        self.proc = None
+        self.outcome = None  # of the last activation
+        self.error = None
+        self.steps = {}
+        self.statements = 0
+        self.activations = 0
+        self.requested = None  # "suspend", "stop" or "abort" while it takes effect
+        self.stop_steps = None
+        self.ready = False
+        self.due = None
+
+    def status(self):
+        """The OBCP's status as plain data (the PUS ST[18] status report's content)."""
+        proc = self.proc
+        line = 0
+        question = None
+        steps = self.steps
+        statements = self.statements
+        if proc is not None:
+            cur = getattr(proc, "cur", None)
+            line = line_col(cur[1])[0] if cur else 0
+            question = proc.question
+            steps = proc.step_status.copy()
+            statements = proc.statements
+        return {
+            "name": self.name,
+            "state": self.state,
+            "outcome": self.outcome,
+            "error": self.error,
+            "steps": steps,
+            "statements": statements,
+            "line": line,
+            "question": question,
+            "activations": self.activations,
+            "requested": self.requested,
+        }
+
+
+def _arguments(arguments):
+    """Procedure arguments from the wire: ``{"value": v, "unit": u}`` becomes a Quantity."""
+    if not arguments:
+        return None
+    if not isinstance(arguments, dict):
+        raise ObcpError(LOAD_FAILED, "arguments must be a map of name to value", arguments)
+    out = {}
+    for k, v in arguments.items():
+        if isinstance(v, dict) and "value" in v and "unit" in v:
+            v = Quantity(v["value"], v["unit"])
+        out[k] = v
+    return out
+
+
+class ObcpEngine:
+    """Loads, runs and controls OBCPs (see the module text).
+
+    ``system`` is an ``IlSystem`` (or any ``System``; one with ``fork`` gives each procedure
+    its own outputs); it also answers the load-time checks unless ``check`` is False.
+    ``capacity`` bounds the loaded OBCPs, ``budget`` the statements one procedure runs per
+    ``step``, ``poll`` how often a waiting condition is re-evaluated (seconds).
+    ``on_event(name, payload)`` sees every event (a PUS service 5 bridge), besides the
+    interaction layer's subscribers once the engine is provided on a node.
+    """
+
+    def __init__(self, system, *, capacity=8, budget=100, poll=1.0, check=True):
+        self.system = system
+        self.capacity = capacity
+        self.budget = budget
+        self.poll = poll
+        self.check = check
+        self.on_event = None
+        self.on_wake = None
+        self.il = None
+        self.now = 0
+        self._obcps = {}
+        self._order = []  # names in load order (dicts keep no order on MicroPython)
+        if getattr(system, "on_wake", 0) is None:
+            system.on_wake = self._wake
+
+    def il_bind(self, provider):
+        self.il = provider
+
+    # -------------------------------------------------------------------------- attributes
+
+    @property
+    def obcps(self):
+        """Names of the loaded OBCPs, in load order."""
+        return list(self._order)
+
+    @property
+    def states(self):
+        return {n: self._obcps[n].state for n in self._order}
+
+    def list(self):
+        """Status of every loaded OBCP."""
+        return [self._obcps[n].status() for n in self._order]
+
+    def status(self, name):
+        return self._get(name).status()
+
+    # -------------------------------------------------------------------------- requests
+
+    def load(self, name, source, arguments=None):
+        """Check ``source`` and keep it as OBCP ``name``, inactive. ``arguments`` are
+        default procedure arguments (their names and types are checked with the text)."""
+        if not isinstance(name, str) or not name or len(name) > 64:
+            raise ObcpError(BAD_NAME, "OBCP name must be a text of 1 to 64 characters", name)
+        if name in self._obcps:
+            raise ObcpError(ALREADY_LOADED, "OBCP %s is already loaded" % name, name)
+        if len(self._obcps) >= self.capacity:
+            raise ObcpError(
+                NO_ROOM, "%d OBCPs loaded, the engine holds %d" % (self.capacity, self.capacity)
+            )
+        if isinstance(source, (bytes, bytearray)):
+            source = bytes(source).decode()
+        arguments = _arguments(arguments)
+        ob = Obcp(name, source, self._compile(name, source, arguments), arguments)
+        self._obcps[name] = ob
+        self._order.append(name)
+        self._changed(ob, INACTIVE, True)
+
+    def load_file(self, name, path, arguments=None):
+        """``load`` from a procedure file on the file system."""
+        try:
+            with open(path) as f:
+                source = f.read()
+        except OSError as e:
+            raise ObcpError(LOAD_FAILED, "cannot read %s: %s" % (path, e), path) from None
+        self.load(name, source, arguments)
+
+    def unload(self, name):
+        ob = self._get(name)
+        if ob.state != INACTIVE:
+            raise ObcpError(NOT_INACTIVE, "OBCP %s is %s; stop it first" % (name, ob.state))
+        del self._obcps[name]
+        self._order.remove(name)
+        self._changed(ob, "unloaded", True)
+
+    def activate(self, name, arguments=None):
+        """Start OBCP ``name``; it runs from the next ``step``."""
+        ob = self._get(name)
+        if ob.state != INACTIVE:
+            raise ObcpError(NOT_INACTIVE, "OBCP %s is %s" % (name, ob.state))
+        args = _arguments(arguments)
+        program = ob.program
+        if args:
+            program = self._compile(name, ob.source, args)
+        else:
+            args = ob.arguments
+        fork = getattr(self.system, "fork", None)
+        if fork is not None:
+            system = fork(lambda kind, text: self._output(ob, kind, text))
+            system.on_wake = lambda: self._wake(ob)
+        else:
+            system = self.system
+        proc = Procedure(program, system, args, poll=self.poll)
+        proc.step_status = _Steps(self, ob)
+        proc.start(self.now)
+        ob.proc = proc
+        ob.activations += 1
+        ob.outcome = ob.error = ob.requested = ob.stop_steps = None
+        ob.ready = True
+        self._changed(ob, RUNNING)
+        self._emit("started", {"obcp": name})
+        self._wake(ob)
+
+    def suspend(self, name):
+        """Hold OBCP ``name`` at its next statement boundary."""
+        ob = self._get(name)
+        if ob.state != RUNNING:
+            raise ObcpError(NOT_RUNNING, "OBCP %s is %s" % (name, ob.state))
+        ob.proc.suspend()
+        ob.requested = "suspend"
+        self._wake(ob)
+
+    def resume(self, name):
+        ob = self._get(name)
+        if ob.state != SUSPENDED and ob.requested != "suspend":
+            raise ObcpError(NOT_SUSPENDED, "OBCP %s is %s" % (name, ob.state))
+        ob.proc.resume()
+        ob.requested = None
+        if ob.state == SUSPENDED:
+            self._changed(ob, RUNNING)
+        self._wake(ob)
+
+    def stop(self, name):
+        """End OBCP ``name`` once the steps it executes now have ended (at once if none)."""
+        ob = self._active(name)
+        steps = [s for s, st in ob.proc.step_status.items() if st == "executing"]
+        ob.requested = "stop"
+        if not steps or ob.state == SUSPENDED:
+            self._end(ob, "stopped by request")
+            return
+        ob.stop_steps = steps
+        self._changed(ob, STOPPING)
+        self._wake(ob)
+
+    def abort(self, name, reason="aborted by request"):
+        """End OBCP ``name`` now with status aborted."""
+        ob = self._active(name)
+        ob.requested = "abort"
+        self._end(ob, reason)
+
+    def abort_all(self, reason="aborted by request"):
+        for ob in self._in_order():
+            if ob.proc is not None:
+                ob.requested = "abort"
+                self._end(ob, reason)
+
+    def answer(self, name, value):
+        """Deliver the operator's answer to the question OBCP ``name`` waits on."""
+        ob = self._active(name)
+        if ob.proc.question is None:
+            raise ObcpError(NO_QUESTION, "OBCP %s asks nothing" % name)
+        ob.proc.answer(value)
+        self._wake(ob)
+
+    # -------------------------------------------------------------------------- running
+
+    def step(self, now):
+        """Run every OBCP that is due at ``now``; return ``next_deadline()``."""
+        self.now = now
+        for ob in self._in_order():
+            if ob.proc is None or (ob.state != RUNNING and ob.state != STOPPING):
+                continue
+            if ob.ready or (ob.due is not None and ob.due <= now):
+                self._run(ob, now)
+        return self.next_deadline()
+
+    def next_deadline(self):
+        """When ``step`` has work next (a time not after the last ``now`` means at once), or
+        None while every active OBCP waits for an answer, a wake-up or is suspended."""
+        best = None
+        for ob in self._obcps.values():
+            if ob.proc is None or (ob.state != RUNNING and ob.state != STOPPING):
+                continue
+            d = self.now if ob.ready else ob.due
+            if d is not None and (best is None or d < best):
+                best = d
+        return best
+
+    def active(self):
+        """Number of OBCPs running, stopping or suspended."""
+        return len([1 for ob in self._obcps.values() if ob.proc is not None])
+
+    async def serve(self, clock, idle=1.0):
+        """Run from an asyncio task: ``clock()`` gives the procedure time; wakes on activity
+        (an activation, an operation's outcome, an event) or at the next deadline."""
+        import asyncio  # only here: boards without asyncio still import this module
+
+        ev = asyncio.Event()
+        self.on_wake = ev.set
+        try:
+            while True:
+                ev.clear()
+                d = self.step(clock())
+                delay = idle if d is None else min(idle, d - clock())
+                if delay > 0:
+                    try:
+                        await asyncio.wait_for(ev.wait(), delay)
+                    except asyncio.TimeoutError:
+                        pass
+                else:
+                    await asyncio.sleep(0)
+        finally:
+            self.on_wake = None
+
+    def _run(self, ob, now):
+        ob.ready = False
+        proc = ob.proc
+        try:
+            if ob.stop_steps is not None:
+                w = self._run_to_step_end(ob, now)
+            else:
+                w = proc.run(now, self.budget)
+        except Exception as e:  # a fault in a system adapter ends this OBCP, not the engine
+            proc.abort("internal error: %s: %s" % (type(e).__name__, e))
+            w = None
+        if ob.proc is not proc:
+            return
+        if proc.state == "finished":
+            self._finished(ob)
+        elif proc.state == "suspended":
+            ob.due = None
+            ob.requested = None
+            self._changed(ob, SUSPENDED)
+        else:
+            ob.due = w.deadline if w is not None else now
+
+    def _run_to_step_end(self, ob, now):
+        proc = ob.proc
+        status = proc.step_status
+        for _ in range(self.budget):
+            if not [s for s in ob.stop_steps if status.get(s) == "executing"]:
+                proc.abort("stopped by request at the end of step %s" % ", ".join(ob.stop_steps))
+                return None
+            w = proc.run(now, 1)
+            if proc.state != "running" or w is None:
+                return w
+            if w.activities or w.prompt or w.deadline is None or w.deadline > now:
+                return w  # a real wait, not the end of the one-statement budget
+        return Wait(now)
+
+    def _end(self, ob, reason):
+        ob.proc.abort(reason)
+        if ob.proc.state == "finished":
+            self._finished(ob)
+
+    def _finished(self, ob):
+        proc = ob.proc
+        ob.proc = None
+        ob.outcome = proc.outcome
+        ob.error = proc.error
+        ob.steps = proc.step_status.copy()
+        ob.statements = proc.statements
+        ob.due = None
+        ob.ready = False
+        ob.stop_steps = None
+        by_request = ob.requested in ("stop", "abort")
+        ob.requested = None
+        self._emit("finished", {"obcp": ob.name, "outcome": ob.outcome, "error": ob.error})
+        if ob.outcome == ABORTED and not by_request:
+            self._emit("failed", {"obcp": ob.name, "error": ob.error or "aborted"})
+        self._changed(ob, INACTIVE)
+
+    # -------------------------------------------------------------------------- helpers
+
+    def _compile(self, name, source, arguments):
+        try:
+            return load_program(source, self.system if self.check else None, arguments)
+        except PlutoError as e:
+            errors = getattr(e, "errors", None) or [e]
+            raise ObcpError(
+                LOAD_FAILED,
+                "OBCP %s rejected: line %d, column %d: %s" % (name, e.line, e.col, e.msg),
+                {
+                    "kind": e.kind,
+                    "line": e.line,
+                    "column": e.col,
+                    "message": e.msg,
+                    "errors": [[x.kind, x.line, x.col, x.msg] for x in errors],
+                },
+            ) from None
+
+    def _in_order(self):
+        return [self._obcps[n] for n in self._order]
+
+    def _get(self, name):
+        ob = self._obcps.get(name)
+        if ob is None:
+            raise ObcpError(UNKNOWN_OBCP, "no OBCP %s loaded" % (name,), name)
+        return ob
+
+    def _active(self, name):
+        ob = self._get(name)
+        if ob.proc is None:
+            raise ObcpError(NOT_ACTIVE, "OBCP %s is %s" % (name, ob.state))
+        return ob
+
+    def _changed(self, ob, state, listing=False):
+        ob.state = state
+        self._emit("state_changed", {"obcp": ob.name, "state": state})
+        il = self.il
+        if il is not None:
+            if listing:
+                il.node.publish(il.name, "obcps", self.obcps)
+            il.node.publish(il.name, "states", self.states)
+
+    def _output(self, ob, kind, text):
+        if kind == "raise":
+            self._emit("raised", {"obcp": ob.name, "event": text})
+        else:
+            self._emit(_OUTPUT_EVENTS.get(kind, "log"), {"obcp": ob.name, "text": text})
+
+    def _emit(self, event, payload):
+        if self.il is not None:
+            self.il.emit(event, payload)
+        if self.on_event is not None:
+            self.on_event(event, payload)
+
+    def _wake(self, ob=None):
+        if ob is None:
+            for x in self._obcps.values():
+                if x.proc is not None:
+                    x.ready = True
+        elif ob.proc is not None:
+            ob.ready = True
+        if self.on_wake is not None:
+            self.on_wake()
+
+
+def provide(node, sdb=None, interfaces=(), *, timeout=1.0, activity_timeout=30.0, **options):
+    """An engine on ``node`` with an ``IlSystem``, provided as component ``ENGINE``;
+    returns the engine (``options`` go to ``ObcpEngine``)."""
+    from obsw.pluto.il_system import IlSystem
+
+    system = IlSystem(
+        node,
+        sdb,
+        interfaces,
+        timeout=timeout,
+        activity_timeout=activity_timeout,
+        user=ENGINE.name,
+    )
+    engine = ObcpEngine(system, **options)
+    node.provide(ENGINE, engine)
+    return engine

@@ -54,6 +54,21 @@ class TestLexer(unittest.TestCase):
         self.assertEqual(cm.exception.kind, "syntax_error")
 
 
+class TestNonAsciiDigits(unittest.TestCase):
+    def test_superscript_digit_is_a_syntax_error(self):
+        # CPython's str.isdigit() accepts "\u00b2"; the lexer must not take it for a number
+        with self.assertRaises(PlutoSyntaxError):
+            tokenize("\u00b2")
+        with self.assertRaises(PlutoSyntaxError):
+            tokenize("x := 1\u00b2;")
+
+    def test_isdigits_is_ascii_only(self):
+        self.assertTrue(units.isdigits("0123456789"))
+        self.assertFalse(units.isdigits(""))
+        self.assertFalse(units.isdigits("\u00b2"))
+        self.assertFalse(units.isdigits("1a"))
+
+
 class TestUnits(unittest.TestCase):
     def test_symbols_with_prefixes(self):
         self.assertEqual(units.symbol("km")[0], 1000)

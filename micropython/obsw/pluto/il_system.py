@@ -22,7 +22,7 @@ procedure) is aborted.
 from obsw.il.errors import COMPONENT_ERROR, OK, InteractionError, error_from_reply
 from obsw.pluto.statements import ABORTED, CONFIRMED, NOT_CONFIRMED
 from obsw.pluto.system import System
-from obsw.pluto.units import AbsTime, Quantity, UnitError
+from obsw.pluto.units import AbsTime, Quantity, UnitError, isdigits
 from obsw.pluto.units import parse as parse_unit
 
 
@@ -59,7 +59,7 @@ def type_code(t):
         return "b"
     if t.startswith("f") or t in ("real", "double"):
         return "r"
-    if t.startswith("uint") or t.startswith("int") or (t[0] in "ui" and t[1:].isdigit()):
+    if t.startswith("uint") or t.startswith("int") or (t[0] in "ui" and isdigits(t[1:])):
         return "i"
     if t.startswith("str") or t == "text":
         return "s"
@@ -467,7 +467,7 @@ class IlSystem(System):
 
 def _position(item):
     k = item[0]
-    if k.startswith("arg") and k[3:].isdigit():
+    if k.startswith("arg") and isdigits(k[3:]):
         return (0, int(k[3:]), "")
     return (1, 0, k)
 

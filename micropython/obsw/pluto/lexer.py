@@ -1,6 +1,6 @@
 """PLUTO lexer: words, numbers, strings, time literals and operators, each with line and column."""
 
-from obsw.pluto.units import UnitError, parse_iso
+from obsw.pluto.units import UnitError, isdigits, parse_iso
 
 # Token kinds
 WORD = "w"
@@ -69,7 +69,7 @@ def tokenize(src):
             while i < n and src[i] != "\n":
                 i += 1
             continue
-        if c.isdigit():
+        if isdigits(c):
             i = _number(src, i, n, out, p)
             after_num = True
             continue
@@ -79,7 +79,7 @@ def tokenize(src):
                 while j < n and src[j].isalpha():
                     j += 1
             else:
-                while j < n and (src[j].isalpha() or src[j].isdigit() or src[j] == "_"):
+                while j < n and (src[j].isalpha() or isdigits(src[j]) or src[j] == "_"):
                     j += 1
             w = src[i:j]
             out.append((WORD, seen.setdefault(w, w), p))
@@ -118,7 +118,7 @@ def tokenize(src):
 
 def _digits(src, i, n):
     j = i
-    while j < n and src[j].isdigit():
+    while j < n and isdigits(src[j]):
         j += 1
     return j
 
@@ -133,18 +133,18 @@ def _number(src, i, n, out, p):
         out.append((NUM, int(src[i + 2 : j], 16), p))
         return j
     j = _digits(src, i, n)
-    if src[j : j + 1] == "-" and j - i == 4 and src[j + 1 : j + 2].isdigit():
+    if src[j : j + 1] == "-" and j - i == 4 and isdigits(src[j + 1 : j + 2]):
         k = j + 1
-        while k < n and (src[k].isdigit() or src[k] in "-:.TZ"):
+        while k < n and (isdigits(src[k]) or src[k] in "-:.TZ"):
             k += 1
         try:
             out.append((ABST, parse_iso(src[i:k]), p))
         except UnitError:
             raise PlutoSyntaxError("malformed absolute time %r" % src[i:k], *line_col(p)) from None
         return k
-    if src[j : j + 1] == ":" and src[j + 1 : j + 3].isdigit() and src[j + 3 : j + 4] == ":":
+    if src[j : j + 1] == ":" and isdigits(src[j + 1 : j + 3]) and src[j + 3 : j + 4] == ":":
         k = j
-        while k < n and (src[k].isdigit() or src[k] in ":."):
+        while k < n and (isdigits(src[k]) or src[k] in ":."):
             k += 1
         parts = src[i:k].split(":")
         if len(parts) not in (4, 5):
@@ -155,14 +155,14 @@ def _number(src, i, n, out, p):
         out.append((RELT, v, p))
         return k
     real = False
-    if src[j : j + 1] == "." and src[j + 1 : j + 2].isdigit():
+    if src[j : j + 1] == "." and isdigits(src[j + 1 : j + 2]):
         j = _digits(src, j + 1, n)
         real = True
     if src[j : j + 1] in ("e", "E"):
         k = j + 1
         if src[k : k + 1] in ("+", "-"):
             k += 1
-        if src[k : k + 1].isdigit():
+        if isdigits(src[k : k + 1]):
             j = _digits(src, k, n)
             real = True
     out.append((NUM, float(src[i:j]) if real else int(src[i:j]), p))

@@ -8,6 +8,16 @@ NONE = (0, 0, 0, 0, 0, 0, 0, 0)
 TIME = (0, 0, 1, 0, 0, 0, 0, 0)
 
 
+def isdigits(s):
+    """True for a non-empty string of ASCII digits (str.isdigit also takes '²' on CPython)."""
+    if not s:
+        return False
+    for c in s:
+        if c < "0" or c > "9":
+            return False
+    return True
+
+
 class UnitError(ValueError):
     """A unit text that is not Annex B, or an operation mixing incompatible dimensions."""
 
@@ -159,7 +169,7 @@ class _UnitParser:
         if self.peek() == "-":
             sign, self.i = -1, self.i + 1
         j = self.i
-        while self.peek().isdigit():
+        while isdigits(self.peek()):
             self.i += 1
         if j == self.i:
             raise UnitError("unit %r: expected an exponent" % self.t)
@@ -168,7 +178,7 @@ class _UnitParser:
             if self.peek() == "/":
                 self.i += 1
                 j = self.i
-                while self.peek().isdigit():
+                while isdigits(self.peek()):
                     self.i += 1
                 e = e / int(self.t[j : self.i] or "1")
             if self.peek() != ")":

@@ -307,7 +307,9 @@ def test_spacepackets_tcs_are_served():
     for seq in range(3):
         tc = SpTc(apid=APID, service=17, message_subtype=1, seq_count=seq, source_id=3)
         loop.app.receive(tc.pack())
-    tc = SpTc(apid=APID, service=17, message_subtype=3, app_data=struct.pack(">H", APID), seq_count=3)
+    tc = SpTc(
+        apid=APID, service=17, message_subtype=3, app_data=struct.pack(">H", APID), seq_count=3
+    )
     loop.app.receive(tc.pack())
     loop.pump()
     assert [t.subtype for t in loop.tm if t.service == 17] == [2, 2, 2, 4]

@@ -120,7 +120,7 @@ class TestFailover(unittest.TestCase):
         net.run(1.0)
         fired = []
         r.on_function = lambda fid, args: fired.append(fid)
-        req = c.call_function(1, 1, None, net.now)  # frames queued, not yet on the bus
+        req = c.call_function(1, 1, net.now)  # frames queued, not yet on the bus
         net.kill(BUS_A)
         self.assertTrue(net.run_until(lambda: req.done, 5.0))
         self.assertEqual(req.status, COMPLETED)

@@ -134,11 +134,11 @@ class TestServices(unittest.TestCase):
         c, r, net = setup()
         calls = []
         r.on_function = lambda fid, args: calls.append((fid, args))
-        req = run(net, c.call_function(1, 1, {1: 1}, net.now))
+        req = run(net, c.call_function(1, 1, net.now, {1: 1}))
         self.assertEqual(req.status, COMPLETED)
         self.assertEqual(calls, [(1, {1: 1})])
         self.assertEqual(frames(net)[0], (0x281, "0000080101010101"))
-        req = run(net, c.call_function(1, 2, None, net.now))
+        req = run(net, c.call_function(1, 2, net.now))
         self.assertEqual(req.status, COMPLETED)
         self.assertEqual(frames(net)[0], (0x281, "0000080102"))
         self.assertEqual(calls[-1], (2, {}))
@@ -146,16 +146,16 @@ class TestServices(unittest.TestCase):
     def test_function_failure_and_rejection(self):
         c, r, net = setup()
         r.on_function = lambda fid, args: False
-        self.assertEqual(run(net, c.call_function(1, 2, None, net.now)).status, FAILED)
+        self.assertEqual(run(net, c.call_function(1, 2, net.now)).status, FAILED)
 
         def boom(fid, args):
             raise RuntimeError("line stuck")
 
         r.on_function = boom
-        req = run(net, c.call_function(1, 2, None, net.now))
+        req = run(net, c.call_function(1, 2, net.now))
         self.assertEqual(req.status, FAILED)
         self.assertEqual(req.reports, [1, 8])
-        self.assertEqual(run(net, c.call_function(1, 9, None, net.now)).status, REJECTED)
+        self.assertEqual(run(net, c.call_function(1, 9, net.now)).status, REJECTED)
         # an argument missing
         req = run(net, c.request(1, 8, 1, h("01"), net.now))
         self.assertEqual(req.status, REJECTED)

@@ -54,7 +54,7 @@ def test_services_over_virtual_can(pair):
     assert ca.request(lambda now: ctrl.ping(1, now)).status == COMPLETED
     req = ca.request(lambda now: ctrl.request_parameters(1, [1, 2], now))
     assert req.result == {1: 3, 2: -20}
-    req = ca.request(lambda now: ctrl.call_function(1, 1, {1: 500}, now))
+    req = ca.request(lambda now: ctrl.call_function(1, 1, now, {1: 500}))
     assert req.status == COMPLETED and fired == [(1, {1: 500})]
     req = ca.request(lambda now: ctrl.set_parameters(1, {1: 4}, now))
     assert req.status == COMPLETED and resp.get_value(1) == 4
@@ -69,7 +69,7 @@ def test_bus_a_dies_mid_command(pair):
     assert ca.request(lambda now: ctrl.ping(1, now)).status == COMPLETED
 
     def start(now):
-        req = ctrl.call_function(1, 1, {1: 7}, now)
+        req = ctrl.call_function(1, 1, now, {1: 7})
         faults.kill(0)  # the frames of this command never make it onto bus A
         return req
 

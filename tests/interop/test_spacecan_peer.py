@@ -194,7 +194,7 @@ def test_periodic_housekeeping(ours_theirs):
 def test_function_call_known_upstream_defect(ours_theirs):
     """spacecan 0.8.1's responder raises TypeError for every 8,1 and never answers."""
     o = ours_theirs
-    req = o.ad.request(lambda now: o.ctrl.call_function(1, 2, None, now, retries=0))
+    req = o.ad.request(lambda now: o.ctrl.call_function(1, 2, now, retries=0))
     assert req.status == TIMEOUT
     assert req.reports == []
 
@@ -203,7 +203,7 @@ def test_function_call_known_upstream_defect(ours_theirs):
 @pytest.mark.xfail(strict=True, reason="known upstream: spacecan 0.8.1 responder breaks on 8,1")
 def test_function_call_completes(ours_theirs):
     o = ours_theirs
-    req = o.ad.request(lambda now: o.ctrl.call_function(1, 1, {1: 1}, now, retries=0))
+    req = o.ad.request(lambda now: o.ctrl.call_function(1, 1, now, {1: 1}, retries=0))
     assert req.status == COMPLETED
 
 

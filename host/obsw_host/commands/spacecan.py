@@ -1,4 +1,5 @@
-"""`obsw spacecan`: the SpaceCAN demo, a bus monitor, a simulated responder node and a ping."""
+"""`obsw spacecan`: the SpaceCAN demo, a bus monitor, a simulated responder node, a ping and
+the OBC's master with its equipment components on the interaction layer."""
 
 
 def add_parser(sub):
@@ -31,6 +32,18 @@ def add_parser(sub):
     r.add_argument("--heartbeat-period", type=float, default=0.5)
     r.set_defaults(func=responder)
 
+    ms = s.add_parser(
+        "master",
+        help="serve the SpaceCAN master and equipment components to other processes",
+        description="The OBC side: SpaceCanMaster and one equipment component per node "
+        "(attributes fed by housekeeping, operations mapped to service 8 functions), served "
+        "on the interaction layer; other processes use them through proxies.",
+    )
+    from obsw_host.spacecan import obc
+
+    obc.add_arguments(ms)
+    ms.set_defaults(func=master)
+
     g = s.add_parser("ping", help="run a controller and ping a node (17,1)")
     bus_args(g)
     g.add_argument("--node-id", type=int, required=True)
@@ -42,6 +55,12 @@ def demo(args):
     from obsw_host.spacecan import demo as d
 
     return d.run()
+
+
+def master(args):
+    from obsw_host.spacecan import obc
+
+    return obc.run(args)
 
 
 def _nodedef(path, node_id):

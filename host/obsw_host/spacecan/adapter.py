@@ -2,6 +2,9 @@
 
 One loop thread owns the state machine; one reader thread per bus only queues frames. Code on
 other threads reaches the state machine through `call(fn)` (fn(now) runs in the loop thread).
+Or the application owns the state machine: `start(loop=False)` starts the readers only and the
+application's own loop calls `run_pending()` when `wake` says frames came (or when
+`next_wait()` has passed); the OBC does this to serve the interaction layer in the same thread.
 Interfaces: "socketcan" (Raspberry Pi, channels e.g. can0/can1), "virtual" and "udp_multicast"
 (simulation; udp_multicast needs msgpack), or anything python-can knows.
 """
@@ -31,8 +34,9 @@ class AdapterError(RuntimeError):
 
 
 def filters_for(node):
-    """python-can receive filters: every REP id for a controller, a responder's own ids."""
-    if isinstance(node, Controller):
+    """python-can receive filters: every REP id for a controller (or the master wrapping one),
+    a responder's own ids."""
+    if isinstance(getattr(node, "controller", node), Controller):
         return [{"can_id": ID_REP, "can_mask": FUNCTION_MASK, "extended": False}]
     ids = (ID_HEARTBEAT, ID_SYNC, ID_SCET, ID_UTC, node._req_id)
     return [{"can_id": i, "can_mask": FULL_MASK, "extended": False} for i in ids]
@@ -101,10 +105,12 @@ class CanAdapter:
         faults=None,
         clock=time.monotonic,
         bitrate=None,
+        wake=None,
         **bus_kwargs,
     ):
         self.node = node
         self.clock = clock
+        self.wake = wake  # called (from reader threads too) whenever something was queued
         self.faults = faults
         self.channels = tuple(channels)
         self._own_buses = buses is None
@@ -128,21 +134,33 @@ class CanAdapter:
         self._stop = threading.Event()
         self._threads = []
         self._loop_thread = None
+        self._driven = False
+        self._driver = None
         self.last_error = None
 
     # -- life cycle ----------------------------------------------------------------------------
 
-    def start(self):
-        """Start the reader threads and the loop thread (daemons; stop() ends them)."""
-        if self._loop_thread is not None:
+    def start(self, loop=True):
+        """Start the reader threads and the loop thread (daemons; stop() ends them).
+
+        With ``loop=False`` no loop thread is started: the node is started here and the
+        caller's thread drives it with ``run_pending()`` (see the module text).
+        """
+        if self._loop_thread is not None or self._driven:
             return self
         self._stop.clear()
         for i, bus in enumerate(self.buses):
             t = threading.Thread(target=self._reader, args=(i, bus), daemon=True)
             t.start()
             self._threads.append(t)
-        self._loop_thread = threading.Thread(target=self._loop, daemon=True)
-        self._loop_thread.start()
+        if loop:
+            self._loop_thread = threading.Thread(target=self._loop, daemon=True)
+            self._loop_thread.start()
+        else:
+            self._driven = True
+            self._driver = threading.get_ident()
+            self.node.start(self.clock())
+            self._flush()
         return self
 
     def stop(self):
@@ -151,6 +169,7 @@ class CanAdapter:
             t.join(2.0)
         self._threads = []
         self._loop_thread = None
+        self._driven = False
 
     def close(self):
         """Stop and shut down the buses this adapter opened."""
@@ -180,6 +199,8 @@ class CanAdapter:
             if self.faults is not None and not self.faults.incoming(index):
                 continue
             self._inbox.put((index, msg.arbitration_id, bytes(msg.data)))
+            if self.wake is not None:
+                self.wake()
 
     def _loop(self):
         node = self.node
@@ -205,6 +226,44 @@ class CanAdapter:
             except Exception as e:  # the loop must outlive any one bad frame or callback
                 self.counters["loop_errors"] += 1
                 self.last_error = e
+
+    def run_pending(self):
+        """Driven mode: handle the frames and calls queued so far, run what is due and send
+        what the node produced; return how many items were handled. Never raises: errors are
+        counted in ``loop_errors`` and kept in ``last_error``, as in the loop thread."""
+        self._driver = threading.get_ident()
+        n = 0
+        try:
+            while True:
+                try:
+                    item = self._inbox.get_nowait()
+                except queue.Empty:
+                    break
+                n += 1
+                self._handle(item)
+            self.node.poll(self.clock())
+            self._flush()
+        except Exception as e:  # the driving loop must outlive any one bad frame or callback
+            self.counters["loop_errors"] += 1
+            self.last_error = e
+        return n
+
+    def flush(self):
+        """Driven mode: send the frames the node has produced (e.g. after a new request)."""
+        try:
+            self._flush()
+        except Exception as e:  # as in run_pending
+            self.counters["loop_errors"] += 1
+            self.last_error = e
+
+    def next_wait(self, limit=_MAX_WAIT):
+        """Seconds until the node's next deadline, at most ``limit`` (0 when items wait)."""
+        if not self._inbox.empty():
+            return 0.0
+        due = self.node.next_deadline()
+        if due is None:
+            return limit
+        return min(max(due - self.clock(), 0.0), limit)
 
     def _handle(self, item):
         if len(item) == 3:  # (bus, can_id, data); calls are 4-tuples
@@ -265,13 +324,20 @@ class CanAdapter:
         self._listeners.append(fn)
 
     def call(self, fn, timeout=5.0):
-        """Run fn(now) in the loop thread (here if the loop is not running); return its value."""
-        if self._loop_thread is None:
+        """Run fn(now) in the loop thread (here if the loop is not running, or if this is the
+        driving thread); return its value."""
+        if self._loop_thread is None and (
+            not self._driven or self._driver == threading.get_ident()
+        ):
             result = fn(self.clock())
+            if self._driven:
+                self.flush()
             return result
         box = []
         done = threading.Event()
         self._inbox.put(("call", fn, box, done))
+        if self.wake is not None:
+            self.wake()
         if not done.wait(timeout):
             raise AdapterError("call into the SpaceCAN loop did not run within %.1f s" % timeout)
         ok, value = box[0]

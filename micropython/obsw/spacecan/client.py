@@ -122,8 +122,13 @@ class ServiceClient:
         data = pk.pack_values(self._nodedef(node_id), values)
         return self.request(node_id, pk.SERVICE_PARAMETER, pk.PARAM_SET, data, now, **kw)
 
-    def call_function(self, node_id, function_id, args=None, now=0, **kw):
-        """(8,1) perform function with args {argument_id: value}."""
+    def call_function(self, node_id, function_id, now, args=None, **kw):
+        """(8,1) perform function with args {argument_id: value} (None or {} for none)."""
+        if args is not None and not isinstance(args, dict):
+            raise RequestError(
+                "function arguments must be a dict {argument_id: value} or None, got %r" % (args,),
+                node_id,
+            )
         data = pk.pack_function(self.nodes.get(node_id), function_id, args)
         return self.request(node_id, pk.SERVICE_FUNCTION, pk.FUNCTION_PERFORM, data, now, **kw)
 

@@ -254,6 +254,8 @@ class Controller(ServiceClient):
     def request(self, node_id, service, subtype, data, now, timeout=None, retries=None):
         """Queue a service request to node_id; returns the Request that tracks it."""
         check_node_id(node_id)
+        if not isinstance(now, (int, float)) or isinstance(now, bool):
+            raise RequestError("now must be a time in seconds, got %r" % (now,), node_id)
         data = bytes(data)
         if len(data) + 2 > 1536:
             raise RequestError("request too long: %d bytes of data" % len(data), node_id)

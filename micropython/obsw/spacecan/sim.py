@@ -157,3 +157,37 @@ class SimNetwork:
             else:
                 stuck = 0
                 self.now = t
+
+
+class NetworkClock:
+    """An interaction-layer clock on the network's simulated time, for IL nodes in tests.
+
+    ``now()`` is the network's time. ``sleep(seconds)`` is what a blocked IL caller does: it
+    lets the watched IL nodes run their providers and callbacks first, and if they had nothing
+    to do, moves the network on to its next deadline (or by ``seconds`` if that comes first).
+    It returns early in either case, so the caller re-checks what it waits for.
+    """
+
+    def __init__(self, network):
+        self.network = network
+        self.nodes = []
+
+    def watch(self, node):
+        """Run ``node.poll()`` whenever a caller waits (a node built on this clock)."""
+        self.nodes.append(node)
+        return node
+
+    def now(self):
+        return self.network.now
+
+    def sleep(self, seconds):
+        busy = 0
+        for node in self.nodes:
+            busy += node.poll()
+        if busy:
+            return
+        net = self.network
+        end = net.now + (seconds if seconds > 0 else 0)
+        t = net.next_deadline()
+        step = (end if t is None or t > end else t) - net.now
+        net.run(step if step > 0 else 0)

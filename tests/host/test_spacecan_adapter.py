@@ -173,3 +173,25 @@ def test_pyb_shim_with_fake_can():
     assert drv.counters["tx_errors"] == 1 and resp.health[1].tx_errors == 1
     t[0] = 10.0
     assert drv.next_wait_ms(10) == 0
+
+
+def test_udp_multicast_buses_stay_apart():
+    # Two multicast groups on one port reach every socket bound to that port: the adapter must
+    # give bus B a port of its own, or a frame on bus A would also arrive on bus B.
+    import can
+
+    groups = ("239.74.163.12", "239.74.163.13")
+    adapter = CanAdapter(Controller(), interface="udp_multicast", channels=groups)
+    listeners = [
+        can.Bus(interface="udp_multicast", channel=g, port=43113 + i) for i, g in enumerate(groups)
+    ]
+    try:
+        adapter.buses[0].send(can.Message(arbitration_id=0x301, data=b"A", is_extended_id=False))
+        got_a = listeners[0].recv(2.0)
+        got_b = listeners[1].recv(0.3)
+    finally:
+        for bus in listeners:
+            bus.shutdown()
+        adapter.close()
+    assert got_a is not None and bytes(got_a.data) == b"A"
+    assert got_b is None

@@ -29,6 +29,10 @@ from obsw.spacecan.ids import (
 _MAX_WAIT = 0.05  # longest the loop sleeps with nothing due, so stop() is prompt
 
 
+# python-can's default udp_multicast port; bus B uses the next one
+UDP_MULTICAST_PORT = 43113
+
+
 class AdapterError(RuntimeError):
     """The loop is not running, or a call into it did not finish in time."""
 
@@ -119,12 +123,18 @@ class CanAdapter:
 
             if bitrate is not None:
                 bus_kwargs["bitrate"] = bitrate
-            buses = [
-                can.Bus(
-                    interface=interface, channel=ch, can_filters=filters_for(node), **bus_kwargs
+            buses = []
+            for index, ch in enumerate(self.channels):
+                kwargs = dict(bus_kwargs)
+                if interface == "udp_multicast":
+                    # Linux hands every group joined on a port to each socket bound to that
+                    # port, so bus A and bus B need a port each to stay apart.
+                    kwargs["port"] = kwargs.get("port", UDP_MULTICAST_PORT) + index
+                buses.append(
+                    can.Bus(
+                        interface=interface, channel=ch, can_filters=filters_for(node), **kwargs
+                    )
                 )
-                for ch in self.channels
-            ]
         self.buses = list(buses)
         self.events = collections.deque((), 10000)
         self.counters = {"rx": 0, "tx": 0, "tx_errors": 0, "loop_errors": 0}

@@ -9,7 +9,7 @@ import time
 SECTIONS = (
     ("PUS monitoring & control: ground and onboard over UDP", "obsw_host.pus.demo", "run"),
     ("Interaction layer: a component in its own process", "obsw_host.il_demo", "run"),
-    ("SpaceCAN: the OBC master and equipment, a node on two buses", "obsw_host.spacecan.demo", "run"),
+    ("SpaceCAN: OBC master and equipment, a node on two buses", "obsw_host.spacecan.demo", "run"),
     ("Space data link: CLTUs and TM frames on two UARTs", "obsw_host.frames.demo", "run"),
     ("CFDP: class 2 file delivery over a lossy link, and a get", "obsw_host.cfdp.demo", "run"),
     ("OBCP engine: a PLUTO procedure drives a component", "obsw_host.obcp", "demo"),

@@ -12,6 +12,21 @@
     obsw ground events disabled | enable NAME.. | disable NAME.. | listen
     obsw ground time rate 0 | listen
     obsw ground connection 10
+    obsw ground function SolarPanel.set_angle angle=15          service 8
+    obsw ground schedule insert --in 10 function SolarPanel.set_angle angle=20
+    obsw ground schedule insert --at 2030-01-01T00:00:00Z ping
+    obsw ground schedule list | summary | shift 30 | delete 0:10:5 | enable | disable | reset
+    obsw ground position insert 120 set SolarPanel.speed=2      service 22
+    obsw ground position list
+    obsw ground monitor add 1 SolarPanel.speed 0.5 10 --high-event monitoring.speed_high
+    obsw ground monitor list | out-of-limits | enable 1 | disable 1 | delete 1
+    obsw ground action add monitoring.speed_high set SolarPanel.speed=5
+    obsw ground action list | enable EVENT | disable EVENT | delete EVENT
+    obsw ground sequence load warmup "0 ping" "2 function SolarPanel.set_angle angle=10"
+    obsw ground sequence status | content warmup | activate warmup | abort warmup | unload warmup
+
+A request to schedule, sequence or run as an action is ``ping``, ``function NAME
+[ARG=VALUE..]`` or ``set NAME=VALUE..``; activities are named SOURCE:APID:SEQ.
 
 ``--json`` prints one JSON object per command instead of text; ``-v`` shows every packet.
 """
@@ -90,6 +105,8 @@ def add_parser(sub):
     x.add_argument("--seconds", type=float, default=3.0)
     x.set_defaults(func=_listen, listen=(5, None))
 
+    _add_automation(s)
+
     ti = s.add_parser("time", help="service 9 time").add_subparsers(dest="time")
     ti.required = True
     x = ti.add_parser("rate", help="TC[9,1] report every 2**EXPONENT s")
@@ -98,6 +115,83 @@ def add_parser(sub):
     x = ti.add_parser("listen", help="print time reports")
     x.add_argument("--seconds", type=float, default=3.0)
     x.set_defaults(func=_listen, listen=(9, 2))
+
+
+def _add_automation(s):
+    x = s.add_parser("function", help="TC[8,1] perform a function")
+    x.add_argument("name", help="function name or ID")
+    x.add_argument("arguments", nargs="*", metavar="ARG=VALUE")
+    x.set_defaults(func=_function)
+
+    for svc, name, tag in (("schedule", "time-based", "--in"), ("position", "position-based", "")):
+        sp = s.add_parser(
+            svc, help="service %s %s scheduling" % ((11, 22)[svc == "position"], name)
+        )
+        sp = sp.add_subparsers(dest=svc)
+        sp.required = True
+        x = sp.add_parser("insert", help="insert one activity")
+        if tag:
+            when = x.add_mutually_exclusive_group(required=True)
+            when.add_argument("--in", dest="delay", type=float, help="seconds from now")
+            when.add_argument("--at", help="UTC release time, YYYY-MM-DDTHH:MM:SS[.fff]Z")
+        else:
+            x.add_argument("position", type=int)
+        x.add_argument("--subschedule", type=int, default=0)
+        x.add_argument("--group", type=int, default=0)
+        x.add_argument("request", nargs="+", help="ping | function NAME ARG=V.. | set NAME=V..")
+        x.set_defaults(func=_sched_insert, service=svc)
+        for action in ("list", "summary", "enable", "disable", "reset"):
+            sp.add_parser(action).set_defaults(func=_sched_simple, service=svc, what=action)
+        x = sp.add_parser("shift", help="shift all activities (or --ids)")
+        x.add_argument("offset", type=float)
+        x.add_argument("--ids", nargs="+", metavar="SOURCE:APID:SEQ")
+        x.set_defaults(func=_sched_shift, service=svc)
+        x = sp.add_parser("delete", help="delete activities")
+        x.add_argument("ids", nargs="+", metavar="SOURCE:APID:SEQ")
+        x.set_defaults(func=_sched_delete, service=svc)
+
+    mo = s.add_parser("monitor", help="service 12 on-board monitoring").add_subparsers(dest="mon")
+    mo.required = True
+    x = mo.add_parser("add", help="TC[12,5] add a limit check and enable it")
+    x.add_argument("pmon", type=int)
+    x.add_argument("parameter")
+    x.add_argument("low", type=float)
+    x.add_argument("high", type=float)
+    x.add_argument("--low-event", default="0")
+    x.add_argument("--high-event", default="0")
+    x.add_argument("--repetitions", type=int, default=1)
+    x.add_argument("--interval", type=int, default=1, help="in on-board cycles")
+    x.set_defaults(func=_monitor_add)
+    for action in ("list", "out-of-limits"):
+        mo.add_parser(action).set_defaults(func=_monitor_simple, what=action)
+    for action in ("enable", "disable", "delete"):
+        x = mo.add_parser(action)
+        x.add_argument("ids", type=int, nargs="+")
+        x.set_defaults(func=_monitor_ids, what=action)
+
+    ac = s.add_parser("action", help="service 19 event-action").add_subparsers(dest="act")
+    ac.required = True
+    x = ac.add_parser("add", help="TC[19,1] run a request on an event, and enable it")
+    x.add_argument("event")
+    x.add_argument("request", nargs="+")
+    x.set_defaults(func=_action_add)
+    ac.add_parser("list").set_defaults(func=_action_list)
+    for action in ("enable", "disable", "delete"):
+        x = ac.add_parser(action)
+        x.add_argument("events", nargs="+")
+        x.set_defaults(func=_action_events, what=action)
+
+    se = s.add_parser("sequence", help="service 21 request sequencing").add_subparsers(dest="seq")
+    se.required = True
+    x = se.add_parser("load", help='TC[21,1]: steps like "DELAY REQUEST.."')
+    x.add_argument("name")
+    x.add_argument("steps", nargs="+")
+    x.set_defaults(func=_sequence_load)
+    se.add_parser("status").set_defaults(func=_sequence_status)
+    for action in ("content", "activate", "abort", "unload"):
+        x = se.add_parser(action)
+        x.add_argument("name")
+        x.set_defaults(func=_sequence_named, what=action)
 
 
 def _raw():
@@ -130,6 +224,9 @@ def _run(args, fn):
             tx = e.transaction
         except KeyError as e:
             print("obsw ground: %s" % e.args[0], file=sys.stderr)
+            return 2
+        except ValueError as e:  # a value the request's field cannot carry
+            print("obsw ground: %s" % e, file=sys.stderr)
             return 2
     result = text.transaction(tx)
     if args.json:
@@ -270,3 +367,187 @@ def _learn(g, tm, decoded):
         return g.hk.decode_report(tm)
     except Exception:
         return decoded
+
+
+# ------------------------------------------------------------------------------ automation
+
+
+def _fresh(g):
+    """Sequence counts that differ from an earlier run's, so request IDs stay unique."""
+    import time
+
+    from obsw.spp import SequenceCounter
+
+    g.proc.sequence = SequenceCounter(int(time.time() * 16) & 0x3FFF)
+    return g
+
+
+def _assignments(words):
+    out = {}
+    for w in words:
+        name, sep, value = w.partition("=")
+        if not sep:
+            raise KeyError("expected NAME=VALUE, got %r" % w)
+        out[_key(name)] = _value(value)
+    return out
+
+
+def _request(g, words):
+    """The on-board request a command line names (a Transaction, not sent)."""
+    kind = words[0] if words else ""
+    if kind == "ping" and len(words) == 1:
+        return g.request(17, 1)
+    if kind == "function" and len(words) >= 2:
+        args = {str(k): v for k, v in _assignments(words[2:]).items()}
+        return g.function_request(_key(words[1]), **args)
+    if kind == "set" and len(words) >= 2:
+        return g.parameter_request(_assignments(words[1:]))
+    raise KeyError(
+        "request: ping | function NAME [ARG=VALUE..] | set NAME=VALUE.., got %r" % words
+    )
+
+
+def _rid(text):
+    try:
+        source, apid, seq = (int(x) for x in text.split(":"))
+    except ValueError:
+        raise KeyError("activity SOURCE:APID:SEQ, got %r" % text) from None
+    return (source, apid, seq)
+
+
+def _function(args):
+    def go(g):
+        values = {str(k): v for k, v in _assignments(args.arguments).items()}
+        return g.perform(_key(args.name), **values)
+
+    return _run(args, go)
+
+
+def _sched_insert(args):
+    def go(g):
+        request = _request(_fresh(g), args.request)
+        if args.service == "position":
+            user = g.position
+            item = (args.position, request, args.subschedule, args.group)
+        else:
+            from obsw.utc import parse_utc
+
+            from obsw_host.pus.onboard import tai_now
+
+            at = parse_utc(args.at) if args.at else tai_now() + args.delay
+            user = g.schedule
+            item = (at, request, args.subschedule, args.group)
+        return g._issue(user.insert(g.apid, [item]))
+
+    return _run(args, go)
+
+
+def _sched_user(g, args):
+    return g.position if args.service == "position" else g.schedule
+
+
+def _sched_simple(args):
+    def go(g):
+        user = _sched_user(g, args)
+        fn = {
+            "list": user.detail_all,
+            "summary": user.summary_all,
+            "enable": user.enable,
+            "disable": user.disable,
+            "reset": user.reset,
+        }[args.what]
+        return g._issue(fn(g.apid))
+
+    return _run(args, go)
+
+
+def _sched_shift(args):
+    def go(g):
+        user = _sched_user(g, args)
+        offset = int(args.offset) if args.service == "position" else args.offset
+        if args.ids:
+            return g._issue(user.shift(g.apid, offset, [_rid(i) for i in args.ids]))
+        return g._issue(user.shift_all(g.apid, offset))
+
+    return _run(args, go)
+
+
+def _sched_delete(args):
+    return _run(
+        args, lambda g: g._issue(_sched_user(g, args).delete(g.apid, [_rid(i) for i in args.ids]))
+    )
+
+
+def _monitor_add(args):
+    def go(g):
+        return g.add_limit_monitor(
+            args.pmon,
+            _key(args.parameter),
+            args.low,
+            args.high,
+            _key(args.low_event),
+            _key(args.high_event),
+            repetitions=args.repetitions,
+            interval=args.interval,
+        )
+
+    return _run(args, go)
+
+
+def _monitor_simple(args):
+    if args.what == "list":
+        return _run(args, lambda g: g.monitors())
+    return _run(args, lambda g: g.out_of_limits())
+
+
+def _monitor_ids(args):
+    if args.what == "delete":
+        return _run(args, lambda g: g.delete_monitors(args.ids))
+    return _run(args, lambda g: g.enable_monitors(args.ids, args.what == "enable"))
+
+
+def _action_add(args):
+    return _run(args, lambda g: g.add_action(_key(args.event), _request(_fresh(g), args.request)))
+
+
+def _action_list(args):
+    return _run(args, lambda g: g.actions())
+
+
+def _action_events(args):
+    events = [_key(e) for e in args.events]
+    if args.what == "delete":
+        return _run(args, lambda g: g.delete_actions(events))
+    return _run(args, lambda g: g.enable_actions(events, args.what == "enable"))
+
+
+def _sequence_load(args):
+    import shlex
+
+    def go(g):
+        _fresh(g)
+        items = []
+        for step in args.steps:
+            words = shlex.split(step)
+            try:
+                delay = float(words[0])
+            except (ValueError, IndexError):
+                raise KeyError("sequence step 'DELAY REQUEST..', got %r" % step) from None
+            items.append((_request(g, words[1:]), delay))
+        return g.load_sequence(args.name, items)
+
+    return _run(args, go)
+
+
+def _sequence_status(args):
+    return _run(args, lambda g: g.sequences())
+
+
+def _sequence_named(args):
+    method = {
+        "content": "sequence_content",
+        "activate": "activate_sequence",
+        "abort": "abort_sequence",
+        "unload": "unload_sequence",
+    }[args.what]
+    return _run(args, lambda g: getattr(g, method)(args.name))

@@ -1,7 +1,9 @@
 """PUS demo: an on-board process and a ground process on loopback UDP (port 5000 + APID).
 
 ``run(out=print)`` pings the on-board process and prints every packet decoded on the ground
-side, one line each; then housekeeping of the solar panel, a parameter set, and an event.
+side, one line each; then housekeeping of the solar panel, a parameter set, an event, and
+on-board automation: a parameter crossing its limit raises an event (service 12) that fires
+an action (service 19), and a time-tagged TC (service 11) runs at its release time.
 """
 
 import os
@@ -106,4 +108,38 @@ def _steps(onboard, ground, out):
         from obsw.utc import format_utc
 
         out("  => on-board time %s" % format_utc(got[1]["time"]))
+    ok &= _automation(ground, out)
     return bool(ok)
+
+
+def _automation(ground, out):
+    ok = True
+    out("7. automation: monitoring (12) -> event (5) -> event-action (19); time-tagged TC (11)")
+    tx = ground.add_limit_monitor(
+        1,
+        "SolarPanel.speed",
+        0.5,
+        10.0,
+        low_event="monitoring.speed_low",
+        high_event="monitoring.speed_high",
+    )
+    ok &= _check(out, tx, "PMON 1 checks SolarPanel.speed within [0.5, 10] deg/s")
+    action = ground.parameter_request({"SolarPanel.speed": 5.0})
+    tx = ground.add_action("monitoring.speed_high", action)
+    ok &= _check(out, tx, "on monitoring.speed_high, set SolarPanel.speed to 5 deg/s")
+    timed = ground.function_request("SolarPanel.set_angle", angle=15.0)
+    ok &= _check(out, ground.schedule_in(1.0, timed), "SolarPanel.set_angle(15) in 1 s")
+    mark = len(ground.received)
+    ok &= _check(out, ground.set_parameter("SolarPanel.speed", 12.0), "speed set to 12 deg/s")
+    got = ground.wait_for(5, 3, timeout=2.0, since=mark)
+    ok &= got is not None
+    out("  => event %s" % (got[1] if got else "MISSING"))
+    ground.wait(action, 2.0, raise_on_timeout=False)
+    ok &= _check(out, action, "event-action TC[20,3] ran on board")
+    ground.wait(timed, 3.0, raise_on_timeout=False)
+    ok &= _check(out, timed, "time-tagged TC[8,1] ran at its release time")
+    tx = ground.get_parameters("SolarPanel.speed", "SolarPanel.angle")
+    values = (tx.reply or {}).get("values", {})
+    ok &= _check(out, tx, "now %s" % values)
+    ok &= values.get("SolarPanel.speed") == 5.0 and values.get("SolarPanel.angle") == 15.0
+    return ok

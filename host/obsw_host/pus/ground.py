@@ -6,6 +6,13 @@
         hk = ground.housekeeping(1)           # {'sid': 1, 'values': {'SolarPanel.angle': 0.0, ..}}
         ground.set_parameter("SolarPanel.speed", 7.5)
         ground.get_parameters("SolarPanel.speed")   # {'SolarPanel.speed': 7.5}
+        ground.perform("SolarPanel.set_angle", angle=15.0)          # service 8
+        act = ground.function_request("SolarPanel.set_angle", angle=20.0)
+        ground.schedule_in(5.0, act)          # service 11; act.ok once it has run on board
+        ground.add_limit_monitor(1, "SolarPanel.speed", 0.5, 10.0,
+                                 high_event="monitoring.speed_high")   # service 12
+        ground.add_action("monitoring.speed_high",
+                          ground.parameter_request({"SolarPanel.speed": 5.0}))  # 19
 
 Each call sends its TC and waits (driving the socket) until the completion report, a
 failure report or the timeout; every packet in either direction can be shown on ``log``.
@@ -17,13 +24,19 @@ import socket
 from obsw.il.clock import REAL_CLOCK
 from obsw.pus.services.s03_housekeeping import HousekeepingUser
 from obsw.pus.services.s05_events import EventUser
+from obsw.pus.services.s08_functions import FunctionUser, functions
 from obsw.pus.services.s09_time import TimeUser
+from obsw.pus.services.s11_scheduling import TimeSchedulingUser
+from obsw.pus.services.s12_user import OnBoardMonitoringUser, limit_check
 from obsw.pus.services.s17_test import ServiceTestUser
+from obsw.pus.services.s19_event_action import EventActionUser
 from obsw.pus.services.s20_parameters import ParameterUser
+from obsw.pus.services.s21_sequencing import RequestSequencingUser
+from obsw.pus.services.s22_position_scheduling import PositionSchedulingUser
 from obsw.pus.user import UserProcess
 
 from obsw_host.pus import text
-from obsw_host.pus.onboard import port_for
+from obsw_host.pus.onboard import port_for, tai_now
 
 
 class PusTimeout(TimeoutError):
@@ -67,6 +80,10 @@ class Ground:
         reg = self.proc.register
         self.test = reg(ServiceTestUser())
         self.time = reg(TimeUser())
+        self.schedule = reg(TimeSchedulingUser())
+        self.position = reg(PositionSchedulingUser())
+        self.event_action = reg(EventActionUser())
+        self.sequencing = reg(RequestSequencingUser())
         if sdb is not None:
             types = lambda pid: sdb.parameter(pid).type  # noqa: E731
             names = lambda pid: sdb.parameter(pid).qualified  # noqa: E731
@@ -74,8 +91,10 @@ class Ground:
             self.hk = reg(HousekeepingUser(types, names, sdb.housekeeping))
             self.events = reg(EventUser(sdb.event))
             self.params = reg(ParameterUser(types, names, ids))
+            self.functions = reg(FunctionUser(functions(sdb)))
+            self.monitoring = reg(OnBoardMonitoringUser(types, ids))
         else:
-            self.hk = self.events = self.params = None
+            self.hk = self.events = self.params = self.functions = self.monitoring = None
 
     # -------------------------------------------------------------------------- I/O
 
@@ -202,6 +221,168 @@ class Ground:
     def set_time_rate(self, exponent, apid=None, timeout=None):
         """TC[9,1]: a time report every 2 ** exponent seconds."""
         return self._issue(self.time.set_rate(self._apid(apid), exponent), timeout)
+
+    # -------------------------------------------------------------------------- automation
+
+    def request(self, service, subtype, data=b"", apid=None):
+        """A TC for on-board use (scheduled, sequenced, an action), not sent: its
+        Transaction, open, so its reports are matched whenever it runs on board."""
+        return self.schedule.embed(self._apid(apid), service, subtype, data)[1]
+
+    def function_request(self, key, apid=None, **arguments):
+        """A TC[8,1] for on-board use (see ``request``)."""
+        return self.request(8, 1, self.functions.pack(key, arguments), apid)
+
+    def parameter_request(self, values, apid=None):
+        """A TC[20,3] for on-board use (see ``request``)."""
+        items = [{"id": self.sdb.parameter(k).id, "value": v} for k, v in values.items()]
+        return self.request(20, 3, self.params.layout.pack({"items": items}), apid)
+
+    def perform(self, key, apid=None, timeout=None, **arguments):
+        """TC[8,1]: perform function ``key`` (ID or name) with named arguments."""
+        return self._issue(self.functions.perform(self._apid(apid), key, arguments), timeout)
+
+    def schedule_at(self, at, request, subschedule=0, group=0, apid=None, timeout=None):
+        """TC[11,4]: release ``request`` (a Transaction of ``request``) at on-board TAI ``at``."""
+        items = [(at, request, subschedule, group)]
+        return self._issue(self.schedule.insert(self._apid(apid), items), timeout)
+
+    def schedule_in(self, seconds, request, **options):
+        """TC[11,4] releasing ``request`` ``seconds`` from now (the ground's clock)."""
+        return self.schedule_at(tai_now() + seconds, request, **options)
+
+    def scheduled(self, apid=None, timeout=None):
+        """TC[11,16]; ``tx.reply['activities']`` lists the time-based schedule."""
+        return self._issue(self.schedule.detail_all(self._apid(apid)), timeout)
+
+    def schedule_summary(self, apid=None, timeout=None):
+        """TC[11,17]; ``tx.reply['activities']`` names the activities by request ID."""
+        return self._issue(self.schedule.summary_all(self._apid(apid)), timeout)
+
+    def shift_schedule(self, seconds, ids=None, apid=None, timeout=None):
+        """TC[11,15] (all) or TC[11,7] (``ids``: request IDs or transactions)."""
+        a = self._apid(apid)
+        if ids is None:
+            return self._issue(self.schedule.shift_all(a, seconds), timeout)
+        return self._issue(self.schedule.shift(a, seconds, ids), timeout)
+
+    def unschedule(self, ids, apid=None, timeout=None):
+        """TC[11,5]: delete activities by request ID (or transaction)."""
+        return self._issue(self.schedule.delete(self._apid(apid), ids), timeout)
+
+    def enable_schedule(self, enabled=True, apid=None, timeout=None):
+        """TC[11,1] or TC[11,2]."""
+        user = self.schedule
+        tx = user.enable(self._apid(apid)) if enabled else user.disable(self._apid(apid))
+        return self._issue(tx, timeout)
+
+    def reset_schedule(self, apid=None, timeout=None):
+        return self._issue(self.schedule.reset(self._apid(apid)), timeout)
+
+    def schedule_at_position(self, position, request, apid=None, timeout=None):
+        """TC[22,4]: release ``request`` when the position parameter reaches ``position``."""
+        return self._issue(self.position.insert(self._apid(apid), [(position, request)]), timeout)
+
+    def position_scheduled(self, apid=None, timeout=None):
+        """TC[22,16]; ``tx.reply['activities']`` lists the position-based schedule."""
+        return self._issue(self.position.detail_all(self._apid(apid)), timeout)
+
+    def add_limit_monitor(
+        self,
+        pmon,
+        parameter,
+        low,
+        high,
+        low_event=0,
+        high_event=0,
+        apid=None,
+        timeout=None,
+        **options,
+    ):
+        """TC[12,5] for one limit check (events by name or ID; 0: none), then TC[12,1]."""
+        d = limit_check(
+            pmon,
+            parameter,
+            low,
+            high,
+            self._event_id(low_event),
+            self._event_id(high_event),
+            **options,
+        )
+        tx = self._issue(self.monitoring.add(self._apid(apid), [d]), timeout)
+        if not tx.ok:
+            return tx
+        return self.enable_monitors([pmon], apid=apid, timeout=timeout)
+
+    def add_monitors(self, definitions, apid=None, timeout=None):
+        """TC[12,5] for definitions built with ``obsw.pus.services.s12_user``."""
+        return self._issue(self.monitoring.add(self._apid(apid), definitions), timeout)
+
+    def enable_monitors(self, ids, enabled=True, apid=None, timeout=None):
+        """TC[12,1] or TC[12,2]."""
+        user = self.monitoring
+        fn = user.enable if enabled else user.disable
+        return self._issue(fn(self._apid(apid), ids), timeout)
+
+    def delete_monitors(self, ids, apid=None, timeout=None):
+        return self._issue(self.monitoring.delete(self._apid(apid), ids), timeout)
+
+    def monitors(self, ids=(), apid=None, timeout=None):
+        """TC[12,8]; ``tx.reply['items']`` are the definitions (all if no ``ids``)."""
+        return self._issue(self.monitoring.report_definitions(self._apid(apid), ids), timeout)
+
+    def out_of_limits(self, apid=None, timeout=None):
+        """TC[12,10]; ``tx.reply['items']`` are the parameters now out of limits."""
+        return self._issue(self.monitoring.report_out_of_limits(self._apid(apid)), timeout)
+
+    def _event_id(self, key):
+        return key if isinstance(key, int) else self.sdb.event(key).id
+
+    def add_action(self, event, request, apid=None, timeout=None, enable=True):
+        """TC[19,1] running ``request`` when ``event`` (name or ID) occurs, then TC[19,4]."""
+        a = self._apid(apid)
+        key = (a, self._event_id(event))
+        tx = self._issue(self.event_action.add(a, [key + (request,)]), timeout)
+        if not tx.ok or not enable:
+            return tx
+        return self._issue(self.event_action.enable(a, [key]), timeout)
+
+    def enable_actions(self, events, enabled=True, apid=None, timeout=None):
+        """TC[19,4] or TC[19,5] for the actions of ``events`` of this process."""
+        a = self._apid(apid)
+        keys = [(a, self._event_id(e)) for e in events]
+        user = self.event_action
+        fn = user.enable if enabled else user.disable
+        return self._issue(fn(a, keys), timeout)
+
+    def delete_actions(self, events, apid=None, timeout=None):
+        a = self._apid(apid)
+        keys = [(a, self._event_id(e)) for e in events]
+        return self._issue(self.event_action.delete(a, keys), timeout)
+
+    def actions(self, apid=None, timeout=None):
+        """TC[19,10]; ``tx.reply['items']`` are every event-action definition."""
+        return self._issue(self.event_action.report_definitions(self._apid(apid)), timeout)
+
+    def load_sequence(self, name, items, apid=None, timeout=None):
+        """TC[21,1]: ``items`` are (request, delay in seconds) pairs."""
+        return self._issue(self.sequencing.load(self._apid(apid), name, items), timeout)
+
+    def activate_sequence(self, name, apid=None, timeout=None):
+        return self._issue(self.sequencing.activate(self._apid(apid), name), timeout)
+
+    def abort_sequence(self, name, apid=None, timeout=None):
+        return self._issue(self.sequencing.abort(self._apid(apid), name), timeout)
+
+    def unload_sequence(self, name, apid=None, timeout=None):
+        return self._issue(self.sequencing.unload(self._apid(apid), name), timeout)
+
+    def sequences(self, apid=None, timeout=None):
+        """TC[21,6]; ``tx.reply['items']`` gives each loaded sequence's status."""
+        return self._issue(self.sequencing.report_status(self._apid(apid)), timeout)
+
+    def sequence_content(self, name, apid=None, timeout=None):
+        return self._issue(self.sequencing.report_content(self._apid(apid), name), timeout)
 
     def wait_for(self, service, subtype, timeout=None, since=0):
         """The next TM[service, subtype] no request asked for (an event, a periodic report),

@@ -1,7 +1,8 @@
 """The on-board PUS process on the host: the core application process on UDP 5000 + APID.
 
 ``Onboard(sdb)`` builds the application process with the services the spacecraft database
-calls for (1, 3, 5, 9, 17, 20), a parameter pool and an event manager on an interaction
+calls for (1, 3, 5, 8, 9, 11, 12, 17, 19, 20, 21, and 22 when the database names a
+``position_scheduling`` parameter), a parameter pool and an event manager on an interaction
 layer node, and serves TCs from UDP. TM goes back to the address the last TC came from
 (and to ``tm_to`` if given). ``start()`` runs it on an asyncio loop in a thread (demo,
 tests); ``serve()`` runs it in the calling thread until stopped (``obsw obc serve``).
@@ -18,9 +19,15 @@ from obsw.pus.events import EventManager
 from obsw.pus.parameters import ParameterPool
 from obsw.pus.services.s03_housekeeping import Housekeeping
 from obsw.pus.services.s05_events import EventReporting
+from obsw.pus.services.s08_functions import FunctionManagement, functions
 from obsw.pus.services.s09_time import TimeManagement
+from obsw.pus.services.s11_scheduling import TimeScheduling
+from obsw.pus.services.s12_monitoring import OnBoardMonitoring
 from obsw.pus.services.s17_test import ServiceTest
+from obsw.pus.services.s19_event_action import EventAction
 from obsw.pus.services.s20_parameters import ParameterManagement
+from obsw.pus.services.s21_sequencing import RequestSequencing
+from obsw.pus.services.s22_position_scheduling import PositionScheduling
 
 PORT_BASE = 5000
 TAI_MINUS_UNIX = 378691200 + 37  # seconds from 1958-01-01 TAI to 1970-01-01 UTC, now
@@ -112,6 +119,14 @@ class Onboard:
         app.register(TimeManagement(time_exponent))
         app.register(ServiceTest())
         app.register(ParameterManagement(self.pool))
+        app.register(FunctionManagement(functions(sdb), self.node))
+        app.register(TimeScheduling())
+        app.register(OnBoardMonitoring(self.pool, sdb.events))
+        app.register(EventAction(known=sdb.events))  # after service 5: it wraps its sink
+        app.register(RequestSequencing())
+        position = sdb.extra.get("position_scheduling")
+        if position:
+            app.register(PositionScheduling(self.pool, position["parameter"]))
 
     def _own_parameters(self):
         counters = self.app.counters

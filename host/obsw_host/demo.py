@@ -12,7 +12,7 @@ SECTIONS = (
     ("SpaceCAN: OBC master and equipment, a node on two buses", "obsw_host.spacecan.demo", "run"),
     ("Space data link: CLTUs and TM frames on two UARTs", "obsw_host.frames.demo", "run"),
     ("CFDP: class 2 file delivery over a lossy link, and a get", "obsw_host.cfdp.demo", "run"),
-    ("OBCP engine: a PLUTO procedure drives a component", "obsw_host.obcp", "demo"),
+    ("OBCPs: ground uploads a PLUTO procedure with service 18", "obsw_host.pus.obcp_demo", "run"),
 )
 
 

@@ -1,6 +1,6 @@
 """The OBCP engine in its own process on the interaction layer's socket transport, and its demo.
 
-``serve`` provides the engine component (``obsw.pluto.engine.ENGINE``) and runs it from one
+``serve`` provides the engine component (``obsw.pluto.obcp.ENGINE``) and runs it from one
 loop with the transport: I/O, idle providers, then the procedures that are due. Run it with
 ``obsw pluto engine [--dir DIR] [--sdb SDB.json]`` or ``python -m obsw_host.obcp``; other
 processes load and start procedures through a proxy and subscribe to its events.
@@ -124,7 +124,7 @@ def demo(out=print, directory=None):
     activated through a proxy reads the panel's angle, deploys it, turns it with
     ``set_angle`` and waits for the angle; its progress prints as the events arrive."""
     from obsw.il.node import Node
-    from obsw.pluto.engine import ENGINE
+    from obsw.pluto.obcp import ENGINE
 
     from obsw_host.il.transport import SocketTransport
     from obsw_host.il_demo import _remove_tree, spawn, stop

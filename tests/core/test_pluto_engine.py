@@ -8,16 +8,8 @@ from obsw.il.clock import SimClock
 from obsw.il.errors import ComponentError
 from obsw.il.interface import DATA, INFO, Attribute, Event, Interface, Operation
 from obsw.il.node import Node
-from obsw.pluto.engine import (
-    ENGINE,
-    INACTIVE,
-    RUNNING,
-    STOPPING,
-    SUSPENDED,
-    ObcpEngine,
-    ObcpError,
-    provide,
-)
+from obsw.pluto.engine import ObcpEngine, provide
+from obsw.pluto.obcp import ENGINE, INACTIVE, RUNNING, STOPPING, SUSPENDED, ObcpError
 from obsw.pluto.system import SimulatedSystem
 
 try:

@@ -17,16 +17,10 @@ from obsw.il.interface import (
 )
 from obsw.il.loopback import resolver_for
 from obsw.il.node import Node
-from obsw.pluto.il_system import (
-    ActivityArgumentError,
-    Catalog,
-    IlSystem,
-    ParameterError,
-    target_of,
-    type_code,
-)
+from obsw.pluto.il_system import ActivityArgumentError, IlSystem
 from obsw.pluto.interp import Procedure, load
 from obsw.pluto.lexer import PlutoError
+from obsw.pluto.names import Catalog, ParameterError, target_of, type_code
 from obsw.pluto.units import Quantity
 
 T0 = 1735689600.0  # 2025-01-01T00:00:00Z

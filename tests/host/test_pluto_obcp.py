@@ -9,7 +9,7 @@ import time
 import pytest
 from obsw.il.errors import ComponentError
 from obsw.il.node import Node
-from obsw.pluto.engine import ENGINE
+from obsw.pluto.obcp import ENGINE
 from obsw_host.il.directory import Directory
 from obsw_host.il.transport import SocketTransport
 from obsw_host.il_demo import python_path, spawn, stop

@@ -51,6 +51,10 @@ def add_parser(sub):
     p.add_argument("-v", "--verbose", action="store_true", help="print every packet")
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
+    from obsw_host.commands import cfdp, obcp
+
+    obcp.add_to_ground(s)
+    cfdp.add_parser(s)  # obsw ground cfdp put|get|status|serve
 
     s.add_parser("ping", help="TC[17,1] are-you-alive").set_defaults(func=_ping)
     c = s.add_parser("connection", help="TC[17,3] on-board connection test")

@@ -12,165 +12,38 @@ States (as in PUS ST[18]): ``inactive`` (loaded), ``running``, ``suspended`` and
 ``suspend`` at the next statement boundary, ``stop`` at the first boundary outside the steps
 executing when it was asked, ``abort`` at once (activities waited for are abandoned).
 
-The IL interface ``ENGINE`` declares the operations (load, unload, activate, stop, suspend,
-resume, abort, answer, status), the attributes ``obcps`` and ``states`` and the events
-(progress, outcome, failures, log lines and user messages, each with the OBCP's name).
-Operations refuse with ``ObcpError`` (a ``ComponentError`` whose ``code`` says why).
+The IL interface ``ENGINE``, the states, the refusal codes and ``Obcp`` (one loaded
+procedure) live in ``obsw.pluto.obcp``; they are imported here too.
 """
 
-from obsw.il.errors import ComponentError
-from obsw.il.interface import DATA, INFO, LOW, MEDIUM, Attribute, Event, Interface, Operation
 from obsw.pluto.interp import Procedure
 from obsw.pluto.interp import load as load_program
-from obsw.pluto.lexer import PlutoError, line_col
-from obsw.pluto.statements import ABORTED, Wait
-from obsw.pluto.units import Quantity
-
-INACTIVE = "inactive"
-RUNNING = "running"
-SUSPENDED = "suspended"
-STOPPING = "stopping"
-
-# why a request was refused (ObcpError.code)
-UNKNOWN_OBCP = "UNKNOWN_OBCP"
-ALREADY_LOADED = "ALREADY_LOADED"
-LOAD_FAILED = "LOAD_FAILED"
-BAD_NAME = "BAD_NAME"
-NO_ROOM = "NO_ROOM"
-NOT_INACTIVE = "NOT_INACTIVE"
-NOT_ACTIVE = "NOT_ACTIVE"
-NOT_RUNNING = "NOT_RUNNING"
-NOT_SUSPENDED = "NOT_SUSPENDED"
-NO_QUESTION = "NO_QUESTION"
-
-ENGINE = Interface(
-    "ObcpEngine",
-    0x18,
-    [
-        Attribute("obcps", 1, DATA, type="list", description="names of the loaded OBCPs"),
-        Attribute("states", 2, DATA, type="map", description="state of each loaded OBCP"),
-        Operation("load", 3, ("name", "source"), description="check and keep a procedure"),
-        Operation("unload", 4, ("name",), description="forget an inactive OBCP"),
-        Operation("activate", 5, ("name", "arguments"), description="start an OBCP"),
-        Operation("stop", 6, ("name",), description="end at the end of the current step"),
-        Operation("suspend", 7, ("name",), description="hold at the next statement"),
-        Operation("resume", 8, ("name",), description="continue a suspended OBCP"),
-        Operation("abort", 9, ("name",), description="end now, status aborted"),
-        Operation("answer", 10, ("name", "value"), description="answer an ask user"),
-        Operation("status", 11, ("name",), returns="map", description="one OBCP's status"),
-        Event("state_changed", 16, INFO, fields=("obcp", "state")),
-        Event("started", 17, INFO, fields=("obcp",)),
-        Event("step_status", 18, INFO, fields=("obcp", "step", "status")),
-        Event("finished", 19, INFO, fields=("obcp", "outcome", "error")),
-        Event("failed", 20, MEDIUM, fields=("obcp", "error")),
-        Event("log", 21, INFO, fields=("obcp", "text")),
-        Event("message", 22, INFO, fields=("obcp", "text")),
-        Event("raised", 23, LOW, fields=("obcp", "event")),
-        Event("question", 24, INFO, fields=("obcp", "text")),
-    ],
-    description="runs PLUTO on-board control procedures",
+from obsw.pluto.lexer import PlutoError
+from obsw.pluto.obcp import (
+    ALREADY_LOADED,
+    BAD_NAME,
+    ENGINE,
+    INACTIVE,
+    LOAD_FAILED,
+    NO_QUESTION,
+    NO_ROOM,
+    NOT_ACTIVE,
+    NOT_INACTIVE,
+    NOT_RUNNING,
+    NOT_SUSPENDED,
+    RUNNING,
+    STOPPING,
+    SUSPENDED,
+    UNKNOWN_OBCP,
+    Obcp,
+    ObcpError,
+    Steps,
+    rejected,
+    wire_arguments,
 )
+from obsw.pluto.statements import ABORTED, Wait
 
 _OUTPUT_EVENTS = {"log": "log", "inform": "message", "ask": "question"}
-
-
-class ObcpError(ComponentError):
-    """A request the engine refuses; ``code`` is one of the module's reason names."""
-
-    def __init__(self, code, message, data=None):
-        super().__init__(code, message, data, ENGINE.name)
-
-
-class _Steps:
-    """A procedure's step statuses that report every change (the engine's progress events)."""
-
-    def __init__(self, engine, ob):
-        self._d = {}
-        self._engine = engine
-        self._ob = ob
-
-    def __setitem__(self, step, status):
-        self._d[step] = status
-        self._engine._emit("step_status", {"obcp": self._ob.name, "step": step, "status": status})
-
-    def __getitem__(self, step):
-        return self._d[step]
-
-    def __contains__(self, step):
-        return step in self._d
-
-    def __len__(self):
-        return len(self._d)
-
-    def get(self, step, default=None):
-        return self._d.get(step, default)
-
-    def items(self):
-        return self._d.items()
-
-    def copy(self):
-        return dict(self._d)
-
-
-class Obcp:
-    """One loaded procedure and, while active, its running ``Procedure``."""
-
-    def __init__(self, name, source, program, arguments):
-        self.name = name
-        self.source = source
-        self.program = program
-        self.arguments = arguments
-        self.state = INACTIVE
-        self.proc = None
-        self.outcome = None  # of the last activation
-        self.error = None
-        self.steps = {}
-        self.statements = 0
-        self.activations = 0
-        self.requested = None  # "suspend", "stop" or "abort" while it takes effect
-        self.stop_steps = None
-        self.ready = False
-        self.due = None
-
-    def status(self):
-        """The OBCP's status as plain data (the PUS ST[18] status report's content)."""
-        proc = self.proc
-        line = 0
-        question = None
-        steps = self.steps
-        statements = self.statements
-        if proc is not None:
-            cur = getattr(proc, "cur", None)
-            line = line_col(cur[1])[0] if cur else 0
-            question = proc.question
-            steps = proc.step_status.copy()
-            statements = proc.statements
-        return {
-            "name": self.name,
-            "state": self.state,
-            "outcome": self.outcome,
-            "error": self.error,
-            "steps": steps,
-            "statements": statements,
-            "line": line,
-            "question": question,
-            "activations": self.activations,
-            "requested": self.requested,
-        }
-
-
-def _arguments(arguments):
-    """Procedure arguments from the wire: ``{"value": v, "unit": u}`` becomes a Quantity."""
-    if not arguments:
-        return None
-    if not isinstance(arguments, dict):
-        raise ObcpError(LOAD_FAILED, "arguments must be a map of name to value", arguments)
-    out = {}
-    for k, v in arguments.items():
-        if isinstance(v, dict) and "value" in v and "unit" in v:
-            v = Quantity(v["value"], v["unit"])
-        out[k] = v
-    return out
 
 
 class ObcpEngine:
@@ -235,7 +108,7 @@ class ObcpEngine:
             )
         if isinstance(source, (bytes, bytearray)):
             source = bytes(source).decode()
-        arguments = _arguments(arguments)
+        arguments = wire_arguments(arguments)
         ob = Obcp(name, source, self._compile(name, source, arguments), arguments)
         self._obcps[name] = ob
         self._order.append(name)
@@ -263,7 +136,7 @@ class ObcpEngine:
         ob = self._get(name)
         if ob.state != INACTIVE:
             raise ObcpError(NOT_INACTIVE, "OBCP %s is %s" % (name, ob.state))
-        args = _arguments(arguments)
+        args = wire_arguments(arguments)
         program = ob.program
         if args:
             program = self._compile(name, ob.source, args)
@@ -276,7 +149,7 @@ class ObcpEngine:
         else:
             system = self.system
         proc = Procedure(program, system, args, poll=self.poll)
-        proc.step_status = _Steps(self, ob)
+        proc.step_status = Steps(self, ob)
         proc.start(self.now)
         ob.proc = proc
         ob.activations += 1
@@ -451,18 +324,7 @@ class ObcpEngine:
         try:
             return load_program(source, self.system if self.check else None, arguments)
         except PlutoError as e:
-            errors = getattr(e, "errors", None) or [e]
-            raise ObcpError(
-                LOAD_FAILED,
-                "OBCP %s rejected: line %d, column %d: %s" % (name, e.line, e.col, e.msg),
-                {
-                    "kind": e.kind,
-                    "line": e.line,
-                    "column": e.col,
-                    "message": e.msg,
-                    "errors": [[x.kind, x.line, x.col, x.msg] for x in errors],
-                },
-            ) from None
+            raise rejected(name, e) from None
 
     def _in_order(self):
         return [self._obcps[n] for n in self._order]

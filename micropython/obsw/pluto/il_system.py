@@ -9,6 +9,8 @@ subscription). Names match whatever their spelling: ``"set state bits of Cpdu N"
 ``CpduN.set_state_bits``; a reference with one name only (``"Switch on Star Tracker1"``)
 finds the member whose name and component's name, run together, spell it.
 
+Names resolve through ``obsw.pluto.names`` (``Catalog``, ``target_of``, ``plain``).
+
 Load-time facts (``describe``) come from the spacecraft database (an ``obsw.sdb.Sdb`` or its
 JSON document, which may also list operations with their arguments) and from component
 ``Interface`` declarations: those given, and those of the node's own providers.
@@ -20,19 +22,21 @@ procedure) is aborted.
 """
 
 from obsw.il.errors import COMPONENT_ERROR, OK, InteractionError, error_from_reply
+from obsw.pluto.names import (
+    CODE,
+    COMPONENT,
+    KIND,
+    PARAMS,
+    UNIT,
+    Catalog,
+    ParameterError,
+    norm,
+    plain,
+    target_of,
+)
 from obsw.pluto.statements import ABORTED, CONFIRMED, NOT_CONFIRMED
 from obsw.pluto.system import System
-from obsw.pluto.units import AbsTime, Quantity, UnitError, isdigits
-from obsw.pluto.units import parse as parse_unit
-
-
-class ParameterError(ValueError):
-    """A parameter could not be read through the interaction layer."""
-
-    def __init__(self, path, cause):
-        super().__init__("%s: %s" % (path, cause))
-        self.path = path
-        self.cause = cause
+from obsw.pluto.units import Quantity, isdigits
 
 
 class ActivityArgumentError(ValueError):
@@ -41,179 +45,6 @@ class ActivityArgumentError(ValueError):
     def __init__(self, msg, path=None):
         super().__init__(msg)
         self.path = path
-
-
-def norm(name):
-    """A name's spelling-free form: lower case, without spaces and underscores."""
-    return name.replace(" ", "").replace("_", "").lower()
-
-
-def type_code(t):
-    """PLUTO checker type code for a database or interface type name ('float32', 'u8'...)."""
-    if isinstance(t, (list, tuple)) and len(t) == 2:
-        return _PTC.get(t[0], "?")
-    t = str(t or "").lower()
-    if not t:
-        return "?"
-    if t.startswith("bool"):
-        return "b"
-    if t.startswith("f") or t in ("real", "double"):
-        return "r"
-    if t.startswith("uint") or t.startswith("int") or (t[0] in "ui" and isdigits(t[1:])):
-        return "i"
-    if t.startswith("str") or t == "text":
-        return "s"
-    return "?"
-
-
-_PTC = {1: "b", 3: "i", 4: "i", 5: "r", 8: "s"}
-
-
-def _unit(u):
-    """``u`` if PLUTO (Annex B) knows it, else None (the value then counts as unitless)."""
-    if not u:
-        return None
-    try:
-        parse_unit(u)
-    except (UnitError, ValueError):
-        return None
-    return u
-
-
-def _items(x):
-    """Entries of a database section given as a list (of dicts or names) or a dict."""
-    if isinstance(x, dict):
-        out = []
-        for k, v in x.items():
-            d = dict(v) if isinstance(v, dict) else {}
-            d.setdefault("name", k)
-            out.append(d)
-        return out
-    return [i if isinstance(i, dict) else {"name": i} for i in (x or ())]
-
-
-# catalog entry fields
-_KIND = 0
-_COMP = 1
-_MEMBER = 2
-_CODE = 3
-_UNIT = 4
-_PARAMS = 5
-
-
-class Catalog:
-    """What is known about component members, by spelling-free (component, member) names.
-
-    An entry is ``[kind, component, member, type code, unit, params]``; ``kind`` is
-    "parameter", "activity" or "event"; ``params`` lists an operation's ``(name, unit)``.
-    """
-
-    def __init__(self, sdb=None, interfaces=()):
-        self.entries = {}
-        self.interfaces = {}  # names of interfaces added
-        self._paths = {}  # path -> entry or None, filled as paths are looked up
-        if sdb is not None:
-            self.add_sdb(sdb)
-        for itf in interfaces or ():
-            self.add_interface(itf)
-
-    def add(self, kind, comp, member, code=None, unit=None, params=None):
-        key = (norm(comp), norm(member))
-        e = self.entries.get(key)
-        if e is None:
-            self.entries[key] = [kind, comp, member, code, _unit(unit), params]
-        else:  # a second source fills in what the first left open
-            if e[_CODE] in (None, "?") and code:
-                e[_CODE] = code
-            if not e[_UNIT]:
-                e[_UNIT] = _unit(unit)
-            if e[_PARAMS] is None and params is not None:
-                e[_PARAMS] = params
-        self._paths = {}
-
-    def add_interface(self, itf):
-        """Attributes, operations and events of an ``obsw.il.interface.Interface``."""
-        self.interfaces[itf.name] = itf
-        for a in itf.attributes:
-            self.add("parameter", itf.name, a.name, type_code(a.type), a.unit)
-        for op in itf.operations:
-            self.add("activity", itf.name, op.name, None, None, [(p, None) for p in op.params])
-        for ev in itf.events:
-            self.add("event", itf.name, ev.name)
-
-    def add_sdb(self, sdb):
-        """A spacecraft database: an ``obsw.sdb.Sdb`` or its JSON document (a dict)."""
-        if not isinstance(sdb, dict):
-            for p in sdb.parameters.values():
-                if p.component:
-                    self.add("parameter", p.component, p.name, type_code(p.type_spec), p.unit)
-            for e in sdb.events.values():
-                if e.component:
-                    self.add("event", e.component, e.name)
-            return
-        comps = sdb.get("components", ())
-        for comp in _items(comps):
-            c = comp["name"]
-            for a in _items(comp.get("attributes")) + _items(comp.get("parameters")):
-                self.add("parameter", c, a["name"], type_code(a.get("type")), a.get("unit"))
-            for op in _items(comp.get("operations")) + _items(comp.get("activities")):
-                args = op.get("arguments", op.get("params"))
-                params = None
-                if args is not None:
-                    params = [(x["name"], x.get("unit")) for x in _items(args)]
-                self.add("activity", c, op["name"], None, None, params)
-            for e in _items(comp.get("events")):
-                self.add("event", c, e["name"])
-
-    def find(self, path):
-        """The entry a PLUTO path names, or None."""
-        if path in self._paths:
-            return self._paths[path]
-        names = path.split(" of ")
-        if len(names) > 2 and names[0] == "value":
-            names = names[1:]
-        e = None
-        if len(names) > 1:
-            e = self.entries.get(("".join([norm(n) for n in names[:0:-1]]), norm(names[0])))
-        else:
-            n = norm(names[0])
-            for (c, m), x in self.entries.items():
-                if m + c == n or c + m == n:
-                    e = x
-                    break
-        self._paths[path] = e
-        return e
-
-    def unit_of(self, comp, name):
-        """Unit of ``comp``'s attribute called ``name`` (an argument's default unit)."""
-        e = self.entries.get((norm(comp), norm(name)))
-        return e[_UNIT] if e is not None and e[_KIND] == "parameter" else None
-
-
-def target_of(path, entry=None):
-    """``(component, member)`` of a PLUTO path (from its catalog entry when there is one)."""
-    if entry is not None:
-        return entry[_COMP], entry[_MEMBER]
-    names = path.split(" of ")
-    if len(names) > 2 and names[0] == "value":
-        names = names[1:]
-    if len(names) < 2:
-        raise ParameterError(path, "names no member of a component ('<member> of <component>')")
-    comp = "".join(names[:0:-1]).replace(" ", "")
-    return comp, names[0].strip().replace(" ", "_")
-
-
-def plain(v, unit=None):
-    """A procedure value as the interaction layer carries it: numbers in ``unit``."""
-    if isinstance(v, Quantity):
-        return v.to(unit).value if unit else v.value
-    if isinstance(v, AbsTime):
-        return v.seconds
-    if isinstance(v, dict):
-        return {k: plain(x) for k, x in v.items()}
-    if isinstance(v, list):
-        return [plain(x) for x in v]
-    return v
 
 
 class Activity:
@@ -337,9 +168,9 @@ class IlSystem(System):
         e = self._find(path)
         if e is None:
             return None
-        if e[_KIND] == "parameter":
-            return ("parameter", e[_CODE] or "?", e[_UNIT])
-        return (e[_KIND], None, None)
+        if e[KIND] == "parameter":
+            return ("parameter", e[CODE] or "?", e[UNIT])
+        return (e[KIND], None, None)
 
     def get(self, path):
         target = self.target(path)
@@ -357,7 +188,7 @@ class IlSystem(System):
         (named, or ``arg1``, ``arg2`` ... in order); quantities in the parameters' units."""
         e = self._find(path)
         given = [(k, v) for k, v in args.items() if k != "directives"]
-        params = e[_PARAMS] if e is not None else None
+        params = e[PARAMS] if e is not None else None
         if params is None:  # positional order; named ones (unordered on MicroPython) by name
             given.sort(key=_position)
             return tuple([plain(v) for _, v in given])
@@ -371,7 +202,7 @@ class IlSystem(System):
                 raise ActivityArgumentError(
                     "%s needs argument %s (takes: %s)" % (path, name, _names(params)), path
                 )
-            out.append(plain(hit[1], unit or self.catalog.unit_of(e[_COMP], name)))
+            out.append(plain(hit[1], unit or self.catalog.unit_of(e[COMPONENT], name)))
         if by_name:
             extra = ", ".join([k for k, _ in by_name.values()])
             raise ActivityArgumentError(

@@ -350,3 +350,7 @@ FAILURE_REFUSED = const(10)  # the request contradicts the current state (e.g. I
 FAILURE_TIMEOUT = const(11)  # the request did not finish in time and was aborted
 FAILURE_UNAVAILABLE = const(12)  # the component behind the request could not be reached
 FAILURE_COMPONENT = const(13)  # the component refused the request (its error in the data)
+FAILURE_PATH = const(14)  # a path that escapes the filestore root or names no repository
+FAILURE_FILESTORE = const(15)  # the filestore refused (no such file, exists, locked, full)
+FAILURE_OUT_OF_BOUNDS = const(16)  # an address or length outside the declared memory area
+FAILURE_OBCP_REJECTED = const(24)  # ST[18] procedure text that does not load (line, column)

@@ -11,7 +11,11 @@ from obsw.pus.messages import (
     FAILURE_BUSY,
     FAILURE_COMPONENT,
     FAILURE_EXECUTION,
+    FAILURE_FILESTORE,
     FAILURE_ILLEGAL_APP_DATA,
+    FAILURE_OBCP_REJECTED,
+    FAILURE_OUT_OF_BOUNDS,
+    FAILURE_PATH,
     FAILURE_REFUSED,
     FAILURE_TIMEOUT,
     FAILURE_UNAVAILABLE,
@@ -45,6 +49,10 @@ FAILURE_NAMES = {
     FAILURE_TIMEOUT: "timeout",
     FAILURE_UNAVAILABLE: "unavailable",
     FAILURE_COMPONENT: "component error",
+    FAILURE_PATH: "bad path",
+    FAILURE_FILESTORE: "filestore refused",
+    FAILURE_OUT_OF_BOUNDS: "out of bounds",
+    FAILURE_OBCP_REJECTED: "OBCP rejected",
 }
 
 # stages of a request, in order

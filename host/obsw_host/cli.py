@@ -6,7 +6,19 @@ import sys
 
 # Each module has add_parser(subparsers); the chosen subcommand's function gets the parsed args
 # and returns the exit status. Modules are imported lazily so one area's extras stay optional.
-COMMANDS = ("demo", "packet", "obc", "ground", "obcp", "il", "spacecan", "frames", "cfdp", "pluto")
+COMMANDS = (
+    "demo",
+    "packet",
+    "obc",
+    "ground",
+    "obcp",
+    "il",
+    "spacecan",
+    "frames",
+    "cfdp",
+    "pluto",
+    "board",
+)
 
 
 def build_parser():

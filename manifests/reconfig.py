@@ -1,0 +1,73 @@
+# The reconfiguration module's image: its application and only the core modules it imports.
+metadata(
+    version="0.1.0",
+    description="obsw reconfiguration module (CPDU, safeguard memory, time, essential TC/TM)",
+)
+
+_CORE = "../micropython"
+
+for _m in (
+    "__init__.py",
+    "compat.py",
+    "crc.py",
+    "spp.py",
+    "utc.py",
+    "timecode.py",
+):
+    module("obsw/" + _m, base_path=_CORE)
+
+package(
+    "obsw/spacecan",
+    files=[
+        "__init__.py",
+        "encoding.py",
+        "events.py",
+        "fragment.py",
+        "ids.py",
+        "nodedef.py",
+        "packets.py",
+        "redundancy.py",
+        "responder.py",
+        "timeframes.py",
+    ],
+    base_path=_CORE,
+)
+package(
+    "obsw/frames",
+    files=[
+        "__init__.py",
+        "asm.py",
+        "bch.py",
+        "clcw.py",
+        "cltu.py",
+        "dedup.py",
+        "errors.py",
+        "farm.py",
+        "processor.py",
+        "randomizer.py",
+        "tc.py",
+        "tm.py",
+        "tm_mux.py",
+    ],
+    base_path=_CORE,
+)
+package(
+    "obsw/reconfig",
+    files=[
+        "__init__.py",
+        "app.py",
+        "cpdu.py",
+        "ds3231.py",
+        "ecc.py",
+        "eeprom.py",
+        "essential.py",
+        "hal.py",
+        "node.py",
+        "safeguard.py",
+        "watchdog.py",
+    ],
+    base_path=_CORE,
+)
+# the Pyboard hardware layer
+module("hal_pyb.py", base_path="../boards/common")
+module("reconfig_main.py", base_path="../boards/OBSW_RECONFIG")

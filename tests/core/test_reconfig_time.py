@@ -1,0 +1,158 @@
+"""DS3231: BCD round trips, time registers, alarm, oscillator-stop flag, temperature; the
+time synchronisation from SpaceCAN UTC and SCET frames; the TPS3813 window watchdog."""
+
+import unittest
+
+from obsw.reconfig import ds3231 as D
+from obsw.reconfig.models import DS3231Model, ModelHal, SimI2C, Tps3813Model
+from obsw.reconfig.watchdog import Watchdog, WatchdogConfigError
+from obsw.spacecan.timeframes import ScetTime, UtcTime
+from obsw.utc import days_from_civil
+
+
+class Clock:
+    def __init__(self):
+        self.t = 0.0
+
+    def __call__(self):
+        return self.t
+
+
+def rtc_rig(seconds=0):
+    clock = Clock()
+    i2c = SimI2C()
+    model = DS3231Model(clock, seconds=seconds)
+    i2c.devices[0x68] = model
+    return clock, model, D.DS3231(i2c)
+
+
+class TestBcd(unittest.TestCase):
+    def test_every_value_round_trips(self):
+        for v in range(100):
+            b = D.to_bcd(v)
+            self.assertEqual(D.from_bcd(b), v)
+            self.assertEqual(b, int(str(v), 16))
+
+    def test_bad_values(self):
+        with self.assertRaises(D.RtcError):
+            D.to_bcd(100)
+        with self.assertRaises(D.RtcError):
+            D.from_bcd(0x1A)
+
+    def test_time_registers_round_trip_over_two_centuries(self):
+        day = days_from_civil(2000, 1, 1)
+        end = days_from_civil(2199, 12, 31)
+        step = 0
+        while day <= end:
+            ms = (step * 7919 % 86400) * 1000
+            t = D.from_day_ms(day, ms)
+            regs = D.encode_time(*t)
+            back = D.decode_time(regs)
+            self.assertEqual(back[:6], t)
+            self.assertEqual(D.to_day_ms(back), (day, ms))
+            self.assertEqual(back[6], (day + 2) % 7 + 1)
+            day += 97
+            step += 1
+        regs = D.encode_time(2150, 2, 28, 23, 59, 58)
+        self.assertEqual(regs[5] & 0x80, 0x80)  # century bit
+
+    def test_twelve_hour_mode_and_range(self):
+        regs = bytearray(D.encode_time(2024, 5, 6, 0, 0, 0))
+        regs[2] = 0x40 | 0x20 | 0x11  # 12-hour mode, PM, 11 o'clock
+        self.assertEqual(D.decode_time(regs)[3], 23)
+        regs[2] = 0x40 | 0x12  # 12 AM is midnight
+        self.assertEqual(D.decode_time(regs)[3], 0)
+        with self.assertRaises(D.RtcError):
+            D.encode_time(1999, 1, 1, 0, 0, 0)
+        with self.assertRaises(D.RtcError):
+            D.encode_time(2024, 13, 1, 0, 0, 0)
+
+
+class TestDriver(unittest.TestCase):
+    def test_set_read_and_oscillator_stop(self):
+        clock, model, rtc = rtc_rig()
+        self.assertTrue(rtc.oscillator_stopped())  # first power-up
+        rtc.set_datetime(2025, 6, 30, 23, 59, 58)
+        self.assertFalse(rtc.oscillator_stopped())
+        clock.t = 3.2
+        self.assertEqual(rtc.datetime()[:6], (2025, 7, 1, 0, 0, 1))
+        model.stop_oscillator()
+        clock.t = 100
+        self.assertTrue(rtc.oscillator_stopped())
+        self.assertEqual(rtc.datetime()[:6], (2025, 7, 1, 0, 0, 1))
+
+    def test_temperature(self):
+        clock, model, rtc = rtc_rig()
+        for t in (25.75, -0.25, -12.5, 0.0, 85.0):
+            model.temperature = t
+            self.assertEqual(rtc.temperature(), t)
+
+    def test_alarm1(self):
+        clock, model, rtc = rtc_rig()
+        rtc.set_datetime(2025, 1, 1, 12, 0, 0)
+        rtc.set_alarm1(D.ALARM_MINUTES, second=30, minute=0)
+        self.assertFalse(rtc.alarm1_fired())
+        clock.t = 30
+        self.assertTrue(rtc.alarm1_fired())
+        rtc.clear_alarm1()
+        clock.t = 31
+        self.assertFalse(rtc.alarm1_fired())
+        self.assertEqual(model.regs[0x0E] & 0x05, 0x05)
+
+
+class TestSync(unittest.TestCase):
+    def test_utc_frame_sets_rtc_at_the_next_whole_second(self):
+        clock, model, rtc = rtc_rig()
+        sync = D.TimeSync(rtc)
+        day = days_from_civil(2025, 3, 1)
+        self.assertTrue(sync.on_utc(UtcTime(day, 3600000 + 400), 10.0))
+        self.assertAlmostEqual(sync.next_deadline(), 10.6)
+        self.assertFalse(sync.poll(10.5))
+        self.assertTrue(sync.poll(10.6))
+        self.assertEqual(rtc.day_ms(), (day, 3601000))
+        self.assertFalse(rtc.oscillator_stopped())
+        clock.t = 2
+        # in agreement now: no new set
+        self.assertFalse(sync.on_utc(UtcTime(day, 3603000), 12.0))
+        self.assertEqual(sync.last_error_ms, 0)
+        sync.on_scet(ScetTime(5000), 12.0)
+        self.assertEqual(sync.scet_offset, 5000 - (day * 86400 + 3603))
+        self.assertEqual(sync.counters["sets"], 1)
+
+
+class TestWatchdog(unittest.TestCase):
+    def test_window_respected_with_jittery_loop(self):
+        hal = ModelHal()
+        wd = Watchdog(hal, open_ms=100, timeout_ms=1000)
+        tps = Tps3813Model(100, 1000)
+        wd.start(0)
+        now = 0
+        for i in range(5000):
+            now += 1 + (i * 37) % 23  # loop period 1..23 ms
+            before = hal.kick_count
+            hal.now = now * 1000
+            wd.poll(now)
+            if hal.kick_count > before:
+                self.assertIsNone(tps.kick(now))
+            self.assertIsNone(tps.poll(now))
+        self.assertEqual(tps.resets, 0)
+        self.assertTrue(wd.kicks > 100)
+
+    def test_unhealthy_is_reset_by_timeout(self):
+        hal = ModelHal()
+        wd = Watchdog(hal, open_ms=100, timeout_ms=1000)
+        tps = Tps3813Model(100, 1000)
+        wd.start(0)
+        reason = None
+        for now in range(0, 3000, 10):
+            if wd.poll(now, healthy=now < 500):
+                tps.kick(now)
+            reason = reason or tps.poll(now)
+        self.assertEqual(reason, "late")
+        self.assertTrue(wd.withheld > 0)
+
+    def test_early_kick_is_a_reset_in_the_model(self):
+        tps = Tps3813Model(100, 1000)
+        self.assertEqual(tps.kick(50), "early")
+        with self.assertRaises(WatchdogConfigError):
+            Watchdog(ModelHal(), open_ms=500, timeout_ms=510)

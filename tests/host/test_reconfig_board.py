@@ -1,0 +1,101 @@
+"""`obsw board build|deploy|flash|repl|test` with fake make, mpremote, mpy-cross and dfu-util
+that record their arguments (no board is touched)."""
+
+import os
+import stat
+
+import pytest
+from obsw_host import board
+from obsw_host.commands import board as cmd
+
+FAKE = """#!/bin/sh
+echo "$(basename "$0") $*" >> "{log}"
+exit 0
+"""
+
+
+@pytest.fixture
+def fakes(tmp_path, monkeypatch):
+    log = tmp_path / "calls.log"
+    bindir = tmp_path / "bin"
+    bindir.mkdir()
+    for name in ("make", "mpremote", "dfu-util", "arm-none-eabi-gcc"):
+        p = bindir / name
+        p.write_text(FAKE.format(log=log))
+        p.chmod(p.stat().st_mode | stat.S_IEXEC)
+    monkeypatch.setenv("PATH", str(bindir) + os.pathsep + os.environ["PATH"])
+    for var in ("MAKE", "MPREMOTE", "DFU_UTIL", "ARM_GCC"):
+        monkeypatch.delenv(var, raising=False)
+
+    def calls():
+        return log.read_text().splitlines() if log.exists() else []
+
+    return tmp_path, calls
+
+
+def run(argv):
+    import argparse
+
+    p = argparse.ArgumentParser()
+    sub = p.add_subparsers()
+    cmd.add_parser(sub)
+    args = p.parse_args(argv)
+    return args.func(args)
+
+
+def test_build_runs_the_stm32_port_with_this_board(fakes):
+    tmp, calls = fakes
+    mp = tmp / "micropython"
+    (mp / "ports" / "stm32").mkdir(parents=True)
+    (mp / "ports" / "stm32" / "Makefile").write_text("")
+    assert run(["board", "build", "--micropython", str(mp), "-j", "3"]) == 0
+    c = calls()
+    assert c[0] == "make -C %s" % (mp / "mpy-cross")
+    assert "submodules" in c[1]
+    assert "-j3" in c[2] and "BOARD=OBSW_RECONFIG" in c[2]
+    assert "BOARD_DIR=%s" % board.board_dir() in c[2]
+    with open(os.path.join(board.board_dir(), "mpconfigboard.mk")) as f:
+        assert "manifests/reconfig.py" in f.read()
+
+
+def test_build_says_what_is_missing(fakes, capsys, monkeypatch):
+    tmp, calls = fakes
+    assert run(["board", "build", "--micropython", str(tmp / "nothing")]) == 2
+    assert "no MicroPython checkout" in capsys.readouterr().out
+    mp = tmp / "mp"
+    (mp / "ports" / "stm32").mkdir(parents=True)
+    (mp / "ports" / "stm32" / "Makefile").write_text("")
+    monkeypatch.setenv("ARM_GCC", str(tmp / "no-such-gcc"))
+    assert run(["board", "build", "--micropython", str(mp)]) == 2
+    assert "arm-none-eabi-gcc not found" in capsys.readouterr().out
+    assert calls() == []
+
+
+def test_deploy_compiles_for_the_pyboard_and_copies(fakes):
+    tmp, calls = fakes
+    assert run(["board", "deploy", "--port", "/dev/ttyACM0"]) == 0
+    c = calls()
+    assert len(c) == 1 and c[0].startswith("mpremote connect /dev/ttyACM0")
+    assert " cp -r " in c[0] and c[0].endswith("reset")
+    assert ":main.py" in c[0] and ":boot.py" in c[0]
+    names = [n for _, n in board.frozen_modules()]
+    assert "obsw/reconfig/app.py" in names and "hal_pyb.py" in names
+    assert not [n for n in names if n.startswith(("obsw/cfdp", "obsw/pluto", "obsw/il"))]
+
+
+def test_flash_repl_and_test(fakes, tmp_path):
+    tmp, calls = fakes
+    fw = tmp / "firmware.dfu"
+    fw.write_bytes(b"DfuSe")
+    assert run(["board", "flash", str(fw)]) == 0
+    assert run(["board", "repl"]) == 0
+    assert run(["board", "test", "--port", "u0"]) == 0
+    c = calls()
+    assert c[0] == "mpremote bootloader"
+    assert c[1] == "dfu-util -a 0 -d 0483:df11 -D %s" % fw
+    assert c[2].startswith("mpremote cp") and c[2].endswith(":main.py")
+    assert c[3] == "mpremote repl"
+    tests = c[4:]
+    assert len(tests) == len(board.BOARD_TESTS)
+    assert all(t.startswith("mpremote connect u0 cp") and " exec " in t for t in tests)
+    assert run(["board", "flash", str(tmp / "missing.dfu")]) == 2

@@ -12,6 +12,7 @@ SECTIONS = (
     ("SpaceCAN: OBC master and equipment, a node on two buses", "obsw_host.spacecan.demo", "run"),
     ("Space data link: CLTUs and TM frames on two UARTs", "obsw_host.frames.demo", "run"),
     ("CFDP: class 2 file delivery over a lossy link, and a get", "obsw_host.cfdp.demo", "run"),
+    ("Storage and files: store, pass, CFDP copies", "obsw_host.pus.storage_demo", "run"),
     ("OBCPs: ground uploads a PLUTO procedure with service 18", "obsw_host.pus.obcp_demo", "run"),
     ("Reconfiguration module: two MicroPython controllers", "obsw_host.reconfig_sim", "demo"),
 )

@@ -10,8 +10,15 @@
                      "data": [{"name": "angle", "type": "float32"}]}]}
       ],
       "events": [{"name": "pus.cycle_overrun", "id": 65281, "severity": "medium"}],
-      "housekeeping": [{"sid": 1, "interval": 10, "parameters": [1], "enabled": true}]
+      "housekeeping": [{"sid": 1, "interval": 10, "parameters": [1], "enabled": true}],
+      "filestores": [{"prefix": "SAT", "entity": 2}, {"prefix": "GROUND", "entity": 1}],
+      "memories": [{"id": 1, "name": "image", "file": "memory/image.bin",
+                    "start": 0, "size": 4096, "writable": true}]
     }
+
+``filestores`` maps the path prefixes of file management (``SAT:/data/x``) to CFDP entity
+ids (the onboard one is the first, unless one says ``"local": true``); ``memories`` declares
+the memory areas service 6 may load, dump and check, by id, start address and size.
 
 A type is a name (``uint8`` .. ``uint64``, ``int8`` .. ``int64``, ``float32``, ``float64``,
 ``bool``, ``enum8``, ``enum16``, ``string`` for a 16-bit-length character string,
@@ -151,6 +158,9 @@ class Sdb:
         self.parameters = {}  # id -> Parameter
         self.events = {}  # id -> EventDef
         self.housekeeping = []  # initial report structures as dicts
+        self.filestores = {}  # path prefix ('SAT') -> CFDP entity id
+        self.local_filestore = None  # the prefix of the onboard filestore
+        self.memories = {}  # memory id -> dict (name, file, start, size, writable)
         self._params_by_name = {}
         self._events_by_name = {}
         self.extra = {k: v for k, v in doc.items() if k not in _KNOWN}
@@ -221,6 +231,40 @@ class Sdb:
                     "enabled": bool(hk.get("enabled", False)),
                 }
             )
+        self._load_files(doc)
+
+    def _load_files(self, doc):
+        for fs in doc.get("filestores", []):
+            prefix = fs["prefix"]
+            if not isinstance(prefix, str) or not prefix or ":" in prefix or "/" in prefix:
+                raise SdbError("filestore prefix %r, expected a name like 'SAT'" % (prefix,))
+            if prefix in self.filestores:
+                raise SdbError("filestore prefix %s declared twice" % prefix)
+            self.filestores[prefix] = _int(fs["entity"], "CFDP entity id of %s" % prefix)
+            if fs.get("local") or self.local_filestore is None:
+                self.local_filestore = prefix
+        for m in doc.get("memories", []):
+            mid = _int(m["id"], "memory id")
+            if mid in self.memories:
+                raise SdbError("memory %d declared twice" % mid)
+            size = _int(m["size"], "size of memory %d" % mid)
+            if size == 0:
+                raise SdbError("memory %d has size 0" % mid)
+            self.memories[mid] = {
+                "id": mid,
+                "name": m.get("name", "memory%d" % mid),
+                "file": m.get("file"),
+                "start": _int(m.get("start", 0), "start of memory %d" % mid),
+                "size": size,
+                "writable": bool(m.get("writable", False)),
+            }
+
+    def filestore_entity(self, prefix):
+        """The CFDP entity id of path prefix ``prefix`` ('SAT', 'GROUND')."""
+        try:
+            return self.filestores[prefix]
+        except KeyError:
+            raise KeyError("no filestore %r in the spacecraft database" % (prefix,)) from None
 
     def _add_parameter(self, p):
         if p.id in self.parameters:
@@ -295,7 +339,16 @@ class Sdb:
                 raise SdbError("%s has no event %s" % (e.component, e.name))
 
 
-_KNOWN = ("mission", "apids", "components", "parameters", "events", "housekeeping")
+_KNOWN = (
+    "mission",
+    "apids",
+    "components",
+    "parameters",
+    "events",
+    "housekeeping",
+    "filestores",
+    "memories",
+)
 
 
 def loads(text):

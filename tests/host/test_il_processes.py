@@ -108,6 +108,18 @@ def test_bytes_int_keys_and_nesting_survive(directory, procs, user):
     assert a.add([b"x"], [{2: None}]).result(timeout=10.0) == [b"x", {2: None}]
 
 
+def test_large_payloads_cross_in_pieces(directory, procs, user):
+    # events and arguments far larger than one socket read arrive whole
+    procs.append(spawn_peer(directory, "A"))
+    a = user.proxy(peer_interface("A", 65), timeout=20.0)
+    sub = a.subscribe("tick", length=4)
+    assert a.emit(2, 1 << 20) == 2
+    for i in range(2):
+        assert sub.receive(timeout=10.0).value == {"i": i, "blob": bytes(1 << 20)}
+    big = bytes(range(256)) * 2048
+    assert a.add(big, b"!").result(timeout=10.0) == big + b"!"
+
+
 def test_user_recovers_after_provider_restart(directory, procs, user):
     procs.append(spawn("obsw_host.solar_panel", directory))
     panel = user.proxy(SOLAR_PANEL, timeout=20.0)

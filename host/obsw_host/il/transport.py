@@ -32,7 +32,7 @@ from obsw_host.il.wire import CborDecodeError, FrameError, FrameReader, frame
 
 _SUN_PATH_MAX = 100
 _SLICE = 0.01  # a lone connection is waited on by a blocking recv of at most this long
-_RECV = 262144
+_RECV = 65536  # below glibc's mmap threshold: a bigger buffer costs an mmap per recv
 _POLLIN = select.POLLIN | select.POLLPRI | select.POLLHUP | select.POLLERR
 
 

@@ -96,6 +96,11 @@ class FrameReader:
     def feed(self, data):
         """Add ``data``; return the list of messages completed by it."""
         buf = self._buf
+        if not buf and len(data) >= 4:
+            # the usual case: one read holds exactly one frame, decoded without buffering
+            (length,) = _LEN.unpack_from(data, 0)
+            if length + 4 == len(data) and length <= MAX_FRAME:
+                return [loads(data[4:])]
         buf += data
         out = []
         pos = 0

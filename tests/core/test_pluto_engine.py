@@ -399,6 +399,45 @@ class TestControl(unittest.TestCase):
         r.drive()
         self.assertEqual(r.texts(), [("p", "procedure aborted: stopped by request")])
 
+    def test_step_by_step_through_the_proxy(self):
+        r = Rig()
+        r.user.load(
+            "p",
+            proc(
+                'log "pre";',
+                step("A", 'log "a1"; wait for 10 s; log "a2";'),
+                step("B", 'log "b";'),
+                'log "post";',
+            ),
+        )
+        r.user.activate_step("p", None)
+        r.drive()
+        self.assertEqual(r.user.states["p"], SUSPENDED)
+        self.assertEqual([t for _, t in r.texts()], ["pre", "a1", "a2"])
+        self.assertTrue(r.user.status("p")["stepping"])
+        self.assertIsNone(r.engine.next_deadline())  # held: nothing due
+        r.user.resume_step("p")
+        r.drive()
+        self.assertEqual([t for _, t in r.texts()][3:], ["b"])
+        self.assertEqual(r.user.states["p"], SUSPENDED)
+        r.user.resume_step("p")
+        r.drive()
+        st = r.user.status("p")
+        self.assertEqual((st["state"], st["outcome"]), (INACTIVE, "confirmed"))
+        self.assertEqual([t for _, t in r.texts()][4:], ["post"])
+        with self.assertRaises(ComponentError) as ctx:
+            r.user.resume_step("p")
+        self.assertEqual(ctx.exception.code, "NOT_SUSPENDED")
+
+    def test_step_by_step_without_steps_runs_to_the_end(self):
+        r = Rig()
+        r.user.load("p", proc('log "1"; log "2";'))
+        r.user.activate_step("p", None)
+        r.drive()
+        st = r.user.status("p")
+        self.assertEqual((st["state"], st["outcome"]), (INACTIVE, "confirmed"))
+        self.assertEqual([t for _, t in r.texts()], ["1", "2"])
+
     def test_resume_cancels_pending_suspend(self):
         r = Rig()
         r.user.load("p", one('wait for 3 s; log "x";'))

@@ -351,10 +351,155 @@ class TestRefusals(unittest.TestCase):
         self.assertTrue(r.run(r.user.set_observability(APID, {"turn": 2})).ok)
         self.assertEqual(r.status()["turn"]["level"], "step")
 
-    def test_activate_and_step_is_not_provided(self):
+    def test_step_by_step_refusals(self):
         r = Rig()
-        tx = r.run(r.loop.ground.send(APID, 18, 14, b"\x01a"))
+        r.run(r.user.load(APID, "steps", STEPS))
+        tx = r.run(r.user.resume_and_step(APID, "steps"))
+        self.assertEqual(failure_info(tx.failure), {"reason": "NOT_SUSPENDED", "obcp": "steps"})
+        tx = r.run(r.user.activate_and_step(APID, "nope"))
+        self.assertEqual((tx.failure["stage"], tx.failure["code"]), (START, FAILURE_UNKNOWN_ID))
+        self.assertTrue(r.run(r.user.activate_and_step(APID, "steps")).ok)
+        tx = r.run(r.user.activate_and_step(APID, "steps"))
+        self.assertEqual(failure_info(tx.failure), {"reason": "NOT_INACTIVE", "obcp": "steps"})
+        tx = r.run(r.user.resume_and_step(APID, "steps"))  # running its first step
+        self.assertEqual(failure_info(tx.failure)["reason"], "NOT_SUSPENDED")
+        r.drive(8.0)
+        self.assertEqual(r.status()["steps"]["status"], "suspended")
+        r.run(r.user.stop_engine(APID))
+        tx = r.run(r.user.resume_and_step(APID, "steps"))
+        self.assertEqual(failure_info(tx.failure)["reason"], "ENGINE_STOPPED")
+        tx = r.run(r.loop.ground.send(APID, 18, 15, b""))
+        self.assertEqual(tx.failure["stage"], 1)  # no OBCP ID: not even accepted
+        tx = r.run(r.loop.ground.send(APID, 18, 23, b"\x01a"))
         self.assertEqual((tx.failure["stage"], tx.failure["code"]), (1, FAILURE_ILLEGAL_SUBTYPE))
+
+
+STEPS = """procedure
+  main
+    log "before";
+    initiate and confirm step One
+      main
+        log "one";
+        wait for 5 s;
+        log "one done";
+      end main
+    end step;
+    log "between";
+    initiate and confirm step Two
+      main
+        log "two";
+      end main
+    end step;
+    log "after";
+  end main
+end procedure"""
+
+NESTED = """procedure
+  main
+    initiate and confirm step Outer
+      main
+        initiate and confirm step Inner
+          main
+            log "inner";
+          end main
+        end step;
+        log "outer";
+      end main
+    end step;
+    log "end";
+  end main
+end procedure"""
+
+
+class TestStepByStep(unittest.TestCase):
+    def logs(self, r):
+        return [d["text"] for _, d in r.reported("log")]
+
+    def test_activate_and_execute_one_step_then_resume_one_step_at_a_time(self):
+        r = Rig()
+        self.assertTrue(r.run(r.user.load(APID, "steps", STEPS)).ok)
+        tx = r.run(r.user.activate_and_step(APID, "steps", level=lay.LEVEL_STATEMENT))
+        self.assertTrue(tx.ok, tx.verification())
+        self.assertEqual(tx.verification()[-1], "completion success")
+        r.drive(8.0)
+        self.assertEqual(self.logs(r), ["before", "one", "one done"])
+        st = r.status()["steps"]
+        self.assertEqual((st["status"], st["outcome"], st["step"]), ("suspended", "none", ""))
+        self.assertEqual(r.engine.status("steps")["steps"], {"One": "confirmed"})
+        r.drive(20.0)  # held, whatever the time
+        self.assertEqual(self.logs(r), ["before", "one", "one done"])
+        self.assertTrue(r.run(r.user.resume_and_step(APID, "steps")).ok)
+        r.drive(2.0)
+        self.assertEqual(self.logs(r)[3:], ["between", "two"])
+        self.assertEqual(r.status()["steps"]["status"], "suspended")
+        self.assertTrue(r.run(r.user.resume_and_step(APID, "steps")).ok)
+        r.drive(2.0)  # no step left: runs to its end
+        self.assertEqual(self.logs(r)[5:], ["after"])
+        st = r.status()["steps"]
+        self.assertEqual((st["status"], st["outcome"]), ("inactive", "confirmed"))
+        states = [d["state"] for _, d in r.reported("state_changed")]
+        self.assertEqual(
+            states,
+            ["inactive", "running", "suspended", "running", "suspended", "running", "inactive"],
+        )
+        self.assertEqual(r.reported("failed"), [])
+
+    def test_resume_leaves_step_by_step_mode(self):
+        r = Rig(level=lay.LEVEL_STATEMENT)
+        r.run(r.user.load(APID, "steps", STEPS))
+        r.run(r.user.activate_and_step(APID, "steps", level=lay.LEVEL_STATEMENT))
+        r.drive(8.0)
+        self.assertEqual(r.status()["steps"]["status"], "suspended")
+        self.assertTrue(r.run(r.user.resume(APID, "steps")).ok)
+        r.drive(2.0)
+        self.assertEqual(self.logs(r)[3:], ["between", "two", "after"])
+        self.assertEqual(r.status()["steps"]["status"], "inactive")
+        r.run(r.user.activate(APID, "steps", level=lay.LEVEL_STATEMENT))  # not step by step
+        r.drive(8.0)
+        self.assertEqual(len(self.logs(r)), 12)
+        self.assertEqual(r.status()["steps"]["activations"], 2)
+
+    def test_suspended_inside_a_step_resume_and_step_ends_that_step(self):
+        r = Rig()
+        r.run(r.user.load(APID, "hold", HOLD))
+        r.run(r.user.activate(APID, "hold", level=lay.LEVEL_STATEMENT))
+        r.drive(1.0)
+        r.run(r.user.suspend(APID, "hold"))
+        r.drive(10.0)  # at the boundary after the wait, inside step Hold
+        st = r.status()["hold"]
+        self.assertEqual((st["status"], st["step"]), ("suspended", "Hold"))
+        self.assertTrue(r.run(r.user.resume_and_step(APID, "hold")).ok)
+        r.drive(2.0)
+        self.assertEqual(self.logs(r), ["held"])  # the rest of the step, not "done"
+        st = r.status()["hold"]
+        self.assertEqual((st["status"], st["step"]), ("suspended", ""))
+        r.run(r.user.resume_and_step(APID, "hold"))
+        r.drive(2.0)
+        self.assertEqual(self.logs(r), ["held", "done"])
+        self.assertEqual(r.status()["hold"]["outcome"], "confirmed")
+
+    def test_a_step_is_an_outermost_step(self):
+        r = Rig()
+        r.run(r.user.load(APID, "nested", NESTED))
+        r.run(r.user.activate_and_step(APID, "nested", level=lay.LEVEL_STATEMENT))
+        r.drive(2.0)
+        self.assertEqual(self.logs(r), ["inner", "outer"])
+        self.assertEqual(r.status()["nested"]["status"], "suspended")
+        r.run(r.user.resume_and_step(APID, "nested"))
+        r.drive(2.0)
+        self.assertEqual(self.logs(r), ["inner", "outer", "end"])
+
+    def test_stop_and_abort_while_step_by_step(self):
+        r = Rig()
+        for name in ("a", "b"):
+            r.run(r.user.load(APID, name, STEPS))
+            r.run(r.user.activate_and_step(APID, name))
+        r.drive(8.0)
+        self.assertEqual(r.engine.states, {"a": "suspended", "b": "suspended"})
+        self.assertTrue(r.run(r.user.stop(APID, "a")).ok)  # suspended between steps: at once
+        self.assertTrue(r.run(r.user.abort(APID, "b")).ok)
+        self.assertEqual(r.engine.states, {"a": "inactive", "b": "inactive"})
+        self.assertEqual(r.engine.status("b")["outcome"], "aborted")
 
 
 if __name__ == "__main__":

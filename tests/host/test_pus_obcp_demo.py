@@ -48,3 +48,54 @@ def test_command_values_and_parsers():
     obcp_command.add_to_ground(g.add_subparsers(dest="action"))
     args = g.parse_args(["obcp", "stop-unload", "x"])
     assert args.func is obcp_command._simple and args.action_name == "stop-unload"
+
+
+TWO_STEPS = """procedure
+  main
+    initiate and confirm step First main log "first"; end main end step;
+    initiate and confirm step Second main log "second"; end main end step;
+  end main
+end procedure
+"""
+
+
+def test_step_commands_run_a_procedure_one_step_at_a_time(tmp_path, capsys):
+    from obsw import sdb as sdb_module
+
+    sdb = sdb_module.load(SDB_PATH)
+    onboard, engine = obcp_demo.onboard_with_obcp(sdb, port=0, period=0.05)
+    path = tmp_path / "two.plt"
+    path.write_text(TWO_STEPS)
+    p = argparse.ArgumentParser()
+    obcp_command.add_parser(p.add_subparsers(dest="command"))
+    onboard.start()
+    try:
+        port = str(onboard.address[1])
+
+        def cli(*words):
+            args = p.parse_args(["obcp", "--port", port, "--json", *words])
+            code = args.func(args)
+            return code, json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+
+        def status_until(state):
+            for _ in range(200):  # each one a TC[18,8] round trip
+                code, out = cli("status")
+                obcps = {o["id"]: o for o in out["replies"][0]["obcps"]}
+                if obcps["two"]["status"] == state:
+                    return obcps["two"]
+            return obcps["two"]
+
+        assert cli("load", "two", str(path))[0] == 0
+        code, out = cli("step-activate", "two", "--level", "3")
+        assert code == 0 and out["explained"][-1] == "completion success"
+        assert status_until("suspended")["status"] == "suspended"
+        assert onboard.call(lambda: engine.status("two")["steps"]) == {"First": "confirmed"}
+        code, out = cli("step", "two")
+        assert code == 0
+        st = status_until("inactive")
+        assert (st["status"], st["outcome"]) == ("inactive", "confirmed")
+        code, out = cli("step", "two")  # no longer suspended
+        assert code == 1 and "NOT_SUSPENDED" in " ".join(out["explained"])
+    finally:
+        onboard.stop()
+        engine.system.close()

@@ -235,3 +235,54 @@ def test_spacepackets_tcs_are_served():
     assert r.panel.angle == 30.0
     assert r.engine.status("ping")["outcome"] == "confirmed"
     assert r.loop.app.counters["completed"] == 2
+
+
+def test_spacepackets_step_by_step_tcs_are_served():
+    """TC[18,14] and TC[18,15] built by spacepackets; the status report in between (TM[18,9])
+    decodes field for field: suspended after the step, inactive and confirmed at the end."""
+    r = Rig()
+    r.run(r.user.load(APID, "hold", HOLD))
+    seq = 10
+    act = bytes([4]) + b"hold" + bytes([3, 0])  # ID, level 3 (statement), N = 0 arguments
+    r.loop.app.receive(
+        SpTc(apid=APID, service=18, message_subtype=14, app_data=act, seq_count=seq).pack()
+    )
+    r.loop.pump()
+    r.drive(12.0)
+    r.run(r.user.report_status(APID))
+    raw, ours = _tm_of(r, 18, 9)[-1]
+    item = _status_items(_sp(raw, ours))[0]
+    assert (item["id"], lay.STATUS_NAMES[item["status"]], item["step"]) == (
+        "hold",
+        "suspended",
+        "",
+    )
+    step = bytes([4]) + b"hold"
+    r.loop.app.receive(
+        SpTc(apid=APID, service=18, message_subtype=15, app_data=step, seq_count=seq + 1).pack()
+    )
+    r.loop.pump()
+    r.drive(2.0)
+    r.run(r.user.report_status(APID))
+    raw, ours = _tm_of(r, 18, 9)[-1]
+    item = _status_items(_sp(raw, ours))[0]
+    assert (lay.STATUS_NAMES[item["status"]], lay.OUTCOME_NAMES[item["outcome"]]) == (
+        "inactive",
+        "confirmed",
+    )
+    params = ManagedParams(timestamp_len=6)
+    verif = ManagedParamsVerification(bytes_step_id=1, bytes_err_code=1)
+    completed = [
+        Service1Tm.unpack(raw, params, verif).tc_req_id.tc_psc.seq_count
+        for raw, t in zip(r.loop.raw, r.loop.tm)
+        if (t.service, t.subtype) == (1, 7)
+    ]
+    assert seq in completed and seq + 1 in completed  # both requests completed
+    events = [d for tm, d, _tx in r.loop.results if tm.service == 5 and d]
+    logs = [d["data"]["text"] for d in events if d.get("event") == "obcp.log"]
+    assert logs == ["held", "done"]
+
+
+def _tm_of(r, service, subtype):
+    pairs = zip(r.loop.raw, r.loop.tm)
+    return [(raw, t) for raw, t in pairs if (t.service, t.subtype) == (service, subtype)]

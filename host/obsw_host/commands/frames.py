@@ -19,6 +19,14 @@ def add_parser(sub):
     proc.add_argument("--host", default="127.0.0.1", help="where the application processes are")
     proc.add_argument("--port-base", type=int, default=5000, help="TC packets go to base+APID")
     proc.add_argument("--tm-port", type=int, default=4999, help="UDP port receiving TM packets")
+    proc.add_argument(
+        "--playback-port", type=int, default=None,
+        help="UDP port whose packets go on the playback VC (default: TM port + 1)",
+    )  # fmt: skip
+    for role, vcid in (("realtime", 0), ("playback", 1), ("essential", 6)):
+        proc.add_argument(
+            "--%s-vc" % role, type=int, default=vcid, help="TM VC of %s TM (%d)" % (role, vcid)
+        )
     proc.add_argument("--frame-length", type=int, default=256, help="TM frame length")
     proc.add_argument("--essential-map", type=int, default=None, help="MAP ID of HPCs")
     proc.add_argument("--duration", type=float, default=None, help="stop after N seconds")
@@ -55,20 +63,32 @@ def _hex(text):
 def processor(args):
     from obsw_host.frames.processor import FrameProcessorHost
 
-    host = FrameProcessorHost(
-        args.uart_a,
-        args.uart_b,
-        args.scid,
-        host=args.host,
-        port_base=args.port_base,
-        tm_port=args.tm_port,
-        tm_frame_length=args.frame_length,
-        essential_map=args.essential_map,
-    )
+    plan = {"realtime": args.realtime_vc, "playback": args.playback_vc}
+    plan["essential"] = args.essential_vc
+    playback = args.playback_port
+    if playback is None:
+        playback = args.tm_port + 1 if args.tm_port else 0
+    try:
+        host = FrameProcessorHost(
+            args.uart_a,
+            args.uart_b,
+            args.scid,
+            host=args.host,
+            port_base=args.port_base,
+            tm_port=args.tm_port,
+            vc_ports={args.playback_vc: playback},
+            tm_frame_length=args.frame_length,
+            essential_map=args.essential_map,
+            tm_plan=plan,
+        )
+    except ValueError as e:
+        raise SystemExit("obsw frames processor: %s" % e) from None
     for link in host.links:
         link.port.baudrate = args.baudrate
-    print("frame processor: %s + %s, TC to UDP %s:%d+APID, TM on UDP %d" % (
-        args.uart_a, args.uart_b, args.host, args.port_base, host.tm_port))  # fmt: skip
+    print("frame processor: %s + %s, TC to UDP %s:%d+APID, TM on UDP %d (VC %d), playback "
+          "TM on UDP %d (VC %d)" % (
+        args.uart_a, args.uart_b, args.host, args.port_base, host.tm_port, args.realtime_vc,
+        host.playback_port, args.playback_vc))  # fmt: skip
     try:
         host.run(duration=args.duration)
     finally:

@@ -8,6 +8,9 @@
     obsw obcp load-ref NAME REPO FILE       load a file of the on-board filestore (TC[18,13])
     obsw obcp activate NAME [--arg N=V].. [--level 0-3]          (TC[18,3])
     obsw obcp stop|suspend|resume|abort|unload|stop-unload NAME  (TC[18,4|5|6|12|2|20])
+    obsw obcp step-activate NAME [--arg N=V].. [--level 0-3]
+                                            activate and execute one step (TC[18,14])
+    obsw obcp step NAME                     resume and execute one step (TC[18,15])
     obsw obcp answer NAME VALUE             the answer to an OBCP's question (TC[18,7])
     obsw obcp observe NAME LEVEL            observability 0 none .. 3 statement (TC[18,16])
     obsw obcp status                        every OBCP's status (TC[18,8] -> TM[18,9])
@@ -87,6 +90,14 @@ def add_actions(s):
     x.add_argument("--arg", action="append", default=[], metavar="NAME=VALUE")
     x.add_argument("--level", type=int, default=2, help="observability 0..3 (default 2)")
     x.set_defaults(func=_activate)
+    x = s.add_parser("step-activate", help="TC[18,14] activate and execute one step")
+    x.add_argument("name")
+    x.add_argument("--arg", action="append", default=[], metavar="NAME=VALUE")
+    x.add_argument("--level", type=int, default=2, help="observability 0..3 (default 2)")
+    x.set_defaults(func=_step_activate)
+    x = s.add_parser("step", help="TC[18,15] resume a suspended OBCP for one step")
+    x.add_argument("name")
+    x.set_defaults(func=_step)
     for action in _SIMPLE:
         x = s.add_parser(action, help="%s an OBCP" % action.replace("-", " and "))
         x.add_argument("name")
@@ -225,6 +236,15 @@ def _load_ref(args):
 def _activate(args):
     arguments = parse_arguments(args.arg)
     return _run(args, lambda o: o.activate(args.name, arguments or None, args.level))
+
+
+def _step_activate(args):
+    arguments = parse_arguments(args.arg)
+    return _run(args, lambda o: o.activate_and_step(args.name, arguments or None, args.level))
+
+
+def _step(args):
+    return _run(args, lambda o: o.resume_and_step(args.name))
 
 
 def _simple(args):

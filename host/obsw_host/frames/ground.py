@@ -17,6 +17,7 @@ class Ground:
     """Sends telecommand packets through FOP-1 as CLTUs on every link and decodes telemetry.
 
     ``corrupt(link_index, cltu) -> cltu`` lets tests and the demo damage what one link carries.
+    ``packets`` holds the TM packets decoded, ``channel_packets`` the same as (VC ID, packet).
     """
 
     def __init__(
@@ -45,6 +46,7 @@ class Ground:
         self.queue = deque()
         self.notifications = []
         self.packets = deque()
+        self.channel_packets = deque()
         self.sent_frames = []
         self.bad_frames = 0
         self._last_mc = None
@@ -85,10 +87,13 @@ class Ground:
                     continue
                 try:
                     frame = TmFrame.unpack(raw)
-                    got.extend(self.demux.on_frame(frame))
+                    packets = self.demux.on_frame(frame)
                 except FrameError:
                     self.bad_frames += 1
                     continue
+                got.extend(packets)
+                for p in packets:
+                    self.channel_packets.append((frame.vcid, p))
                 if frame.ocf is not None and self.demux.clcw is not None:
                     self.fop.on_clcw(self.demux.clcw, now)
         self.fop.tick(now)

@@ -1,7 +1,12 @@
 """The frame processor process: two serial links to the COM module, UDP to the applications.
 
-Telecommand packets go to UDP port ``port_base + APID`` (5000 + APID by default); telemetry
-packets sent by the applications to ``tm_port`` leave as TM frames on both links.
+Telecommand packets go to UDP port ``port_base + APID`` (5000 + APID by default), sent from
+the ``tm_port`` socket, so an application answering the sender reaches the TM input; telemetry
+packets sent to ``tm_port`` (4999) leave as TM frames on both links, on the VC of their APID
+(the real-time VC unless mapped). Each entry of ``vc_ports`` (VC ID -> UDP port) is one more
+input whose packets all go on that VC, unchanged: by default the playback VC of the plan on
+``tm_port + 1`` (5000 would collide with APID 0), where the PUS application process sends
+what service 15 retrieves from its packet stores.
 """
 
 import select
@@ -27,6 +32,7 @@ class FrameProcessorHost:
         port_base=5000,
         tm_port=DEFAULT_TM_PORT,
         essential_port=None,
+        vc_ports=None,
         clock=time.monotonic,
         **options,
     ):
@@ -38,12 +44,40 @@ class FrameProcessorHost:
         self.essential_port = essential_port
         self.clock = clock
         self.essential = []
-        self.out = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self.tm = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self.tm.bind((host, tm_port))
-        self.tm.setblocking(False)
-        self.tm_port = self.tm.getsockname()[1]
         self.core = FrameProcessor(scid, self._route, self._essential, **options)
+        if vc_ports is None:
+            pb = self.core.playback_vcid
+            vc_ports = {} if pb is None else {pb: tm_port + 1 if tm_port else 0}
+        self.tm = self._bind(tm_port)
+        self.out = self.tm
+        self.tm_port = self.tm.getsockname()[1]
+        self.vc_inputs = {}  # socket -> VC ID
+        self.vc_ports = {}  # VC ID -> bound UDP port
+        try:
+            for vcid, port in vc_ports.items():
+                try:
+                    self.core.mux.channel(vcid)
+                except KeyError:
+                    raise ValueError(
+                        "no TM virtual channel %r for UDP port %d" % (vcid, port)
+                    ) from None
+                s = self._bind(port)
+                self.vc_inputs[s] = vcid
+                self.vc_ports[vcid] = s.getsockname()[1]
+        except (OSError, ValueError):
+            self.close()
+            raise
+
+    @property
+    def playback_port(self):
+        """The UDP port whose packets go on the playback VC (None without one)."""
+        return self.vc_ports.get(self.core.playback_vcid)
+
+    def _bind(self, port):
+        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        s.bind((self.host, port))
+        s.setblocking(False)
+        return s
 
     def _route(self, apid, packet):
         try:
@@ -58,7 +92,8 @@ class FrameProcessorHost:
 
     def step(self, timeout=0.05):
         """Wait up to ``timeout`` for input, process it, write due telemetry to both links."""
-        readable, _, _ = select.select(self.links + [self.tm], [], [], timeout)
+        inputs = self.links + [self.tm] + list(self.vc_inputs)
+        readable, _, _ = select.select(inputs, [], [], timeout)
         now = self.clock()
         for i, link in enumerate(self.links):
             if link in readable:
@@ -69,9 +104,17 @@ class FrameProcessorHost:
             while True:
                 try:
                     packet = self.tm.recv(65542)
-                except BlockingIOError:
+                except OSError:  # nothing more (or an ICMP error from a TC sent earlier)
                     break
                 self.core.send_packet(packet)
+        for s, vcid in self.vc_inputs.items():
+            if s in readable:
+                while True:
+                    try:
+                        packet = s.recv(65542)
+                    except OSError:
+                        break
+                    self.core.send_packet(packet, vcid)
         for cadu in self.core.tm_output(now):
             for link in self.links:
                 link.write(cadu)
@@ -84,5 +127,6 @@ class FrameProcessorHost:
     def close(self):
         for link in self.links:
             link.close()
-        self.out.close()
         self.tm.close()
+        for s in self.vc_inputs:
+            s.close()

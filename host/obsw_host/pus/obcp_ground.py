@@ -6,6 +6,8 @@
         obcp = ObcpGround(ground)
         obcp.load("turn", open("turn.plt").read())      # TC[18,1]; a Transaction
         obcp.activate("turn", level=3)                 # TC[18,3]
+        obcp.activate_and_step("turn")                 # TC[18,14] (when inactive): one step
+        obcp.resume_and_step("turn")                   # TC[18,15]: the next step
         obcp.status()                                  # {'turn': {'status': 'running', ..}}
         for e in obcp.events(timeout=5.0): ...         # the OBCP's service 5 events
 
@@ -69,6 +71,15 @@ class ObcpGround:
         """TC[18,3]; ``arguments`` maps names to values or ``{"value": v, "unit": u}``."""
         tx = self.user.activate(self._apid(apid), name, arguments, level)
         return self._issue(tx, timeout)
+
+    def activate_and_step(self, name, arguments=None, level=LEVEL_STEP, apid=None, timeout=None):
+        """TC[18,14]: activate; the OBCP suspends once its first step has ended."""
+        tx = self.user.activate_and_step(self._apid(apid), name, arguments, level)
+        return self._issue(tx, timeout)
+
+    def resume_and_step(self, name, apid=None, timeout=None):
+        """TC[18,15]: a suspended OBCP runs its next step, then suspends again."""
+        return self._issue(self.user.resume_and_step(self._apid(apid), name), timeout)
 
     def unload(self, name, apid=None, timeout=None):
         return self._issue(self.user.unload(self._apid(apid), name), timeout)

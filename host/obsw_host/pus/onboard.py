@@ -4,8 +4,11 @@
 calls for (1, 3, 5, 8, 9, 11, 12, 17, 19, 20, 21, and 22 when the database names a
 ``position_scheduling`` parameter), a parameter pool and an event manager on an interaction
 layer node, and serves TCs from UDP. TM goes back to the address the last TC came from
-(and to ``tm_to`` if given). ``start()`` runs it on an asyncio loop in a thread (demo,
-tests); ``serve()`` runs it in the calling thread until stopped (``obsw obc serve``).
+(and to ``tm_to`` if given). Packets that service 15 retrieves from a packet store go to
+``playback_to[vc]`` (a UDP address per virtual channel: the frame processor's input for that
+VC, ``FrameProcessorHost.vc_ports``), or out in real time when the store's VC has none.
+``start()`` runs it on an asyncio loop in a thread (demo, tests); ``serve()`` runs it in the
+calling thread until stopped (``obsw obc serve``).
 """
 
 import asyncio
@@ -17,6 +20,7 @@ from obsw.il.node import Node
 from obsw.pus.app import EVENT_CYCLE_OVERRUN, ApplicationProcess
 from obsw.pus.events import EventManager
 from obsw.pus.parameters import ParameterPool
+from obsw.pus.services.report_types import router_of
 from obsw.pus.services.s03_housekeeping import Housekeeping
 from obsw.pus.services.s05_events import EventReporting
 from obsw.pus.services.s08_functions import FunctionManagement, functions
@@ -71,6 +75,7 @@ class Onboard:
         period=0.1,
         store=None,
         tm_to=None,
+        playback_to=None,
         max_tasks=16,
         components=(),
         time_exponent=None,
@@ -81,6 +86,7 @@ class Onboard:
         self.port = port_for(self.apid) if port is None else port
         self.period = period
         self.tm_to = tm_to
+        self.playback_to = dict(playback_to or {})
         self.node = node if node is not None else Node("pus")
         self.address = None
         self.ground = None  # where TM goes: the sender of the last TC
@@ -114,6 +120,8 @@ class Onboard:
         self.pool.bind()
         self.events.bind()
         app = self.app
+        if self.playback_to:
+            router_of(app).playback = self._playback
         app.register(Housekeeping(self.pool, sdb.housekeeping))
         app.register(EventReporting(known=sdb.events))
         app.register(TimeManagement(time_exponent))
@@ -155,6 +163,19 @@ class Onboard:
             sent = True
         if not sent:
             self.app.count("tm_no_ground")
+
+    def _playback(self, raw, vc):
+        """TmRouter.playback: a retrieved packet on the frame processor's input of ``vc``."""
+        address = self.playback_to.get(vc)
+        if address is None:
+            self.app.count("playback_realtime")
+            self._send(raw)
+            return
+        t = self._transport
+        if t is None:
+            raise OSError("not bound")
+        t.sendto(raw, address)
+        self.app.count("playback_sent")
 
     def _received(self, data, addr):
         self.ground = addr

@@ -4,8 +4,12 @@ pass (services 14 and 15); a science file copied SAT: -> GROUND: with service 23
 ``Segment`` wires the pieces on loopback: the on-board PUS process (``Onboard``) with
 services 4, 6, 13, 14, 15 and 23 added, an on-board and a ground CFDP entity on UDP (PDUs
 optionally dropped), the remote file copy component of the on-board entity on the on-board
-interaction-layer node, and the ground process with ``StorageGround``. ``run(out=print)`` is
-the demo section; the host tests use ``Segment`` too.
+interaction-layer node, and the ground process with ``StorageGround``. With ``frames=True``
+the PUS packets travel the space link instead of plain UDP: a ground station (FOP-1, CLTUs)
+and the frame processor on two pseudo-UARTs; real-time TM comes down on the real-time VC and
+what service 15 retrieves on the playback VC (``obsw.frames.tm_plan``; the database's
+``frames.tm_vcs`` may renumber them). ``run(out=print)`` is the demo section; the host tests
+use ``Segment`` too.
 """
 
 import asyncio
@@ -28,12 +32,24 @@ from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity
 
 HK_STORE = 1
+SCID = 0x2A
 
 
 class Segment:
     """On-board and ground, PUS and CFDP, on loopback (see the module text)."""
 
-    def __init__(self, work, sdb=None, loss=0.0, seed=1, log=None, segment=512, timeout=5.0):
+    def __init__(
+        self,
+        work,
+        sdb=None,
+        loss=0.0,
+        seed=1,
+        log=None,
+        segment=512,
+        timeout=5.0,
+        frames=False,
+        tm_frame_length=256,
+    ):
         from obsw_host.pus.demo import load_sdb
         from obsw_host.pus.onboard import Onboard
 
@@ -61,12 +77,20 @@ class Segment:
         self.ground_udp.peers[sat_id] = self.sat_udp.address
         from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 
+        self.fp = self.station = None
+        self._threads = []
+        self._stop = None
+        playback_to = None
+        if frames:
+            self._open_link(sdb, tm_frame_length)
+            playback_to = {vc: ("127.0.0.1", p) for vc, p in self.fp.vc_ports.items()}
         self.onboard = Onboard(
             sdb,
             port=0,
             period=0.05,
             store=Store(os.path.join(work, "context")),
             components=[(SOLAR_PANEL, SolarPanel())],  # its parameters bind at once
+            playback_to=playback_to,
         )
         app = self.onboard.app
         self.copy = RemoteCopy(self.sat_entity)
@@ -86,7 +110,26 @@ class Segment:
         self.sg = None
         self._running = False
 
+    def _open_link(self, sdb, frame_length):
+        """The frame processor and a ground station on two pseudo-UART pairs."""
+        from obsw_host.frames.links import FdLink, SerialLink, open_pty_pair
+        from obsw_host.frames.processor import FrameProcessorHost
+        from obsw_host.frames.station import GroundStation
+
+        plan = (sdb.extra.get("frames") or {}).get("tm_vcs")
+        ctrl_a, dev_a = open_pty_pair()
+        ctrl_b, dev_b = open_pty_pair()
+        self.fp = FrameProcessorHost(
+            SerialLink(dev_a), SerialLink(dev_b), SCID, port_base=0, tm_port=0,
+            tm_frame_length=frame_length, tm_plan=plan, clcw_period=0.5,
+        )  # fmt: skip
+        self.station = GroundStation(
+            [FdLink(ctrl_a, "A"), FdLink(ctrl_b, "B")], SCID, tm_frame_length=frame_length
+        )
+
     def start(self):
+        import threading
+
         from obsw_host.pus.ground import Ground
         from obsw_host.pus.storage_ground import StorageGround
 
@@ -94,6 +137,14 @@ class Segment:
         self._running = True
         self.onboard.call(lambda: asyncio.ensure_future(self._cfdp_task()))
         host, port = self.onboard.address[:2]
+        if self.fp is not None:
+            self.fp.port_base = port - self.onboard.apid  # TC packets to the process's port
+            self._stop = threading.Event()
+            for name, target in (("frames", self.fp.run), ("station", self.station.run)):
+                t = threading.Thread(target=target, args=(self._stop,), name=name, daemon=True)
+                t.start()
+                self._threads.append(t)
+            host, port = self.station.address[:2]
         self.ground = Ground(self.sdb, target=(host, port), log=self.log, timeout=self.timeout)
         self.sg = StorageGround(self.ground, cfdp=self.ground_udp)
         return self
@@ -112,6 +163,15 @@ class Segment:
     def stop(self):
         self._running = False
         self.onboard.stop()
+        if self._stop is not None:
+            self._stop.set()
+            for t in self._threads:
+                t.join(2)
+            self._threads = []
+        if self.fp is not None:
+            self.fp.close()
+            self.station.close()
+            self.fp = self.station = None
         if self.ground is not None:
             self.ground.close()
         self.sat_udp.close()
@@ -133,21 +193,42 @@ def _hk_received(ground, since):
     return [d for tm, d in ground.received[since:] if (tm.service, tm.subtype) == (3, 25)]
 
 
-def run(out=print, loss=0.05, seed=3, size=48000):
-    """The demo section; returns True when every step went as expected."""
+def _vc_names(seg, packets):
+    """ "VC 1 (playback)" for each VC the (VC ID, packet) pairs came on."""
+    roles = {v: k for k, v in (seg.fp.core.tm_plan or {}).items()}
+    vcs = sorted({vc for vc, _ in packets})
+    return ", ".join("VC %d (%s)" % (vc, roles.get(vc, "?")) for vc in vcs) or "no VC"
+
+
+def _hk_on_link(seg, mark):
+    return [(vc, p) for vc, p in list(seg.station.downlinked)[mark:] if p[7:9] == b"\x03\x19"]
+
+
+def run(out=print, loss=0.05, seed=3, size=48000, frames=True):
+    """The demo section; returns True when every step went as expected. With ``frames`` the
+    PUS packets go over the space link (frame processor, two pseudo-UARTs, ground station)."""
     from obsw_host.pus.onboard import tai_now
 
     work = tempfile.mkdtemp(prefix="obsw-storage-demo-")
     ok = True
     try:
-        with Segment(work, loss=loss, seed=seed) as seg:
+        with Segment(work, loss=loss, seed=seed, frames=frames) as seg:
             sg, ground = seg.sg, seg.ground
             apid = ground.apid
             out(
                 "Storage and files: on-board PUS process APID %d with services 14, 15 and 23; "
                 "CFDP entities on loopback UDP, %d%% of PDUs dropped" % (apid, int(loss * 100))
             )
-            out("1. a packet store for housekeeping (service 15): circular, 64 KiB")
+            if frames:
+                out(
+                    "  PUS packets over the space link: ground station <-> 2 pseudo-UARTs <-> "
+                    "frame processor (TM VCs %s)"
+                    % ", ".join("%s %d" % (k, v) for k, v in seg.fp.core.tm_plan.items())
+                )
+            out(
+                "1. a packet store for housekeeping (service 15): circular, 64 KiB, "
+                "downlinked on the playback VC"
+            )
             ok &= _ok(out, sg.create_store(HK_STORE, 65536), "store %d created" % HK_STORE)
             ok &= _ok(out, sg.store_types(HK_STORE, {apid: {3: [25]}}), "keeps TM[3,25]")
             ok &= _ok(out, sg.enable_storage([HK_STORE]), "storage enabled")
@@ -177,6 +258,7 @@ def run(out=print, loss=0.05, seed=3, size=48000):
             ok &= st.get("count", 0) > 0
             out("3. the pass: downlink what was stored while out of contact, by time window")
             mark = len(ground.received)
+            link_mark = len(seg.station.downlinked) if frames else 0
             ok &= _ok(out, sg.retrieve_time(HK_STORE, t0, t1), "retrieval started")
             sg.wait_until(lambda: len(_hk_received(ground, mark)) >= 5, 3.0)
             sg.wait_until(lambda: False, 0.3)
@@ -185,7 +267,15 @@ def run(out=print, loss=0.05, seed=3, size=48000):
             if got:
                 out("     first: %s" % (got[0] or {}).get("values"))
             ok &= len(got) >= 5
+            if frames:
+                on_link = _hk_on_link(seg, link_mark)
+                out("  => they came down on %s" % _vc_names(seg, on_link))
+                ok &= {vc for vc, _ in on_link} == {seg.fp.core.playback_vcid}
+            link_mark = len(seg.station.downlinked) if frames else 0
             ok &= _ok(out, sg.forward_hk([]), "real-time HK forwarded again")
+            if frames:
+                sg.wait_until(lambda: _hk_on_link(seg, link_mark), 2.0)
+                out("  => live HK on %s" % _vc_names(seg, _hk_on_link(seg, link_mark)))
             ok &= _ok(out, sg.disable_storage([HK_STORE]), "storage disabled")
             out("4. a science file copied SAT: -> GROUND: with service 23, carried by CFDP")
             data = bytes((i * 7 + (i >> 8)) & 0xFF for i in range(size))

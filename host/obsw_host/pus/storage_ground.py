@@ -7,7 +7,7 @@
         sg.create_store(1, 65536)                          # TC[15,20]
         sg.store_types(1, {10: {3: [25]}}); sg.enable_storage([1])
         sg.summary()                                       # {'stores': [{'store': 1, ...}]}
-        sg.retrieve_time(1, t0, t1)                        # playback arrives as ordinary TM
+        sg.retrieve_time(1, t0, t1)                        # on the store's VC (playback)
         op = sg.copy("SAT:/science/a.dat", "GROUND:/a.dat")   # TC[23,14], operation ID
         sg.wait_copy(op)                                   # until TM[23,23] says completed
 
@@ -17,6 +17,7 @@ entity, until the completion report, a failure report or the timeout.
 
 import time
 
+from obsw.frames.tm_plan import PLAYBACK_VCID
 from obsw.pus.services.s02_device_access import DeviceUser
 from obsw.pus.services.s04_statistics import StatisticsUser
 from obsw.pus.services.s06_memory import MemoryUser
@@ -83,7 +84,9 @@ class StorageGround:
 
     # -------------------------------------------------------------------------- ST[15]
 
-    def create_store(self, store, size, kind=0, vc=0):
+    def create_store(self, store, size, kind=0, vc=PLAYBACK_VCID):
+        """TC[15,20]: a circular (``kind`` 0) or bounded (1) store of ``size`` bytes whose
+        retrievals go down on virtual channel ``vc`` (the playback VC unless told)."""
         return self.issue(
             self.storage.create(
                 self.apid, [{"store": store, "size": size, "kind": kind, "vc": vc}]

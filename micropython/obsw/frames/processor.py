@@ -10,7 +10,9 @@ from obsw.frames.dedup import Deduplicator
 from obsw.frames.errors import FecfError, FrameError
 from obsw.frames.farm import ACCEPT, Farm1
 from obsw.frames.tc import TYPE_BC, Reassembler, Segment, TcFrame, frame_length
-from obsw.frames.tm_mux import TmMultiplexer, TmVirtualChannel
+from obsw.frames.tm_mux import TmMultiplexer
+from obsw.frames.tm_plan import plan_channels
+from obsw.frames.tm_plan import tm_plan as make_plan
 
 COUNTERS = (
     "cltus",
@@ -26,6 +28,7 @@ COUNTERS = (
     "essential",
     "tm_packets",
     "tm_dropped",
+    "tm_unknown_vc",
     "tm_frames",
 )
 
@@ -50,6 +53,14 @@ class FrameProcessor:
     ``route(apid, packet)`` receives every telecommand packet; ``essential(unit)`` receives
     what arrives on MAP ``essential_map`` instead (high priority commands). TM packets go in
     with ``send_packet`` and come out of ``tm_output`` as CADUs for both links.
+
+    TM virtual channels: by default those of the plan ``tm_plan`` (``obsw.frames.tm_plan``:
+    real-time VC 0, playback VC 1, essential VC 6 unless the dict says otherwise); a packet
+    goes on the VC its APID is mapped to in ``tm_vc_of_apid``, else on the real-time VC,
+    unless ``send_packet`` names the VC (``send_playback`` names the playback VC). Explicit
+    ``tm_channels`` replace the plan's channels (with ``tm_plan`` given too, it still names
+    their roles); without a plan, packets whose APID is not mapped go to ``tm_default_vcid``
+    (default: the lowest-priority channel) and there is no playback VC.
     """
 
     def __init__(
@@ -64,6 +75,8 @@ class FrameProcessor:
         tm_frame_length=256,
         tm_channels=None,
         tm_vc_of_apid=None,
+        tm_plan=None,
+        tm_default_vcid=None,
         tm_randomize=True,
         farm_window=10,
         dedup_window=2.0,
@@ -85,11 +98,20 @@ class FrameProcessor:
         self._ocf_next = 0
         self.decoders = [CltuDecoder(tc_randomized), CltuDecoder(tc_randomized)]
         self.dedup = Deduplicator(dedup_window)
-        if tm_channels is None:
-            tm_channels = [TmVirtualChannel(0, 1, name="realtime")]
+        plan = None
+        if tm_channels is None or tm_plan is not None:
+            plan = make_plan(tm_plan)
+            if tm_channels is None:
+                tm_channels = plan_channels(plan)
+            if tm_default_vcid is None:
+                tm_default_vcid = plan["realtime"]
+        self.tm_plan = plan
         self.mux = TmMultiplexer(scid, tm_frame_length, tm_channels, self._ocf)
         self.tm_vc_of_apid = tm_vc_of_apid or {}
-        self.tm_default_vcid = self.mux.channels[-1].vcid if tm_channels else 0
+        if tm_default_vcid is None:
+            tm_default_vcid = self.mux.channels[-1].vcid if tm_channels else 0
+        self.tm_default_vcid = tm_default_vcid
+        self.playback_vcid = self.tm_plan["playback"] if self.tm_plan is not None else None
         self.counters = {}
         for name in COUNTERS:
             self.counters[name] = 0
@@ -176,15 +198,28 @@ class FrameProcessor:
         return farm.clcw().pack()
 
     def send_packet(self, packet, vcid=None):
-        """Queue a TM packet on its virtual channel (by APID unless ``vcid`` is given)."""
+        """Queue a TM packet, unchanged, on virtual channel ``vcid`` (by default the one its
+        APID is mapped to); False when the channel is full or not configured (counted)."""
         if vcid is None:
             apid = ((packet[0] & 7) << 8) | packet[1] if len(packet) >= 2 else 0
             vcid = self.tm_vc_of_apid.get(apid, self.tm_default_vcid)
-        if self.mux.channel(vcid).push(packet):
+        try:
+            channel = self.mux.channel(vcid)
+        except KeyError:
+            self._count("tm_unknown_vc")
+            return False
+        if channel.push(packet):
             self._count("tm_packets")
             return True
         self._count("tm_dropped")
         return False
+
+    def send_playback(self, packet):
+        """Queue a packet retrieved from a packet store on the plan's playback VC."""
+        if self.playback_vcid is None:
+            self._count("tm_unknown_vc")
+            return False
+        return self.send_packet(packet, self.playback_vcid)
 
     def tm_output(self, now, flush=True):
         """CADUs to write to both links: full frames by priority, then (with ``flush``) the

@@ -12,6 +12,13 @@ States (as in PUS ST[18]): ``inactive`` (loaded), ``running``, ``suspended`` and
 ``suspend`` at the next statement boundary, ``stop`` at the first boundary outside the steps
 executing when it was asked, ``abort`` at once (activities waited for are abandoned).
 
+Step by step (PUS TC[18,14] and TC[18,15]): ``activate_step`` starts an OBCP and
+``resume_step`` continues a suspended one, each for one step: the OBCP runs until a step
+(an outermost PLUTO ``step``: the one executing when resumed, else the next to begin) has
+ended, then suspends at the next statement boundary. Statements outside steps run with the
+step that follows them; with no step left the OBCP runs to its end. ``resume`` leaves step
+by step mode and runs on.
+
 The IL interface ``ENGINE``, the states, the refusal codes and ``Obcp`` (one loaded
 procedure) live in ``obsw.pluto.obcp``; they are imported here too.
 """
@@ -154,10 +161,25 @@ class ObcpEngine:
         ob.proc = proc
         ob.activations += 1
         ob.outcome = ob.error = ob.requested = ob.stop_steps = None
+        ob.stepping = ob.step_done = False
         ob.ready = True
         self._changed(ob, RUNNING)
         self._emit("started", {"obcp": name})
         self._wake(ob)
+
+    def activate_step(self, name, arguments=None):
+        """Start OBCP ``name`` step by step: it suspends once its first step has ended."""
+        self.activate(name, arguments)
+        self._obcps[name].stepping = True
+
+    def resume_step(self, name):
+        """Continue suspended OBCP ``name`` for one step, then suspend it again."""
+        ob = self._get(name)
+        if ob.state != SUSPENDED and ob.requested != "suspend":
+            raise ObcpError(NOT_SUSPENDED, "OBCP %s is %s" % (name, ob.state))
+        self.resume(name)
+        ob.stepping = True
+        ob.step_done = False
 
     def suspend(self, name):
         """Hold OBCP ``name`` at its next statement boundary."""
@@ -174,6 +196,7 @@ class ObcpEngine:
             raise ObcpError(NOT_SUSPENDED, "OBCP %s is %s" % (name, ob.state))
         ob.proc.resume()
         ob.requested = None
+        ob.stepping = False
         if ob.state == SUSPENDED:
             self._changed(ob, RUNNING)
         self._wake(ob)
@@ -266,6 +289,8 @@ class ObcpEngine:
         try:
             if ob.stop_steps is not None:
                 w = self._run_to_step_end(ob, now)
+            elif ob.stepping:
+                w = self._run_one_step(ob, now)
             else:
                 w = proc.run(now, self.budget)
         except Exception as e:  # a fault in a system adapter ends this OBCP, not the engine
@@ -292,6 +317,20 @@ class ObcpEngine:
             w = proc.run(now, 1)
             if proc.state != "running" or w is None:
                 return w
+            if w.activities or w.prompt or w.deadline is None or w.deadline > now:
+                return w  # a real wait, not the end of the one-statement budget
+        return Wait(now)
+
+    def _run_one_step(self, ob, now):
+        proc = ob.proc
+        for _ in range(self.budget):
+            w = proc.run(now, 1)
+            if proc.state != "running" or w is None:
+                return w
+            if ob.step_done and proc.at_boundary():
+                ob.step_done = False
+                proc.hold()
+                return None
             if w.activities or w.prompt or w.deadline is None or w.deadline > now:
                 return w  # a real wait, not the end of the one-statement budget
         return Wait(now)

@@ -73,6 +73,16 @@ class Procedure(Statements):
         if self.state == "running":
             self._suspend = True
 
+    def at_boundary(self):
+        """True when running and held between two statements (``run`` ran out of budget),
+        not inside a statement that waits."""
+        return self.state == "running" and self._pending
+
+    def hold(self):
+        """Suspend now, at the statement boundary ``run`` stopped at (see ``at_boundary``)."""
+        if self.at_boundary():
+            self.state = "suspended"
+
     def resume(self):
         if self.state == "suspended":
             self.state = "running"

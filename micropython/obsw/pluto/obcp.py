@@ -1,9 +1,10 @@
 """OBCPs as the engine keeps them: states, refusal codes, the engine's IL interface.
 
 ``ENGINE`` declares the OBCP engine component (``obsw.pluto.engine.ObcpEngine``): the
-operations (load, unload, activate, stop, suspend, resume, abort, answer, status), the
-attributes ``obcps`` and ``states`` and the events (progress, outcome, failures, log lines
-and user messages, each with the OBCP's name). Operations refuse with ``ObcpError`` (a
+operations (load, unload, activate, stop, suspend, resume, abort, answer, status, and
+activate_step and resume_step for execution one step at a time), the attributes ``obcps``
+and ``states`` and the events (progress, outcome, failures, log lines and user messages,
+each with the OBCP's name). Operations refuse with ``ObcpError`` (a
 ``ComponentError`` whose ``code`` is one of the reason names below). ``Obcp`` is one loaded
 procedure with its state; its ``status()`` is the plain data of a PUS ST[18] status report.
 """
@@ -45,6 +46,8 @@ ENGINE = Interface(
         Operation("abort", 9, ("name",), description="end now, status aborted"),
         Operation("answer", 10, ("name", "value"), description="answer an ask user"),
         Operation("status", 11, ("name",), returns="map", description="one OBCP's status"),
+        Operation("activate_step", 12, ("name", "arguments"), description="start, one step"),
+        Operation("resume_step", 13, ("name",), description="continue for one step"),
         Event("state_changed", 16, INFO, fields=("obcp", "state")),
         Event("started", 17, INFO, fields=("obcp",)),
         Event("step_status", 18, INFO, fields=("obcp", "step", "status")),
@@ -75,7 +78,15 @@ class Steps:
         self._ob = ob
 
     def __setitem__(self, step, status):
-        self._d[step] = status
+        d = self._d
+        d[step] = status
+        ob = self._ob
+        if ob.stepping and status != "executing":
+            for x in d.values():
+                if x == "executing":
+                    break
+            else:
+                ob.step_done = True  # an outermost step has ended: hold at the next boundary
         self._engine._emit("step_status", {"obcp": self._ob.name, "step": step, "status": status})
 
     def __getitem__(self, step):
@@ -114,6 +125,8 @@ class Obcp:
         self.activations = 0
         self.requested = None  # "suspend", "stop" or "abort" while it takes effect
         self.stop_steps = None
+        self.stepping = False  # step by step: hold once the step being run has ended
+        self.step_done = False
         self.ready = False
         self.due = None
 
@@ -141,6 +154,7 @@ class Obcp:
             "question": question,
             "activations": self.activations,
             "requested": self.requested,
+            "stepping": self.stepping,
         }
 
 

@@ -18,8 +18,12 @@ parameters (7: the answer to the question an OBCP waits on), report the status o
 (8, answered by TM[18,9]), abort (12), set observability levels (16), abort all and report
 (17, answered by TM[18,18] with the OBCPs aborted), load by reference and activate (19), stop
 and unload (20), start and stop the engine (21, 22; stopping aborts every active OBCP, and
-nothing is activated or resumed until it starts again). Activate-and-step (14, 15) is not
-provided.
+nothing is activated or resumed until it starts again), and execution one step at a time:
+activate and execute one OBCP step (14: activate with arguments and an observability level
+as TC[18,3]; the OBCP suspends once its first step has ended) and resume and execute one
+OBCP step (15: a suspended OBCP runs its next step, or finishes the step it was suspended
+in, then suspends again). A step is an outermost PLUTO step; TC[18,6] resume leaves step by
+step mode (``obsw.pluto.engine``).
 
 The engine's events become service 5 events with the IDs and auxiliary data of the
 spacecraft database entries ``obcp.<event>`` (``sdb_events``), filtered by the OBCP's
@@ -36,12 +40,14 @@ from obsw.pus.messages import (
     TC_OBCP_ABORT,
     TC_OBCP_ABORT_ALL,
     TC_OBCP_ACTIVATE,
+    TC_OBCP_ACTIVATE_AND_STEP,
     TC_OBCP_COMMUNICATE_PARAMETERS,
     TC_OBCP_LOAD_AND_ACTIVATE,
     TC_OBCP_LOAD_BY_REFERENCE,
     TC_OBCP_LOAD_DIRECT,
     TC_OBCP_REPORT_STATUS,
     TC_OBCP_RESUME,
+    TC_OBCP_RESUME_AND_STEP,
     TC_OBCP_SET_OBSERVABILITY,
     TC_OBCP_START_ENGINE,
     TC_OBCP_STOP,
@@ -96,6 +102,8 @@ class ObcpManagement(Service):
         (TC_OBCP_REPORT_STATUS, "report_status"),
         (TC_OBCP_ABORT, "abort"),
         (TC_OBCP_LOAD_BY_REFERENCE, "load_by_reference"),
+        (TC_OBCP_ACTIVATE_AND_STEP, "activate_and_step"),
+        (TC_OBCP_RESUME_AND_STEP, "resume_and_step"),
         (TC_OBCP_SET_OBSERVABILITY, "set_observability"),
         (TC_OBCP_ABORT_ALL, "abort_all"),
         (TC_OBCP_LOAD_AND_ACTIVATE, "load_and_activate"),
@@ -224,13 +232,13 @@ class ObcpManagement(Service):
         except UnicodeError:
             raise lay.rejection("other", 0, 0, "procedure text is not UTF-8") from None
 
-    def _activate(self, name, level, arguments):
+    def _activate(self, name, level, arguments, op="activate"):
         self._started(name)
         level = self._level(level)
         before = self.levels.get(name)
         self.levels[name] = level  # before the call: the started event is filtered by it
         try:
-            self._engine("activate", name, lay.decode_arguments(arguments) or None)
+            self._engine(op, name, lay.decode_arguments(arguments) or None)
         except PusFailure:
             if before is None:
                 self.levels.pop(name, None)
@@ -275,6 +283,15 @@ class ObcpManagement(Service):
     def activate(self, req):
         v = req.decode(lay.ACTIVATE)
         self._activate(v["id"], v["level"], v["args"])
+
+    def activate_and_step(self, req):
+        v = req.decode(lay.ACTIVATE)
+        self._activate(v["id"], v["level"], v["args"], "activate_step")
+
+    def resume_and_step(self, req):
+        name = req.decode(lay.ID)["id"]
+        self._started(name)
+        self._engine("resume_step", name)
 
     def stop(self, req):
         self._engine("stop", req.decode(lay.ID)["id"])

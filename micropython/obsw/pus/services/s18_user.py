@@ -11,12 +11,14 @@ from obsw.pus.messages import (
     TC_OBCP_ABORT,
     TC_OBCP_ABORT_ALL,
     TC_OBCP_ACTIVATE,
+    TC_OBCP_ACTIVATE_AND_STEP,
     TC_OBCP_COMMUNICATE_PARAMETERS,
     TC_OBCP_LOAD_AND_ACTIVATE,
     TC_OBCP_LOAD_BY_REFERENCE,
     TC_OBCP_LOAD_DIRECT,
     TC_OBCP_REPORT_STATUS,
     TC_OBCP_RESUME,
+    TC_OBCP_RESUME_AND_STEP,
     TC_OBCP_SET_OBSERVABILITY,
     TC_OBCP_START_ENGINE,
     TC_OBCP_STOP,
@@ -83,6 +85,17 @@ class ObcpUser(ServiceUser):
             {"id": name, "level": level, "args": lay.encode_arguments(arguments)}
         )
         return self.request(apid, TC_OBCP_ACTIVATE, data)
+
+    def activate_and_step(self, apid, name, arguments=None, level=lay.LEVEL_STEP):
+        """TC[18,14]: activate as TC[18,3]; the OBCP suspends once its first step ended."""
+        data = lay.ACTIVATE.pack(
+            {"id": name, "level": level, "args": lay.encode_arguments(arguments)}
+        )
+        return self.request(apid, TC_OBCP_ACTIVATE_AND_STEP, data)
+
+    def resume_and_step(self, apid, name):
+        """TC[18,15]: a suspended OBCP runs one more step, then suspends again."""
+        return self._id(apid, TC_OBCP_RESUME_AND_STEP, name)
 
     def load_and_activate(
         self, apid, name, repository, file, arguments=None, level=lay.LEVEL_STEP

@@ -1,0 +1,77 @@
+"""A ground station for a mission control process: space packets on UDP, frames on the links.
+
+TC packets that arrive on the station's UDP socket go up through FOP-1 (AD service, MAP
+``map_id``) as CLTUs on every link; TM frames read from the links are decoded and their
+packets go, unchanged, to the mission control process (``mcs``, or whoever sent the last TC)
+on UDP. ``downlinked`` keeps (VC ID, packet) of the packets forwarded, so a test or the demo
+can tell real-time telemetry from playback.
+"""
+
+import socket
+import time
+from collections import deque
+
+from obsw.frames import fop as F
+
+from obsw_host.frames.ground import Ground
+
+
+class GroundStation:
+    """``Ground`` (FOP-1, CLTUs, TM decoding) between ``links`` and one UDP socket."""
+
+    def __init__(
+        self, links, scid, host="127.0.0.1", port=0, mcs=None, keep=10000, clock=None, **options
+    ):
+        self.ground = Ground(links, scid, **options)
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.bind((host, port))
+        self.sock.setblocking(False)
+        self.address = self.sock.getsockname()
+        self.mcs = mcs
+        self.downlinked = deque((), keep)
+        self.clock = clock or time.monotonic
+        self._t0 = self.clock()
+        self.uplinked = 0
+        self._initiated = False
+
+    def now(self):
+        return self.clock() - self._t0
+
+    def step(self, timeout=0.02):
+        """Forward what came from the mission control process and from the links."""
+        now = self.now()
+        if not self._initiated:
+            self.ground.initiate(now)  # AD service with Unlock; TCs queue until it is active
+            self._initiated = True
+        while True:
+            try:
+                packet, sender = self.sock.recvfrom(65542)
+            except OSError:
+                break
+            if self.mcs is None or self.mcs != sender:
+                self.mcs = sender
+            self.ground.send(packet, now)
+            self.uplinked += 1
+        self.ground.poll(now, timeout)
+        ch = self.ground.channel_packets
+        while ch:
+            vcid, packet = ch.popleft()
+            self.downlinked.append((vcid, packet))
+            if self.mcs is not None:
+                try:
+                    self.sock.sendto(packet, self.mcs)
+                except OSError:
+                    pass  # the mission control process is gone: UDP drops it
+        self.ground.packets.clear()  # kept in ``downlinked`` with their VC
+        if self.ground.fop.state == F.INITIAL and self.ground.fop.outstanding == 0:
+            self._initiated = False  # FOP-1 gave up (e.g. links cut): start it again
+
+    def run(self, stop):
+        """Step until ``stop`` (a threading.Event) is set."""
+        while not stop.is_set():
+            self.step()
+
+    def close(self):
+        self.sock.close()
+        for link in self.ground.links:
+            link.close()

@@ -77,6 +77,22 @@ else:
             return struct.unpack_from(self.format, buf, offset)
 
 
+def _struct_checks_ranges():
+    for fmt, value in ((">B", 256), (">B", -1), (">H", 1 << 16), (">I", 1 << 32), (">I", -1)):
+        try:
+            struct.pack(fmt, value)
+        except Exception:
+            continue
+        return False
+    return True
+
+
+# True where struct.pack rejects a value its format code cannot hold (CPython raises
+# struct.error) instead of truncating it (MicroPython): codecs can then leave those range
+# checks to struct and only check the fields narrower than a format code themselves.
+STRUCT_CHECKS_RANGES = _struct_checks_ranges()
+
+
 def sleep(seconds):
     """Sleep for a (possibly fractional) number of seconds on either interpreter."""
     if hasattr(time, "sleep_ms"):

@@ -61,6 +61,13 @@ class TestRunningValues(unittest.TestCase):
         for f in (crc.crc16_ccitt, crc.crc32, crc.crc32c, crc.crc32_proximity1):
             self.assertEqual(f(data[100:], f(data[:100])), f(data))
 
+    def test_update_form_agrees(self):
+        # crc16_ccitt_update takes the register explicitly (binascii.crc_hqx on CPython)
+        for s in (b"", CHECK, bytes(range(256))):
+            self.assertEqual(crc.crc16_ccitt_update(s, 0xFFFF), crc.crc16_ccitt(s))
+            self.assertEqual(crc.crc16_ccitt_update(s, 0xFFFF), crc.CRC16_CCITT_FALSE(s))
+        self.assertEqual(crc.crc16_ccitt_update(CHECK[4:], crc.crc16_ccitt(CHECK[:4])), 0x29B1)
+
     def test_fast_path_agrees_with_pure(self):
         # On CPython the accelerated functions come from crcmod; on MicroPython they are the pure
         # ones. Either way both must agree on every input.

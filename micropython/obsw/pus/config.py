@@ -64,6 +64,11 @@ class PusConfig:
         self.source_id_max = (1 << (8 * self.source_id_size)) - 1
         self.destination_id_max = (1 << (8 * self.destination_id_size)) - 1
         self.message_counter_max = (1 << (8 * self.message_counter_size)) - 1
+        # widths in bits: ``value >> bits`` is non-zero exactly when a value (negative ones
+        # included) does not fit, one cheap test per field on the encode path
+        self.source_id_bits = 8 * self.source_id_size
+        self.destination_id_bits = 8 * self.destination_id_size
+        self.message_counter_bits = 8 * self.message_counter_size
         self._build_fast_paths()
 
     def _build_fast_paths(self):

@@ -152,6 +152,20 @@ def _range(field, value, maximum):
         raise FieldRangeError(field, value, maximum)
 
 
+def _refused(p, config, total):
+    """Why struct.pack refused ``p``: FieldRangeError for an integer out of range, TypeError for
+    a value that is no integer, or None (the caller then re-raises struct's own error)."""
+    try:
+        p._check(config, total)
+    except FieldRangeError as e:
+        if isinstance(e.value, int):
+            return e
+        return TypeError("%s must be an integer, not %r" % (e.field, e.value))
+    except Exception:  # a malformed value the checks themselves trip over
+        pass
+    return None
+
+
 def _check_common(p):
     _range("APID", p.apid, 0x7FF)
     _range("sequence count", p.seq_count, 0x3FFF)

@@ -1,7 +1,7 @@
 """PUS-C telecommand packets (ECSS-E-ST-70-41C 7.4.3): TC secondary header, app data, PEC."""
 
-from obsw.compat import const
-from obsw.crc import crc16_ccitt
+from obsw.compat import STRUCT_CHECKS_RANGES, const
+from obsw.crc import crc16_ccitt_update as _crc
 from obsw.pus.config import DEFAULT
 from obsw.pus.packets import (
     _PEC_PACK,
@@ -13,10 +13,13 @@ from obsw.pus.packets import (
     _frame,
     _int,
     _range,
+    _refused,
 )
 from obsw.spp import SEQ_UNSEGMENTED, TYPE_TC, FieldRangeError
 
 _TC_ID = const(0x1800)  # version 0, type 1 (TC), secondary header flag 1
+_new = object.__new__
+_LAX = not STRUCT_CHECKS_RANGES  # check every field in Python, struct will not
 
 
 class PusTc:
@@ -76,42 +79,81 @@ class PusTc:
         c = self.config
         data = self.data
         apid = self.apid
-        src = self.source_id
         count = self.seq_count
         flags = self.seq_flags
         ack = self.ack
-        svc = self.service
-        sub = self.subtype
-        # one cheap test for every field; negative values shift to -1 and fail it too
-        if apid >> 11 or count >> 14 or flags >> 2 or ack >> 4 or (svc | sub) >> 8 or src < 0:
-            self._check(c)
-        if src > c.source_id_max:
-            self._check(c)
         total = c.tc_min_size + len(data)
+        # Python checks the upper bounds of the fields narrower than a struct code; struct.pack
+        # refuses the rest (a negative value makes its header word negative too).
+        if apid > 0x7FF or count > 0x3FFF or flags > 3 or ack > 15 or _LAX and self._lax(c):
+            self._check(c, total)
+        s = c.tc_struct
+        if s is None:
+            return self._pack_fields(c, total)
+        try:
+            head = (
+                s.pack(
+                    _TC_ID | apid,
+                    (flags << 14) | count,
+                    total - 7,
+                    0x20 | ack,
+                    self.service,
+                    self.subtype,
+                    self.source_id,
+                )
+                + data
+            )
+        except Exception:
+            e = _refused(self, c, total)
+            if e is None:
+                raise
+            raise e from None
         if total > c.max_packet_size:
             raise FieldRangeError("TC packet length", total, c.max_packet_size)
-        s = c.tc_struct
-        if s is not None:
-            head = s.pack(
-                _TC_ID | apid, (flags << 14) | count, total - 7, 0x20 | ack, svc, sub, src
-            )
-        else:
-            head = c.tc_common.pack(
-                _TC_ID | apid, (flags << 14) | count, total - 7, 0x20 | ack, svc, sub
-            )
-            if c.source_id_size:
-                head += src.to_bytes(c.source_id_size, "big")
-            if c.tc_spare:
-                head += bytes(c.tc_spare)
         if c.pec:
-            head += data
-            return head + _PEC_PACK(crc16_ccitt(head))
-        return head + data
+            return head + _PEC_PACK(_crc(head, 0xFFFF))
+        return head
 
-    def _check(self, c):
+    def _pack_fields(self, c, total):
+        # layouts without one struct for the whole header (3-octet source ID, spare octets)
+        if self._lax(c):
+            self._check(c, total)
+        elif total > c.max_packet_size:
+            raise FieldRangeError("TC packet length", total, c.max_packet_size)
+        head = c.tc_common.pack(
+            self.packet_id,
+            self.sequence_control,
+            total - 7,
+            0x20 | self.ack,
+            self.service,
+            self.subtype,
+        )
+        if c.source_id_size:
+            head += self.source_id.to_bytes(c.source_id_size, "big")
+        if c.tc_spare:
+            head += bytes(c.tc_spare)
+        head += self.data
+        if c.pec:
+            return head + _PEC_PACK(_crc(head, 0xFFFF))
+        return head
+
+    def _lax(self, c):
+        # True if a value is negative or too wide for its octets: what struct.pack refuses on
+        # CPython but lets through truncated on MicroPython (pack() tests the upper bounds of
+        # the fields narrower than a struct code itself)
+        return (
+            (self.apid | self.seq_count | self.seq_flags | self.ack) < 0
+            or (self.service | self.subtype) >> 8
+            or self.source_id >> c.source_id_bits
+        )
+
+    def _check(self, c, total=0):
+        # every field in turn, then the packet length: the first that is wrong raises
         _check_common(self)
         _range("acknowledgement flags", self.ack, 15)
         _range("source ID", self.source_id, c.source_id_max)
+        if total > c.max_packet_size:
+            raise FieldRangeError("TC packet length", total, c.max_packet_size)
 
     @classmethod
     def unpack(cls, buf, config=DEFAULT):
@@ -126,26 +168,20 @@ class PusTc:
                 and dlen + 7 == n
                 and b0 & 0xF0 == 0x20
                 and n <= config.max_packet_size
+                and (not config.pec or _crc(buf, 0xFFFF) == 0)
             ):
-                if config.pec:
-                    ok = crc16_ccitt(buf) == 0
-                    end = n - 2
-                else:
-                    ok = True
-                    end = n
-                if ok:
-                    data = buf[config.tc_data_offset : end]
-                    return cls(
-                        pid & 0x7FF,
-                        svc,
-                        sub,
-                        data if data.__class__ is bytes else bytes(data),
-                        psc & 0x3FFF,
-                        b0 & 15,
-                        src,
-                        psc >> 14,
-                        config,
-                    )
+                data = buf[config.tc_data_offset : n - config.pec_size]
+                tc = _new(cls)
+                tc.apid = pid & 0x7FF
+                tc.service = svc
+                tc.subtype = sub
+                tc.data = data if data.__class__ is bytes else bytes(data)
+                tc.seq_count = psc & 0x3FFF
+                tc.ack = b0 & 15
+                tc.source_id = src
+                tc.seq_flags = psc >> 14
+                tc.config = config
+                return tc
         return cls._decode(buf, 0, config, True)[0]
 
     @classmethod

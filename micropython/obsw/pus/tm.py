@@ -1,7 +1,7 @@
 """PUS-C telemetry packets (ECSS-E-ST-70-41C 7.4.2): TM secondary header, source data, PEC."""
 
-from obsw.compat import const
-from obsw.crc import crc16_ccitt
+from obsw.compat import STRUCT_CHECKS_RANGES, const
+from obsw.crc import crc16_ccitt_update as _crc
 from obsw.pus.config import DEFAULT
 from obsw.pus.packets import (
     _PEC_PACK,
@@ -12,11 +12,15 @@ from obsw.pus.packets import (
     _frame,
     _int,
     _range,
+    _refused,
 )
 from obsw.spp import SEQ_UNSEGMENTED, TYPE_TM, FieldRangeError
 from obsw.timecode import TimeCodeError
 
 _TM_ID = const(0x0800)  # version 0, type 0 (TM), secondary header flag 1
+_NO_TIME = (0, 0)  # what time=None packs as in the struct layouts
+_new = object.__new__
+_LAX = not STRUCT_CHECKS_RANGES  # check every field in Python, struct will not
 
 
 class PusTm:
@@ -79,13 +83,16 @@ class PusTm:
     def message_type(self):
         return (self.service, self.subtype)
 
-    def _check(self, c):
+    def _check(self, c, total=0, time=True):
+        # every header field in turn, the packet length, then the time: the first wrong raises
         _check_common(self)
         _range("time reference status", self.time_ref, 15)
         _range("message type counter", self.message_counter, c.message_counter_max)
         _range("destination ID", self.destination_id, c.destination_id_max)
+        if total > c.max_packet_size:
+            raise FieldRangeError("TM packet length", total, c.max_packet_size)
         tf = c.time_fields
-        if tf is not None and self.time is not None:
+        if time and tf is not None and self.time is not None:
             _range("time coarse", self.time[0], (1 << tf[0]) - 1)
             _range("time fine", self.time[1], (1 << tf[1]) - 1)
 
@@ -96,59 +103,96 @@ class PusTm:
         count = self.seq_count
         flags = self.seq_flags
         ref = self.time_ref
-        svc = self.service
-        sub = self.subtype
-        cnt = self.message_counter
-        dest = self.destination_id
-        if apid >> 11 or count >> 14 or flags >> 2 or ref >> 4 or (svc | sub) >> 8:
-            self._check(c)
-        if cnt < 0 or dest < 0 or cnt > c.message_counter_max or dest > c.destination_id_max:
-            self._check(c)
         total = c.tm_min_size + len(data)
+        # Python checks the upper bounds of the fields narrower than a struct code; struct.pack
+        # refuses the rest (a negative value makes its header word negative too).
+        if apid > 0x7FF or count > 0x3FFF or flags > 3 or ref > 15 or _LAX and self._lax(c):
+            self._check(c, total)
+        s = c.tm_struct
+        if s is None:
+            return self._pack_fields(c, total)
+        t = self.time
+        if _LAX and t is not None:
+            self._lax_time(c, total, t)
+        coarse, fine = _NO_TIME if t is None else t
+        try:
+            head = (
+                s.pack(
+                    _TM_ID | apid,
+                    (flags << 14) | count,
+                    total - 7,
+                    0x20 | ref,
+                    self.service,
+                    self.subtype,
+                    self.message_counter,
+                    self.destination_id,
+                    coarse,
+                    fine,
+                )
+                + data
+            )
+        except Exception:
+            e = _refused(self, c, total)
+            if e is None:
+                raise
+            raise e from None
         if total > c.max_packet_size:
             raise FieldRangeError("TM packet length", total, c.max_packet_size)
-        s = c.tm_struct
-        t = self.time
-        if s is not None:
-            if t is None:
-                coarse = fine = 0
-            else:
-                coarse, fine = t
-                tf = c.time_fields
-                if (coarse >> tf[0]) | (fine >> tf[1]):
-                    self._check(c)
-            head = s.pack(
-                _TM_ID | apid,
-                (flags << 14) | count,
-                total - 7,
-                0x20 | ref,
-                svc,
-                sub,
-                cnt,
-                dest,
-                coarse,
-                fine,
-            )
-        else:
-            head = c.tc_common.pack(
-                _TM_ID | apid, (flags << 14) | count, total - 7, 0x20 | ref, svc, sub
-            )
-            if c.message_counter_size:
-                head += cnt.to_bytes(c.message_counter_size, "big")
-            if c.destination_id_size:
-                head += dest.to_bytes(c.destination_id_size, "big")
-            code = c.time
-            if code is not None:
-                try:
-                    head += code.pack(*t) if t is not None else code.pack_seconds(0)
-                except TimeCodeError as e:
-                    raise FieldRangeError("time", t, code.size) from e
-            if c.tm_spare:
-                head += bytes(c.tm_spare)
         if c.pec:
-            head += data
-            return head + _PEC_PACK(crc16_ccitt(head))
-        return head + data
+            return head + _PEC_PACK(_crc(head, 0xFFFF))
+        return head
+
+    def _lax(self, c):
+        # True if a value is negative or too wide for its octets: what struct.pack refuses on
+        # CPython but lets through truncated on MicroPython (pack() tests the upper bounds of
+        # the fields narrower than a struct code itself)
+        return (
+            (self.apid | self.seq_count | self.seq_flags | self.time_ref) < 0
+            or (self.service | self.subtype) >> 8
+            | self.message_counter >> c.message_counter_bits
+            | self.destination_id >> c.destination_id_bits
+        )
+
+    def _lax_time(self, c, total, t):
+        # the time range checks struct.pack makes on CPython, in the order pack() always had
+        coarse, fine = t
+        tf = c.time_fields
+        if coarse >> tf[0] | fine >> tf[1]:
+            if total > c.max_packet_size:
+                raise FieldRangeError("TM packet length", total, c.max_packet_size)
+            self._check(c, total)
+
+    def _pack_fields(self, c, total):
+        # layouts without one struct for the whole header (odd field sizes, other time codes)
+        if self._lax(c):
+            self._check(c, total, False)  # the time code checks the time as it packs it
+        elif total > c.max_packet_size:
+            raise FieldRangeError("TM packet length", total, c.max_packet_size)
+        head = c.tc_common.pack(
+            self.packet_id,
+            self.sequence_control,
+            total - 7,
+            0x20 | self.time_ref,
+            self.service,
+            self.subtype,
+        )
+        if c.message_counter_size:
+            head += self.message_counter.to_bytes(c.message_counter_size, "big")
+        if c.destination_id_size:
+            head += self.destination_id.to_bytes(c.destination_id_size, "big")
+        code = c.time
+        t = self.time
+        if code is not None:
+            try:
+                head += code.pack(*t) if t is not None else code.pack_seconds(0)
+            except TimeCodeError as e:
+                raise FieldRangeError("time", t, code.size) from e
+        if c.tm_spare:
+            head += bytes(c.tm_spare)
+        head += self.data
+        if c.pec:
+            return head + _PEC_PACK(_crc(head, 0xFFFF))
+        return head
 
     @classmethod
     def unpack(cls, buf, config=DEFAULT):
@@ -163,28 +207,22 @@ class PusTm:
                 and dlen + 7 == n
                 and b0 & 0xF0 == 0x20
                 and n <= config.max_packet_size
+                and (not config.pec or _crc(buf, 0xFFFF) == 0)
             ):
-                if config.pec:
-                    ok = crc16_ccitt(buf) == 0
-                    end = n - 2
-                else:
-                    ok = True
-                    end = n
-                if ok:
-                    data = buf[config.tm_data_offset : end]
-                    return cls(
-                        pid & 0x7FF,
-                        svc,
-                        sub,
-                        data if data.__class__ is bytes else bytes(data),
-                        psc & 0x3FFF,
-                        cnt,
-                        dest,
-                        (coarse, fine),
-                        b0 & 15,
-                        psc >> 14,
-                        config,
-                    )
+                data = buf[config.tm_data_offset : n - config.pec_size]
+                tm = _new(cls)
+                tm.apid = pid & 0x7FF
+                tm.service = svc
+                tm.subtype = sub
+                tm.data = data if data.__class__ is bytes else bytes(data)
+                tm.seq_count = psc & 0x3FFF
+                tm.message_counter = cnt
+                tm.destination_id = dest
+                tm.time = (coarse, fine)
+                tm.time_ref = b0 & 15
+                tm.seq_flags = psc >> 14
+                tm.config = config
+                return tm
         return cls._decode(buf, 0, config, True)[0]
 
     @classmethod

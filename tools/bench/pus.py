@@ -2,7 +2,8 @@
 
 Each round trip builds a packet object from field values, packs it, unpacks the bytes and reads
 the fields back. The reference is hand-written `struct` code doing the same with the same CRC
-function (obsw.crc.crc16_ccitt). TM[3,25] carries a 16-bit structure ID and 16 uint32
+function obsw uses (obsw.crc.crc16_ccitt_update, binascii.crc_hqx on CPython). TM[3,25]
+carries a 16-bit structure ID and 16 uint32
 parameters, encoded once up front and the same bytes for every implementation.
 
 Usage: python tools/bench/pus.py [--quick] [--json]
@@ -19,7 +20,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
-from obsw.crc import crc16_ccitt  # noqa: E402
+from obsw.crc import crc16_ccitt_update  # noqa: E402
 from obsw.pus.tc import PusTc  # noqa: E402
 from obsw.pus.tm import PusTm  # noqa: E402
 
@@ -72,9 +73,9 @@ def reference_tc(service, subtype, data):
             body = head_pack(
                 0x1800 | APID, 0xC000 | (i & 0x3FFF), len(data) + 6, 0x2F, service, subtype, 0
             ) + bytes(data)
-            raw = body + pec(crc16_ccitt(body))
+            raw = body + pec(crc16_ccitt_update(body, 0xFFFF))
             pid, psc, dlen, b0, svc, sub, src = head_unpack(raw)
-            if dlen + 7 != len(raw) or crc16_ccitt(raw) != 0 or b0 >> 4 != 2:
+            if dlen + 7 != len(raw) or crc16_ccitt_update(raw, 0xFFFF) != 0 or b0 >> 4 != 2:
                 raise ValueError("bad packet")
             app = raw[11:-2]
             if sub != subtype or len(app) != len(data):
@@ -101,9 +102,9 @@ def reference_tm(service, subtype, data):
                 TIME[0],
                 TIME[1],
             ) + bytes(data)
-            raw = body + pec(crc16_ccitt(body))
+            raw = body + pec(crc16_ccitt_update(body, 0xFFFF))
             pid, psc, dlen, b0, svc, sub, cnt, dest, coarse, fine = head_unpack(raw)
-            if dlen + 7 != len(raw) or crc16_ccitt(raw) != 0 or b0 >> 4 != 2:
+            if dlen + 7 != len(raw) or crc16_ccitt_update(raw, 0xFFFF) != 0 or b0 >> 4 != 2:
                 raise ValueError("bad packet")
             src = raw[19:-2]
             if sub != subtype or len(src) != len(data):

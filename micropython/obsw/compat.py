@@ -101,13 +101,24 @@ def sleep(seconds):
         time.sleep(seconds)
 
 
+def pure():
+    """True where the core must not use C accelerators: always on MicroPython, and on CPython
+    when the environment variable OBSW_PURE is set to anything but "" or "0" (tests then
+    exercise the pure-Python paths the accelerated ones must agree with)."""
+    if MICROPYTHON:
+        return True
+    import os
+
+    return os.environ.get("OBSW_PURE", "0") not in ("", "0")
+
+
 def crc_accelerator(width, poly, init, reflect, xorout):
     """Return a C-accelerated CRC function ``f(data, previous_crc)`` or None.
 
     ``poly`` is given without its top bit; ``init`` is the register value before the first byte.
     The function returned continues a running CRC the same way the core's pure functions do.
     """
-    if MICROPYTHON:
+    if pure():
         return None
     if (width, poly, reflect, xorout) == (16, 0x1021, False, 0):
         import binascii  # CPython's crc_hqx is this CRC family, C-fast and always present
@@ -119,3 +130,23 @@ def crc_accelerator(width, poly, init, reflect, xorout):
         return None
     # crcmod applies xorOut to initCrc itself, so hand it the value it will un-xor.
     return crcmod.mkCrcFun((1 << width) | poly, initCrc=init ^ xorout, rev=reflect, xorOut=xorout)
+
+
+_PUS_API = const(1)  # the obsw_speedups interface this core speaks
+
+
+def pus_accelerator():
+    """The C packet codec ``obsw_speedups`` (built with the host package on CPython) or None.
+
+    It only ever takes the inputs it can handle without doubt and returns None for the rest,
+    so the pure-Python codec stays the definition and raises the errors.
+    """
+    if pure():
+        return None
+    try:
+        import obsw_speedups
+    except ImportError:
+        return None
+    if getattr(obsw_speedups, "API", None) != _PUS_API:
+        return None  # a stale build from other sources
+    return obsw_speedups

@@ -1,6 +1,6 @@
 """PUS-C mission parameters: which optional packet fields exist and their sizes."""
 
-from obsw.compat import Struct
+from obsw.compat import Struct, pus_accelerator
 from obsw.timecode import Cuc
 
 _INT_FMT = {1: "B", 2: "H", 4: "I"}
@@ -90,6 +90,31 @@ class PusConfig:
             self.tm_struct = Struct(_COMMON + cfmt + dfmt + tfmt + pad)
         else:
             self.tm_struct = None
+        self._build_accelerated()
+
+    def _build_accelerated(self):
+        # The C codec (obsw.compat.pus_accelerator) takes the layouts the structs above cover,
+        # described by one int each; 0 means no C path (MicroPython, OBSW_PURE, other layouts).
+        self.tc_fast = 0
+        self.tm_fast = 0
+        m = self.max_packet_size
+        if not isinstance(m, int) or pus_accelerator() is None:
+            return
+        m = min(max(m, 0), 65542) << 16  # no packet is longer: the length field has 16 bits
+        pec = 1 if self.pec else 0
+        if self.tc_struct is not None:
+            self.tc_fast = m | pec << 5 | self.tc_spare << 3 | self.source_id_size
+        if self.tm_struct is not None:
+            t = self.time
+            self.tm_fast = (
+                m
+                | pec << 13
+                | self.tm_spare << 11
+                | t.fine << 8
+                | t.coarse << 5
+                | self.destination_id_size << 2
+                | self.message_counter_size
+            )
 
     def __eq__(self, other):
         return isinstance(other, PusConfig) and _key(self) == _key(other)

@@ -1,6 +1,6 @@
 """PUS-C telecommand packets (ECSS-E-ST-70-41C 7.4.3): TC secondary header, app data, PEC."""
 
-from obsw.compat import STRUCT_CHECKS_RANGES, const
+from obsw.compat import STRUCT_CHECKS_RANGES, const, pus_accelerator
 from obsw.crc import crc16_ccitt_update as _crc
 from obsw.pus.config import DEFAULT
 from obsw.pus.packets import (
@@ -20,6 +20,9 @@ from obsw.spp import SEQ_UNSEGMENTED, TYPE_TC, FieldRangeError
 _TC_ID = const(0x1800)  # version 0, type 1 (TC), secondary header flag 1
 _new = object.__new__
 _LAX = not STRUCT_CHECKS_RANGES  # check every field in Python, struct will not
+_C = pus_accelerator()  # the C codec; config.tc_fast is 0 whenever this is None
+_c_pack = _C.tc_pack if _C is not None else None
+_c_unpack = _C.tc_unpack if _C is not None else None
 
 
 class PusTc:
@@ -77,6 +80,22 @@ class PusTc:
 
     def pack(self):
         c = self.config
+        f = c.tc_fast
+        if f:
+            # the C codec packs what it can vouch for and returns None for anything odd
+            raw = _c_pack(
+                self.apid,
+                self.seq_count,
+                self.seq_flags,
+                self.ack,
+                self.service,
+                self.subtype,
+                self.source_id,
+                self.data,
+                f,
+            )
+            if raw is not None:
+                return raw
         data = self.data
         apid = self.apid
         count = self.seq_count
@@ -158,6 +177,11 @@ class PusTc:
     @classmethod
     def unpack(cls, buf, config=DEFAULT):
         """Decode a buffer holding exactly one TC; raises a PusError subclass if malformed."""
+        f = config.tc_fast
+        if f:
+            tc = _c_unpack(cls, buf, f, config)  # None unless well-formed
+            if tc is not None:
+                return tc
         s = config.tc_struct
         n = len(buf)
         if s is not None and n >= config.tc_min_size:

@@ -1,6 +1,6 @@
 """PUS-C telemetry packets (ECSS-E-ST-70-41C 7.4.2): TM secondary header, source data, PEC."""
 
-from obsw.compat import STRUCT_CHECKS_RANGES, const
+from obsw.compat import STRUCT_CHECKS_RANGES, const, pus_accelerator
 from obsw.crc import crc16_ccitt_update as _crc
 from obsw.pus.config import DEFAULT
 from obsw.pus.packets import (
@@ -21,6 +21,9 @@ _TM_ID = const(0x0800)  # version 0, type 0 (TM), secondary header flag 1
 _NO_TIME = (0, 0)  # what time=None packs as in the struct layouts
 _new = object.__new__
 _LAX = not STRUCT_CHECKS_RANGES  # check every field in Python, struct will not
+_C = pus_accelerator()  # the C codec; config.tm_fast is 0 whenever this is None
+_c_pack = _C.tm_pack if _C is not None else None
+_c_unpack = _C.tm_unpack if _C is not None else None
 
 
 class PusTm:
@@ -98,6 +101,24 @@ class PusTm:
 
     def pack(self):
         c = self.config
+        f = c.tm_fast
+        if f:
+            # the C codec packs what it can vouch for and returns None for anything odd
+            raw = _c_pack(
+                self.apid,
+                self.seq_count,
+                self.seq_flags,
+                self.time_ref,
+                self.service,
+                self.subtype,
+                self.message_counter,
+                self.destination_id,
+                self.time,
+                self.data,
+                f,
+            )
+            if raw is not None:
+                return raw
         data = self.data
         apid = self.apid
         count = self.seq_count
@@ -197,6 +218,11 @@ class PusTm:
     @classmethod
     def unpack(cls, buf, config=DEFAULT):
         """Decode a buffer holding exactly one TM; raises a PusError subclass if malformed."""
+        f = config.tm_fast
+        if f:
+            tm = _c_unpack(cls, buf, f, config)  # None unless well-formed
+            if tm is not None:
+                return tm
         s = config.tm_struct
         n = len(buf)
         if s is not None and n >= config.tm_min_size:

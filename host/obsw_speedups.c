@@ -1,0 +1,466 @@
+/* obsw_speedups: the PUS-C TC/TM packet codec hot path in C, for CPython only.
+ *
+ * The pure-Python codec in micropython/obsw/pus/ stays the definition. These functions take
+ * only what they can handle without doubt (exact ints in range, bytes data, one of the
+ * layouts PusConfig describes with whole-octet fields) and return None for anything else, so
+ * the caller falls back to its Python path, which raises the precise typed error. For any
+ * input they do accept, the result is byte for byte what the Python path produces.
+ *
+ * A layout is one int that obsw.pus.config packs from a PusConfig:
+ *   TC: bits 0-2 source ID octets, 3-4 spare octets, 5 PEC, 16.. maximum packet size
+ *   TM: bits 0-1 message type counter octets, 2-4 destination ID octets, 5-7 CUC coarse
+ *       octets, 8-10 CUC fine octets, 11-12 spare octets, 13 PEC, 16.. maximum packet size
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <string.h>
+
+#define API_VERSION 1
+#define TC_ID 0x1800u
+#define TM_ID 0x0800u
+
+static unsigned short crc_table[256];
+
+static void
+crc_init(void)
+{
+    for (unsigned n = 0; n < 256; n++) {
+        unsigned c = n << 8;
+        for (int k = 0; k < 8; k++)
+            c = (c & 0x8000u) ? ((c << 1) ^ 0x1021u) : (c << 1);
+        crc_table[n] = (unsigned short)(c & 0xFFFFu);
+    }
+}
+
+/* CRC-16/CCITT-FALSE (poly 0x1021, not reflected, no final XOR) continuing from reg */
+static unsigned
+crc16(unsigned reg, const unsigned char *p, Py_ssize_t n)
+{
+    while (n-- > 0)
+        reg = ((reg << 8) & 0xFFFFu) ^ crc_table[((reg >> 8) ^ *p++) & 0xFFu];
+    return reg;
+}
+
+/* 0 with *out set if v is an exact int in [0, max]; -1 otherwise, with no error left set */
+static int
+field(PyObject *v, unsigned long long max, unsigned long long *out)
+{
+    int overflow;
+    long long x;
+
+    if (!PyLong_CheckExact(v))
+        return -1;
+    x = PyLong_AsLongLongAndOverflow(v, &overflow);
+    if (x == -1 && PyErr_Occurred()) {
+        PyErr_Clear();
+        return -1;
+    }
+    if (overflow || x < 0 || (unsigned long long)x > max)
+        return -1;
+    *out = (unsigned long long)x;
+    return 0;
+}
+
+static unsigned long long
+max_for(int octets)
+{
+    return octets >= 8 ? ~0ULL : (1ULL << (8 * octets)) - 1;
+}
+
+static unsigned char *
+put(unsigned char *p, unsigned long long v, int octets)
+{
+    for (int i = octets - 1; i >= 0; i--) {
+        p[i] = (unsigned char)(v & 0xFF);
+        v >>= 8;
+    }
+    return p + octets;
+}
+
+static unsigned long long
+get(const unsigned char *p, int octets)
+{
+    unsigned long long v = 0;
+    for (int i = 0; i < octets; i++)
+        v = (v << 8) | p[i];
+    return v;
+}
+
+/* the layout int: -1 if it is not an exact int (no error left set) */
+static long long
+layout_of(PyObject *v)
+{
+    unsigned long long x;
+    if (field(v, 0x7FFFFFFFFFFFULL, &x))
+        return -1;
+    return (long long)x;
+}
+
+/* Borrow a contiguous octet buffer from bytes, bytearray or a one-dimensional memoryview of
+ * octets; 0 on success (release with PyBuffer_Release), -1 to take the Python path. */
+static int
+octets_of(PyObject *buf, Py_buffer *view)
+{
+    if (PyMemoryView_Check(buf)) {
+        Py_buffer *m = PyMemoryView_GET_BUFFER(buf);
+        if (m->ndim != 1 || m->itemsize != 1 || !PyBuffer_IsContiguous(m, 'C'))
+            return -1;
+    }
+    else if (!PyBytes_CheckExact(buf) && !PyByteArray_CheckExact(buf)) {
+        return -1;
+    }
+    if (PyObject_GetBuffer(buf, view, PyBUF_SIMPLE) < 0) {
+        PyErr_Clear();
+        return -1;
+    }
+    return 0;
+}
+
+/* header words and the PUS version octet shared by TC and TM */
+static unsigned char *
+put_common(unsigned char *p, unsigned id, unsigned long long apid, unsigned long long flags,
+           unsigned long long count, Py_ssize_t total, unsigned long long low,
+           unsigned long long service, unsigned long long subtype)
+{
+    p = put(p, id | apid, 2);
+    p = put(p, (flags << 14) | count, 2);
+    p = put(p, (unsigned long long)(total - 7), 2);
+    *p++ = (unsigned char)(0x20 | low);
+    *p++ = (unsigned char)service;
+    *p++ = (unsigned char)subtype;
+    return p;
+}
+
+static PyObject *
+finish(PyObject *out, unsigned char *p, PyObject *data, int spare, int pec)
+{
+    unsigned char *start = (unsigned char *)PyBytes_AS_STRING(out);
+    Py_ssize_t n = PyBytes_GET_SIZE(data);
+
+    if (spare) {
+        memset(p, 0, (size_t)spare);
+        p += spare;
+    }
+    if (n) {
+        memcpy(p, PyBytes_AS_STRING(data), (size_t)n);
+        p += n;
+    }
+    if (pec) {
+        unsigned c = crc16(0xFFFFu, start, p - start);
+        p[0] = (unsigned char)(c >> 8);
+        p[1] = (unsigned char)(c & 0xFF);
+    }
+    return out;
+}
+
+/* tc_pack(apid, seq_count, seq_flags, ack, service, subtype, source_id, data, layout)
+ * -> the whole TC as bytes, or None to take the Python path */
+static PyObject *
+tc_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    unsigned long long apid, count, flags, ack, service, subtype, source;
+    long long layout;
+    int sid, spare, pec;
+    Py_ssize_t total;
+    PyObject *data, *out;
+    unsigned char *p;
+
+    (void)self;
+    if (nargs != 9) {
+        PyErr_SetString(PyExc_TypeError, "tc_pack takes 9 arguments");
+        return NULL;
+    }
+    layout = layout_of(args[8]);
+    if (layout < 0)
+        Py_RETURN_NONE;
+    sid = (int)(layout & 7);
+    spare = (int)((layout >> 3) & 3);
+    pec = (int)((layout >> 5) & 1);
+    data = args[7];
+    if (sid < 1 || sid > 4 || !PyBytes_CheckExact(data) || field(args[0], 0x7FF, &apid) ||
+        field(args[1], 0x3FFF, &count) || field(args[2], 3, &flags) ||
+        field(args[3], 15, &ack) || field(args[4], 255, &service) ||
+        field(args[5], 255, &subtype) || field(args[6], max_for(sid), &source))
+        Py_RETURN_NONE;
+    total = 9 + sid + spare + 2 * pec + PyBytes_GET_SIZE(data);
+    if (total - 7 > 0xFFFF || total > (layout >> 16))
+        Py_RETURN_NONE;
+    out = PyBytes_FromStringAndSize(NULL, total);
+    if (out == NULL)
+        return NULL;
+    p = (unsigned char *)PyBytes_AS_STRING(out);
+    p = put_common(p, TC_ID, apid, flags, count, total, ack, service, subtype);
+    p = put(p, source, sid);
+    return finish(out, p, data, spare, pec);
+}
+
+/* tm_pack(apid, seq_count, seq_flags, time_ref, service, subtype, message_counter,
+ *         destination_id, time, data, layout) -> the whole TM as bytes, or None */
+static PyObject *
+tm_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    unsigned long long apid, count, flags, ref, service, subtype, counter, dest;
+    unsigned long long coarse = 0, fine = 0;
+    long long layout;
+    int cnt, dst, tc, tf, spare, pec;
+    Py_ssize_t total;
+    PyObject *data, *t, *out;
+    unsigned char *p;
+
+    (void)self;
+    if (nargs != 11) {
+        PyErr_SetString(PyExc_TypeError, "tm_pack takes 11 arguments");
+        return NULL;
+    }
+    layout = layout_of(args[10]);
+    if (layout < 0)
+        Py_RETURN_NONE;
+    cnt = (int)(layout & 3);
+    dst = (int)((layout >> 2) & 7);
+    tc = (int)((layout >> 5) & 7);
+    tf = (int)((layout >> 8) & 7);
+    spare = (int)((layout >> 11) & 3);
+    pec = (int)((layout >> 13) & 1);
+    data = args[9];
+    t = args[8];
+    if (cnt < 1 || dst < 1 || dst > 4 || tc < 1 || tc > 4 || tf < 1 || tf > 4 ||
+        !PyBytes_CheckExact(data) || field(args[0], 0x7FF, &apid) ||
+        field(args[1], 0x3FFF, &count) || field(args[2], 3, &flags) ||
+        field(args[3], 15, &ref) || field(args[4], 255, &service) ||
+        field(args[5], 255, &subtype) || field(args[6], max_for(cnt), &counter) ||
+        field(args[7], max_for(dst), &dest))
+        Py_RETURN_NONE;
+    if (t != Py_None) {
+        if (!PyTuple_CheckExact(t) || PyTuple_GET_SIZE(t) != 2 ||
+            field(PyTuple_GET_ITEM(t, 0), max_for(tc), &coarse) ||
+            field(PyTuple_GET_ITEM(t, 1), max_for(tf), &fine))
+            Py_RETURN_NONE;
+    }
+    total = 9 + cnt + dst + tc + tf + spare + 2 * pec + PyBytes_GET_SIZE(data);
+    if (total - 7 > 0xFFFF || total > (layout >> 16))
+        Py_RETURN_NONE;
+    out = PyBytes_FromStringAndSize(NULL, total);
+    if (out == NULL)
+        return NULL;
+    p = (unsigned char *)PyBytes_AS_STRING(out);
+    p = put_common(p, TM_ID, apid, flags, count, total, ref, service, subtype);
+    p = put(p, counter, cnt);
+    p = put(p, dest, dst);
+    p = put(p, coarse, tc);
+    p = put(p, fine, tf);
+    return finish(out, p, data, spare, pec);
+}
+
+static PyObject *s_apid, *s_service, *s_subtype, *s_data, *s_seq_count, *s_ack, *s_source_id,
+    *s_seq_flags, *s_config, *s_message_counter, *s_destination_id, *s_time, *s_time_ref,
+    *empty_tuple;
+
+/* set name = value on obj, taking the reference to value; -1 on error */
+static int
+set_new(PyObject *obj, PyObject *name, PyObject *value)
+{
+    int rc;
+    if (value == NULL)
+        return -1;
+    rc = PyObject_SetAttr(obj, name, value);
+    Py_DECREF(value);
+    return rc;
+}
+
+/* a packet of type cls made like object.__new__(cls), or NULL */
+static PyObject *
+blank(PyObject *cls)
+{
+    return PyBaseObject_Type.tp_new((PyTypeObject *)cls, empty_tuple, NULL);
+}
+
+/* check the frame of a whole packet: type ID, length, version octet, size, PEC; 0 if good */
+static int
+frame_ok(const unsigned char *b, Py_ssize_t n, Py_ssize_t min, unsigned id, long long layout,
+         int pec)
+{
+    if (n < min || n > (layout >> 16))
+        return -1;
+    if (((b[0] << 8 | b[1]) & 0xF800u) != id || (Py_ssize_t)get(b + 4, 2) + 7 != n ||
+        (b[6] & 0xF0) != 0x20)
+        return -1;
+    if (pec && crc16(0xFFFFu, b, n) != 0)
+        return -1;
+    return 0;
+}
+
+/* tc_unpack(cls, buf, layout, config) -> a cls instance for a well-formed TC, or None */
+static PyObject *
+tc_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    Py_buffer view;
+    const unsigned char *b;
+    long long layout;
+    int sid, spare, pec;
+    Py_ssize_t n, off;
+    unsigned pid, psc;
+    PyObject *obj = NULL, *cls;
+
+    (void)self;
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "tc_unpack takes 4 arguments");
+        return NULL;
+    }
+    cls = args[0];
+    layout = layout_of(args[2]);
+    if (layout < 0 || !PyType_Check(cls))
+        Py_RETURN_NONE;
+    sid = (int)(layout & 7);
+    spare = (int)((layout >> 3) & 3);
+    pec = (int)((layout >> 5) & 1);
+    if (sid < 1 || sid > 4 || octets_of(args[1], &view))
+        Py_RETURN_NONE;
+    b = (const unsigned char *)view.buf;
+    n = view.len;
+    off = 9 + sid + spare;
+    if (frame_ok(b, n, off + 2 * pec, TC_ID, layout, pec)) {
+        PyBuffer_Release(&view);
+        Py_RETURN_NONE;
+    }
+    pid = (unsigned)get(b, 2);
+    psc = (unsigned)get(b + 2, 2);
+    obj = blank(cls);
+    if (obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
+        set_new(obj, s_service, PyLong_FromLong(b[7])) ||
+        set_new(obj, s_subtype, PyLong_FromLong(b[8])) ||
+        set_new(obj, s_data,
+                PyBytes_FromStringAndSize((const char *)b + off, n - off - 2 * pec)) ||
+        set_new(obj, s_seq_count, PyLong_FromLong(psc & 0x3FFF)) ||
+        set_new(obj, s_ack, PyLong_FromLong(b[6] & 15)) ||
+        set_new(obj, s_source_id, PyLong_FromUnsignedLongLong(get(b + 9, sid))) ||
+        set_new(obj, s_seq_flags, PyLong_FromLong(psc >> 14)) ||
+        PyObject_SetAttr(obj, s_config, args[3])) {
+        Py_CLEAR(obj);
+    }
+    PyBuffer_Release(&view);
+    return obj;
+}
+
+/* tm_unpack(cls, buf, layout, config) -> a cls instance for a well-formed TM, or None */
+static PyObject *
+tm_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    Py_buffer view;
+    const unsigned char *b;
+    long long layout;
+    int cnt, dst, tc, tf, spare, pec;
+    Py_ssize_t n, off;
+    unsigned pid, psc;
+    const unsigned char *q;
+    PyObject *obj = NULL, *cls, *t;
+
+    (void)self;
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "tm_unpack takes 4 arguments");
+        return NULL;
+    }
+    cls = args[0];
+    layout = layout_of(args[2]);
+    if (layout < 0 || !PyType_Check(cls))
+        Py_RETURN_NONE;
+    cnt = (int)(layout & 3);
+    dst = (int)((layout >> 2) & 7);
+    tc = (int)((layout >> 5) & 7);
+    tf = (int)((layout >> 8) & 7);
+    spare = (int)((layout >> 11) & 3);
+    pec = (int)((layout >> 13) & 1);
+    if (cnt < 1 || dst < 1 || dst > 4 || tc < 1 || tc > 4 || tf < 1 || tf > 4 ||
+        octets_of(args[1], &view))
+        Py_RETURN_NONE;
+    b = (const unsigned char *)view.buf;
+    n = view.len;
+    off = 9 + cnt + dst + tc + tf + spare;
+    if (frame_ok(b, n, off + 2 * pec, TM_ID, layout, pec)) {
+        PyBuffer_Release(&view);
+        Py_RETURN_NONE;
+    }
+    pid = (unsigned)get(b, 2);
+    psc = (unsigned)get(b + 2, 2);
+    q = b + 9 + cnt + dst;
+    t = Py_BuildValue("(KK)", get(q, tc), get(q + tc, tf));
+    obj = blank(cls);
+    if (t == NULL || obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
+        set_new(obj, s_service, PyLong_FromLong(b[7])) ||
+        set_new(obj, s_subtype, PyLong_FromLong(b[8])) ||
+        set_new(obj, s_data,
+                PyBytes_FromStringAndSize((const char *)b + off, n - off - 2 * pec)) ||
+        set_new(obj, s_seq_count, PyLong_FromLong(psc & 0x3FFF)) ||
+        set_new(obj, s_message_counter, PyLong_FromUnsignedLongLong(get(b + 9, cnt))) ||
+        set_new(obj, s_destination_id, PyLong_FromUnsignedLongLong(get(b + 9 + cnt, dst))) ||
+        PyObject_SetAttr(obj, s_time, t) ||
+        set_new(obj, s_time_ref, PyLong_FromLong(b[6] & 15)) ||
+        set_new(obj, s_seq_flags, PyLong_FromLong(psc >> 14)) ||
+        PyObject_SetAttr(obj, s_config, args[3])) {
+        Py_CLEAR(obj);
+    }
+    Py_XDECREF(t);
+    PyBuffer_Release(&view);
+    return obj;
+}
+
+/* crc16_ccitt(data, register) -> CRC-16/CCITT-FALSE of data continuing from register */
+static PyObject *
+crc16_ccitt(PyObject *self, PyObject *args)
+{
+    Py_buffer view;
+    unsigned int reg;
+    unsigned c;
+
+    (void)self;
+    if (!PyArg_ParseTuple(args, "y*I:crc16_ccitt", &view, &reg))
+        return NULL;
+    c = crc16(reg & 0xFFFFu, (const unsigned char *)view.buf, view.len);
+    PyBuffer_Release(&view);
+    return PyLong_FromUnsignedLong(c);
+}
+
+#define FASTCALL(f) (PyCFunction)(void (*)(void))(f), METH_FASTCALL
+
+static PyMethodDef methods[] = {
+    {"tc_pack", FASTCALL(tc_pack), "Pack a TC of a whole-octet layout, or None."},
+    {"tm_pack", FASTCALL(tm_pack), "Pack a TM of a whole-octet layout, or None."},
+    {"tc_unpack", FASTCALL(tc_unpack), "Decode a well-formed TC into cls, or None."},
+    {"tm_unpack", FASTCALL(tm_unpack), "Decode a well-formed TM into cls, or None."},
+    {"crc16_ccitt", crc16_ccitt, METH_VARARGS, "CRC-16/CCITT-FALSE continuing a register."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "obsw_speedups",
+    "C hot path of the obsw PUS-C packet codec (CPython only; the Python code is the "
+    "definition).",
+    -1, methods, NULL, NULL, NULL, NULL,
+};
+
+PyMODINIT_FUNC
+PyInit_obsw_speedups(void)
+{
+    PyObject *m;
+    PyObject **names[] = {&s_apid, &s_service, &s_subtype, &s_data, &s_seq_count,
+                          &s_ack, &s_source_id, &s_seq_flags, &s_config, &s_message_counter,
+                          &s_destination_id, &s_time, &s_time_ref};
+    const char *texts[] = {"apid", "service", "subtype", "data", "seq_count",
+                           "ack", "source_id", "seq_flags", "config", "message_counter",
+                           "destination_id", "time", "time_ref"};
+
+    crc_init();
+    for (size_t i = 0; i < sizeof(names) / sizeof(names[0]); i++) {
+        if (*names[i] == NULL && (*names[i] = PyUnicode_InternFromString(texts[i])) == NULL)
+            return NULL;
+    }
+    if (empty_tuple == NULL && (empty_tuple = PyTuple_New(0)) == NULL)
+        return NULL;
+    m = PyModule_Create(&module);
+    if (m == NULL)
+        return NULL;
+    if (PyModule_AddIntConstant(m, "API", API_VERSION) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
+}

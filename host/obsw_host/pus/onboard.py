@@ -111,6 +111,7 @@ class Onboard:
             task_timeout=10.0,
             overrun_event=overrun,
         )
+        self.tasks = []  # more coroutine functions to run on the process's loop
         self.providers = [self.node.provide(itf, impl) for itf, impl in components]
         self.pool = ParameterPool(sdb, self.node)
         self.events = EventManager(sdb, self.node)
@@ -197,6 +198,8 @@ class Onboard:
         tasks = [asyncio.ensure_future(self.app.run(self.period))]
         if self.node is not None:
             tasks.append(asyncio.ensure_future(self.node.serve()))
+        for make in self.tasks:
+            tasks.append(asyncio.ensure_future(make()))
         self._ready.set()
         try:
             await self._stopping.wait()

@@ -106,6 +106,7 @@ class ObcSpaceCan:
         timeout=0.5,
         retries=2,
         policy=None,
+        device_access=False,
     ):
         self.node = node if node is not None else Node("spacecan-master")
         self.interface = interface
@@ -135,6 +136,12 @@ class ObcSpaceCan:
             t._fds[self._waker.fileno()] = self._waker
             t._poll.register(self._waker.fileno(), select.POLLIN)
         self.node.provide(MASTER, self.master)
+        self.access = None
+        if device_access:  # PUS service 2's way to the equipment (packet mode)
+            from obsw.spacecan.device_access import DEVICE_ACCESS, SpaceCanDeviceAccess
+
+            self.access = SpaceCanDeviceAccess(self.controller, timeout=timeout * (retries + 1))
+            self.node.provide(DEVICE_ACCESS, self.access)
         for eq in self.equipment:
             eq.provide(self.node)
         self.node.wait = self.wait
@@ -223,6 +230,8 @@ class ObcSpaceCan:
 
     def pump(self):
         """Handle what is queued on both sides: IL requests, frames, deadlines, callbacks."""
+        if self.access is not None:
+            self.access.now = self.node.clock.now()
         self._poll_node()
         self.adapter.run_pending()
         self._poll_node()

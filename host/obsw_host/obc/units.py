@@ -95,6 +95,9 @@ class PusUnit:
             tm_port = int(f.get("tm_port", 4999))
             tm_to = (config.host, tm_port)
             playback_to = {int(f.get("playback_vc", 1)): (config.host, tm_port + 1)}
+        if opts.get("tm_to"):  # a fixed ground address besides the last TC's sender
+            host, port = str(opts["tm_to"]).rsplit(":", 1)
+            tm_to = (host, int(port))
         self.node = Node("obc-pus")
         self.transport = SocketTransport(self.node, config.il_directory)
         self.onboard = Onboard(

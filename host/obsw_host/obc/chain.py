@@ -213,7 +213,7 @@ class Chain:
         end = time.monotonic() + (timeout or self.timeout)
         while time.monotonic() < end:
             self.ground.poll(0.02)
-            for tm, decoded in self.ground.received[since:]:
+            for tm, _ in self.ground.received[since:]:
                 if tm.service == 5 and len(tm.data) >= 2:
                     eid = (tm.data[0] << 8) | tm.data[1]
                     if eid in ids:

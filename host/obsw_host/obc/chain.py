@@ -16,6 +16,7 @@ The ground station holds the other ends of the OBC's UARTs; the ground's PUS use
 
 import json
 import os
+import select
 import sys
 import threading
 import time
@@ -47,12 +48,15 @@ def _station_class():
         started = False
 
         def step(self, timeout=0.02):
+            # wait on the mission control socket as well as on the links, so a TC goes out
+            # as soon as it comes (the base class waits on the links only)
+            select.select([self.sock] + self.ground.links, [], [], timeout)
             fop = self.ground.fop
             if self.started and fop.state == F.INITIAL:
                 self.ground.initiate(self.now(), F.INITIATE_AD_WITH_SET_VR, fop.vs)
                 self._initiated = True
             self.started = True
-            super().step(timeout)
+            super().step(0)
 
     return OperatorStation
 

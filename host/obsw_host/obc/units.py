@@ -165,7 +165,8 @@ class PusUnit:
         )
         files = opts.get("files")
         fs = OsFilestore(self.config.resolve(files)) if files else None
-        self.app.register(
+        self.step_period = float(opts.get("step_period", 0.01))
+        self.obcp = self.app.register(
             ObcpManagement(
                 self.engine,
                 filestore=fs,
@@ -215,11 +216,27 @@ class PusUnit:
                 return
             await asyncio.sleep(0.005)
 
+    async def _engine_task(self):
+        """Step the OBCP engine between the activity loop's cycles too: a procedure's next
+        statement runs within ``step_period`` of its reply, not at the next cycle."""
+        engine = self.engine
+        while self._running:
+            due = engine.next_deadline()
+            now = time.time()
+            if self.obcp.running and due is not None and due <= now:
+                try:
+                    engine.step(now)
+                except Exception:
+                    self.app.count("engine_errors")
+            await asyncio.sleep(self.step_period)
+
     def start(self):
         self._running = True
         self.onboard.tasks.append(lambda: drive_transport(self.transport, self.node))
         if self.cfdp is not None:
             self.onboard.tasks.append(self._cfdp_task)
+        if self.engine is not None:
+            self.onboard.tasks.append(self._engine_task)
         self.onboard.start()
         self.out(
             "PUS application process APID %d on udp %s:%d, services %s"

@@ -267,3 +267,83 @@ def _free_ports(n):
     for s in socks:
         s.close()
     return ports
+
+
+def demo(out=print):
+    """The chain, then its faults, narrated; returns 0 if every step went as expected."""
+    import shutil
+    import signal
+    import tempfile
+
+    from obsw.reconfig.essential import HPC_POWER_CYCLE, Hpc
+
+    work = tempfile.mkdtemp(prefix="obsw-chain-")
+    ok = True
+
+    def check(what, good, t0):
+        nonlocal ok
+        ok = ok and bool(good)
+        out("  %-66s %s (%.2f s)" % (what, "ok" if good else "FAILED", time.monotonic() - t0))
+
+    def ping_until_ok(chain, timeout=60.0):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            try:
+                if chain.ground.ping(timeout=3.0).ok:
+                    return True
+            except Exception:
+                pass
+        return False
+
+    try:
+        out("  starting: ground station on two pty UARTs, the OBC (frames, core, can processes")
+        out("  under the platform manager), the CAN hub, both MicroPython reconfiguration")
+        out("  controllers; CPDU line 0 powers the OBC")
+        with Chain(work) as chain:
+            t = time.monotonic()
+            chain.wait_up(60.0)
+            check("ping through CLTUs, frame processor, PUS, TM frames", True, t)
+            t = time.monotonic()
+            tx, end = chain.switch(0x005, timeout=20.0)
+            check(
+                "TC[18,3] -> PLUTO -> CpduN.set_state_bits -> SpaceCAN -> CPDU 0x%03x"
+                % chain.lines(),
+                tx.ok and end == "obcp.finished" and chain.lines() == 0x005,
+                t,
+            )
+            t = time.monotonic()
+            end_t = t + 20.0
+            hk = None
+            while time.monotonic() < end_t:
+                hk = chain.cpdu_housekeeping()
+                if hk.get("CpduN.state_bits") == 5:
+                    break
+            check("housekeeping through TM frames: CpduN.state_bits = %s" % hk.get(
+                "CpduN.state_bits"), hk.get("CpduN.state_bits") == 5, t)  # fmt: skip
+            for name in ("core", "can", "frames"):
+                pid = chain.pid_of(name)
+                t = time.monotonic()
+                os.kill(pid, signal.SIGKILL)
+                while chain.pid_of(name) in (None, pid) and time.monotonic() < t + 30:
+                    time.sleep(0.05)
+                check("OBC process %s killed: restarted, serving again" % name,
+                      ping_until_ok(chain), t)  # fmt: skip
+            chain.sim.hub.kill(0)
+            t = time.monotonic()
+            tx, end = chain.switch(0x007, name="bus_b", timeout=20.0)
+            check("bus A cut: CPDU switched over bus B", tx.ok and chain.lines() == 0x007, t)
+            chain.sim.hub.revive(0)
+            chain.links[0].enabled = False
+            t = time.monotonic()
+            check("UART A cut: ping over UART B", ping_until_ok(chain), t)
+            chain.links[0].enabled = True
+            boots = chain.sim.obc_boots
+            chain.sim.kill_obc()
+            t = time.monotonic()
+            chain.sim.send_hpc(Hpc(HPC_POWER_CYCLE, (0, 200)))
+            chain.sim.wait_for(lambda: chain.sim.obc_boots == boots + 1, 30.0)
+            check("OBC killed: power-cycled by an essential TC, serving again",
+                  ping_until_ok(chain), t)  # fmt: skip
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return 0 if ok else 1

@@ -50,12 +50,12 @@ def known_interfaces():
 
 def load_sdb(path=None):
     """The spacecraft database for name and type checks: ``path``, else the packaged one;
-    an ``obsw.sdb.Sdb`` when it loads as one, else the plain JSON document."""
+    an ``obsw.pus.sdb.Sdb`` when it loads as one, else the plain JSON document."""
     path = path or DEFAULT_SDB
     if not os.path.exists(path):
         return None
     try:
-        from obsw.sdb import load
+        from obsw.pus.sdb import load
 
         return load(path)
     except Exception:  # a database the strict loader refuses still names things

@@ -10,9 +10,9 @@ except ImportError:  # the unix port keeps asyncio frozen under ".frozen", off a
 
 from obsw.il.clock import SimClock
 from obsw.pus.app import ApplicationProcess
+from obsw.pus.sdb import loads
 from obsw.pus.tm import PusTm
 from obsw.pus.user import UserProcess
-from obsw.sdb import loads
 
 APID = 10
 

@@ -199,7 +199,7 @@ class TestNames(unittest.TestCase):
         self.assertAlmostEqual(args[0], 7200)
 
     def test_describe_from_sdb_object_and_interface(self):
-        from obsw.sdb import Sdb
+        from obsw.pus.sdb import Sdb
 
         sdb = Sdb(
             {

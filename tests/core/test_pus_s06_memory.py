@@ -6,13 +6,13 @@ import unittest
 from obsw.cfdp.filestore import MemoryFilestore
 from obsw.crc import crc16_ccitt
 from obsw.pus.messages import FAILURE_OUT_OF_BOUNDS, FAILURE_REFUSED, FAILURE_UNKNOWN_ID
+from obsw.pus.sdb import loads
 from obsw.pus.services.s06_memory import (
     BytesMemory,
     MemoryManagement,
     MemoryUser,
     areas_from_sdb,
 )
-from obsw.sdb import loads
 from pus_loop import APID, Loop
 
 SDB = """{"memories": [

@@ -7,6 +7,7 @@ from obsw.il.clock import SimClock
 from obsw.il.errors import ComponentError
 from obsw.il.interface import Interface, Operation
 from obsw.il.node import Node
+from obsw.pus.sdb import Sdb, SdbError
 from obsw.pus.services.s01_verification import (
     FAILURE_COMPONENT,
     FAILURE_ILLEGAL_APP_DATA,
@@ -14,7 +15,6 @@ from obsw.pus.services.s01_verification import (
     FAILURE_UNKNOWN_ID,
 )
 from obsw.pus.services.s08_functions import FunctionManagement, FunctionUser, functions
-from obsw.sdb import Sdb, SdbError
 from pus_loop import APID, SDB, Loop
 
 HEATER = Interface(

@@ -18,11 +18,11 @@ from obsw.pus.messages import (
     FAILURE_REFUSED,
     FAILURE_UNKNOWN_ID,
 )
+from obsw.pus.sdb import loads
 from obsw.pus.services import s18_layouts as lay
 from obsw.pus.services.s05_events import EventReporting, EventUser
 from obsw.pus.services.s18_obcp import ObcpManagement
 from obsw.pus.services.s18_user import ObcpUser, failure_info
-from obsw.sdb import loads
 from pus_loop import APID, Loop
 
 T0 = 1735689600.0  # 2025-01-01T00:00:00Z

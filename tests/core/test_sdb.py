@@ -3,7 +3,7 @@
 import unittest
 
 from obsw.il.interface import CONFIGURATION, DATA, INFO, Attribute, Event, Interface
-from obsw.sdb import SdbError, loads
+from obsw.pus.sdb import SdbError, loads
 from pus_loop import SDB
 
 
@@ -93,3 +93,54 @@ class TestSdb(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class SectionsTest(unittest.TestCase):
+    """Every section of the database is parsed here, into typed objects."""
+
+    DOC = {
+        "components": [
+            {
+                "name": "Heater",
+                "attributes": [{"name": "power", "parameter": 1, "type": "float32"}],
+                "operations": [{"name": "set_power", "arguments": [{"name": "w", "unit": "W"}]}],
+            }
+        ],
+        "functions": [
+            {"id": 7, "name": "Heater.set_power",
+             "arguments": [{"id": 1, "name": "w", "type": "float32"}]}
+        ],
+        "position_scheduling": {"parameter": "Heater.power"},
+        "frames": {"tm_vcs": {"realtime": 0, "playback": 2}, "scid": 66},
+        "nodes": [{"name": "CpduN", "node_id": 10, "definition": "cpdu_node.json"}],
+    }  # fmt: skip
+
+    def test_typed_sections_and_lookups(self):
+        from obsw.pus.sdb import Sdb
+
+        db = Sdb(self.DOC, "/data")
+        f = db.function("Heater.set_power")
+        self.assertIs(db.function(7), f)
+        self.assertEqual(f.arguments, [(1, "w", "float32", None)])
+        self.assertEqual(db.operations["Heater.set_power"].arguments, [("w", "W")])
+        self.assertEqual(db.position_parameter.qualified, "Heater.power")
+        self.assertEqual(db.tm_vcs, {"realtime": 0, "playback": 2})
+        self.assertEqual(db.scid, 66)
+        n = db.nodes["CpduN"]
+        self.assertEqual((n.node_id, n.definition), (10, "/data/cpdu_node.json"))
+
+    def test_bad_sections_are_sdb_errors(self):
+        from obsw.pus.sdb import Sdb, SdbError
+
+        for change in (
+            {"warp": {}},
+            {"functions": [{"id": 7, "name": "a"}, {"id": 7, "name": "b"}]},
+            {"functions": [{"id": 1, "name": "f", "arguments": [{"id": 1, "name": "x"}]}]},
+            {"position_scheduling": {"parameter": "Nowhere.x"}},
+            {"nodes": [{"name": "A", "node_id": 200}]},
+            {"nodes": [{"name": "A", "node_id": 3}, {"name": "B", "node_id": 3}]},
+        ):
+            doc = dict(self.DOC)
+            doc.update(change)
+            with self.assertRaises((SdbError, KeyError)):
+                Sdb(doc)

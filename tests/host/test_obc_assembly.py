@@ -9,7 +9,7 @@ import socket
 import time
 
 import pytest
-from obsw import sdb as sdb_module
+from obsw.pus import sdb as sdb_module
 from obsw.pus.tm import PusTm
 from obsw_host.obc import config as obc_config
 from obsw_host.obc.platform import PlatformManager
@@ -45,8 +45,6 @@ def write_config(tmp_path, doc):
     """The sample's relative paths point into the package: make them absolute here."""
     base = os.path.dirname(obc_config.SAMPLE)
     doc["sdb"] = os.path.join(base, doc["sdb"])
-    for n in doc.get("spacecan", {}).get("nodes", []):
-        n["definition"] = os.path.join(base, n["definition"])
     if "obcp" in doc:
         doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])
     doc["state"] = str(tmp_path / "state")

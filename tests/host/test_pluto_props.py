@@ -122,9 +122,11 @@ def test_check_command_with_sdb(tmp_path, capsys):
     f = tmp_path / "p.pluto"
     f.write_text("procedure initiate and confirm set_state_bits of CpduN; end procedure")
     sdb = tmp_path / "sdb.json"
-    sdb.write_text(json.dumps({"components": {"CpduN": {"operations": {"set_state_bits": {}}}}}))
+    cpdu = {"name": "CpduN", "operations": [{"name": "set_state_bits"}]}
+    sdb.write_text(json.dumps({"components": [cpdu]}))
     assert cmd.check_cmd(argparse.Namespace(file=str(f), sdb=str(sdb), system=None)) == 0
-    sdb.write_text(json.dumps({"components": {"CpduN": {"operations": ["reset"]}}}))
+    cpdu["operations"] = [{"name": "reset"}]
+    sdb.write_text(json.dumps({"components": [cpdu]}))
     assert cmd.check_cmd(argparse.Namespace(file=str(f), sdb=str(sdb), system=None)) == 1
     assert "unknown activity set_state_bits of CpduN" in capsys.readouterr().out
 
@@ -182,7 +184,9 @@ def test_sdb_resolver_reads_the_spacecraft_database_layout():
             "components": [
                 {
                     "name": "SolarPanel",
-                    "attributes": [{"name": "angle", "type": "float32", "unit": "deg"}],
+                    "attributes": [
+                        {"name": "angle", "parameter": 1, "type": "float32", "unit": "deg"}
+                    ],
                     "events": [{"name": "angle_reached", "id": 1}],
                 }
             ]

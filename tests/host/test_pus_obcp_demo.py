@@ -60,7 +60,7 @@ end procedure
 
 
 def test_step_commands_run_a_procedure_one_step_at_a_time(tmp_path, capsys):
-    from obsw import sdb as sdb_module
+    from obsw.pus import sdb as sdb_module
 
     sdb = sdb_module.load(SDB_PATH)
     onboard, engine = obcp_demo.onboard_with_obcp(sdb, port=0, period=0.05)

@@ -68,6 +68,21 @@ def obsw():
     return [exe] if exe else [sys.executable, "-m", "obsw_host.cli"]
 
 
+def ports_free(ports=(5010, 5100)):
+    """True when the sample spacecraft's UDP ports can be bound (another run may hold them)."""
+    import socket
+
+    for port in ports:
+        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            s.bind(("127.0.0.1", port))
+        except OSError:
+            return False
+        finally:
+            s.close()
+    return True
+
+
 def run(argv, cwd, timeout=COMMAND_TIMEOUT):
     return subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=timeout)
 
@@ -87,6 +102,9 @@ def test_every_obc_example_of_the_readme(tmp_path, capsys):
         (tmp_path / name).write_text(DEMO_PROCEDURE)
     state = tmp_path / "state"
     t0 = time.monotonic()
+    end = t0 + 300.0
+    while not ports_free() and time.monotonic() < end:  # another checkout's run: wait our turn
+        time.sleep(0.5)
     server = subprocess.Popen(
         obsw() + ["obc", "serve", "--state", str(state)],
         stdout=subprocess.PIPE,

@@ -15,6 +15,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
 
 from obsw.pus.events import EventManager  # noqa: E402
 from obsw.pus.parameters import ParameterPool  # noqa: E402
+from obsw.pus.sdb import Sdb  # noqa: E402
 from obsw.pus.services.s05_events import EventReporting  # noqa: E402
 from obsw.pus.services.s08_functions import FunctionManagement, FunctionUser, functions  # noqa: E402
 from obsw.pus.services.s11_scheduling import TimeScheduling, TimeSchedulingUser  # noqa: E402
@@ -27,7 +28,6 @@ from obsw.pus.services.s22_position_scheduling import (  # noqa: E402
     PositionScheduling,
     PositionSchedulingUser,
 )
-from obsw.sdb import Sdb  # noqa: E402
 from pus_loop import APID, SDB, Loop  # noqa: E402
 
 T0 = 2_100_000_000.0

@@ -205,7 +205,7 @@ def _raw():
 
 
 def _ground(args):
-    from obsw import sdb as sdb_module
+    from obsw.pus import sdb as sdb_module
 
     from obsw_host.pus.demo import SDB_PATH
     from obsw_host.pus.ground import Ground

@@ -127,7 +127,7 @@ def _raw():
 
 
 def _sdb(args):
-    from obsw import sdb as sdb_module
+    from obsw.pus import sdb as sdb_module
 
     from obsw_host.pus.demo import SDB_PATH
 

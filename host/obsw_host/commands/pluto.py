@@ -58,25 +58,25 @@ def _type_code(t):
 
 
 class SdbResolver:
-    """Answers the checker's questions from a spacecraft database JSON: components with their
-    parameters (attributes), operations and events, as dicts or lists of dicts with "name"."""
+    """Answers the checker's questions from the spacecraft database (an ``obsw.pus.sdb.Sdb``
+    or its JSON document, parsed by that one parser): component parameters, operations and
+    events."""
 
     def __init__(self, sdb):
+        from obsw.pus.sdb import Sdb
+
+        if isinstance(sdb, dict):
+            sdb = Sdb(sdb)
         self.known = {}
-        comps = sdb.get("components", sdb)
-        if isinstance(comps, list):
-            comps = {c["name"]: c for c in comps}
-        for cname, comp in comps.items():
-            for key, kind in (("parameters", "parameter"), ("attributes", "parameter"),
-                              ("operations", "activity"), ("activities", "activity"),
-                              ("events", "event")):  # fmt: skip
-                items = comp.get(key, {})
-                if isinstance(items, list):
-                    items = {(i["name"] if isinstance(i, dict) else i): i for i in items}
-                for name, info in items.items():
-                    info = info if isinstance(info, dict) else {}
-                    code = _type_code(info.get("type"))
-                    self.known["%s of %s" % (name, cname)] = (kind, code, info.get("unit"))
+        for p in sdb.parameters.values():
+            if p.component:
+                code = _type_code(p.type_spec)
+                self.known["%s of %s" % (p.name, p.component)] = ("parameter", code, p.unit)
+        for op in sdb.operations.values():
+            self.known["%s of %s" % (op.name, op.component)] = ("activity", "?", None)
+        for e in sdb.events.values():
+            if e.component:
+                self.known["%s of %s" % (e.name, e.component)] = ("event", "?", None)
 
     def describe(self, path):
         return self.known.get(path)
@@ -94,7 +94,9 @@ def _errors(e):
 def check_cmd(args):
     resolver = None
     if args.sdb:
-        resolver = SdbResolver(json.loads(_read(args.sdb)))
+        from obsw.pus.sdb import load as load_sdb
+
+        resolver = SdbResolver(load_sdb(args.sdb))
     elif args.system:
         resolver = SimulatedSystem(json.loads(_read(args.system)))
     try:

@@ -47,7 +47,7 @@ class ObcProcess:
     """The units of one process of ``config`` (see the module text)."""
 
     def __init__(self, config, name, out=print):
-        from obsw import sdb as sdb_module
+        from obsw.pus import sdb as sdb_module
 
         if name not in config.processes:
             raise KeyError("no process %r in %s" % (name, config.path))

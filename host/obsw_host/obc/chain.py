@@ -119,8 +119,6 @@ class Chain:
             timeout=0.3,
             retries=3,
         )
-        for n in doc["spacecan"]["nodes"]:
-            n["definition"] = os.path.join(base, n["definition"])
         doc["frames"].update(
             uart_a=uart_a, uart_b=uart_b, scid=SCID, tm_port=self.tm_port, clcw_period=0.2
         )
@@ -134,7 +132,7 @@ class Chain:
         return [sys.executable, "-m", "obsw_host.obc", self.config_path]
 
     def start(self):
-        from obsw import sdb as sdb_module
+        from obsw.pus import sdb as sdb_module
 
         from obsw_host.obc.config import load
         from obsw_host.pus.ground import Ground

@@ -21,22 +21,34 @@ PLAYBACK_PORT = 5000  # the frame processor's playback input (UDP 4999 + 1)
 
 
 def equipment_interfaces(config):
-    """The interfaces of the SpaceCAN equipment components the configuration declares."""
+    """The interfaces of the SpaceCAN equipment components the mission has."""
     from obsw.spacecan.equipment import equipment_interface
 
-    return [equipment_interface(eq.name, eq.node_id, eq.nodedef) for eq in equipments(config)]
+    return [
+        equipment_interface(eq.name, eq.node_id, eq.nodedef) for eq in equipments(config)
+    ]
 
 
 def equipments(config):
+    """The SpaceCAN equipment: the configuration's ``spacecan.nodes`` if it lists any, else
+    the spacecraft database's ``nodes``."""
+    from obsw.pus.sdb import NodeDef
+    from obsw.pus.sdb import load as load_sdb
     from obsw.spacecan.equipment import Equipment
     from obsw.spacecan.nodedef import NodeDefinition
 
-    out = []
-    for n in config.section("spacecan").get("nodes", []):
-        nid = int(n["node_id"])
-        nodedef = NodeDefinition.load(config.resolve(n["definition"]), nid)
-        out.append(Equipment(n["name"], nid, nodedef))
-    return out
+    listed = config.section("spacecan").get("nodes")
+    if listed:
+        nodes = [
+            NodeDef(n["name"], int(n["node_id"]), config.resolve(n["definition"]))
+            for n in listed
+        ]
+    else:
+        nodes = list(load_sdb(config.sdb_path).nodes.values())
+    return [
+        Equipment(n.name, n.node_id, NodeDefinition.load(n.definition, n.node_id))
+        for n in nodes
+    ]
 
 
 async def drive_transport(transport, node):
@@ -339,7 +351,7 @@ class FramesUnit:
         apid = int(pus.get("apid", sdb.apid("pus")))
         port = int(pus.get("port", 5000 + apid))
         tm_port = int(opts.get("tm_port", 4999))
-        plan = (sdb.extra.get("frames") or {}).get("tm_vcs")
+        plan = sdb.tm_vcs
         self.fp = FrameProcessorHost(
             links[0],
             links[1],

@@ -8,7 +8,7 @@ an action (service 19), and a time-tagged TC (service 11) runs at its release ti
 
 import os
 
-from obsw import sdb as sdb_module
+from obsw.pus import sdb as sdb_module
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data")
 SDB_PATH = os.path.join(DATA, "sdb.json")

@@ -132,9 +132,8 @@ class Onboard:
         app.register(OnBoardMonitoring(self.pool, sdb.events))
         app.register(EventAction(known=sdb.events))
         app.register(RequestSequencing())
-        position = sdb.extra.get("position_scheduling")
-        if position:
-            app.register(PositionScheduling(self.pool, position["parameter"]))
+        if sdb.position_parameter is not None:
+            app.register(PositionScheduling(self.pool, sdb.position_parameter.qualified))
 
     def _own_parameters(self):
         counters = self.app.counters

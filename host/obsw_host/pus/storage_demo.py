@@ -116,7 +116,7 @@ class Segment:
         from obsw_host.frames.processor import FrameProcessorHost
         from obsw_host.frames.station import GroundStation
 
-        plan = (sdb.extra.get("frames") or {}).get("tm_vcs")
+        plan = sdb.tm_vcs
         ctrl_a, dev_a = open_pty_pair()
         ctrl_b, dev_b = open_pty_pair()
         self.fp = FrameProcessorHost(

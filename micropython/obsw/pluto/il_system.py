@@ -11,7 +11,7 @@ finds the member whose name and component's name, run together, spell it.
 
 Names resolve through ``obsw.pluto.names`` (``Catalog``, ``target_of``, ``plain``).
 
-Load-time facts (``describe``) come from the spacecraft database (an ``obsw.sdb.Sdb`` or its
+Load-time facts (``describe``) come from the spacecraft database (an ``obsw.pus.sdb.Sdb`` or its
 JSON document, which may also list operations with their arguments) and from component
 ``Interface`` declarations: those given, and those of the node's own providers.
 

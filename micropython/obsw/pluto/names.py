@@ -57,18 +57,6 @@ def _unit(u):
     return u
 
 
-def _items(x):
-    """Entries of a database section given as a list (of dicts or names) or a dict."""
-    if isinstance(x, dict):
-        out = []
-        for k, v in x.items():
-            d = dict(v) if isinstance(v, dict) else {}
-            d.setdefault("name", k)
-            out.append(d)
-        return out
-    return [i if isinstance(i, dict) else {"name": i} for i in (x or ())]
-
-
 # catalog entry fields
 KIND = 0
 COMPONENT = 1
@@ -119,28 +107,20 @@ class Catalog:
             self.add("event", itf.name, ev.name)
 
     def add_sdb(self, sdb):
-        """A spacecraft database: an ``obsw.sdb.Sdb`` or its JSON document (a dict)."""
-        if not isinstance(sdb, dict):
-            for p in sdb.parameters.values():
-                if p.component:
-                    self.add("parameter", p.component, p.name, type_code(p.type_spec), p.unit)
-            for e in sdb.events.values():
-                if e.component:
-                    self.add("event", e.component, e.name)
-            return
-        comps = sdb.get("components", ())
-        for comp in _items(comps):
-            c = comp["name"]
-            for a in _items(comp.get("attributes")) + _items(comp.get("parameters")):
-                self.add("parameter", c, a["name"], type_code(a.get("type")), a.get("unit"))
-            for op in _items(comp.get("operations")) + _items(comp.get("activities")):
-                args = op.get("arguments", op.get("params"))
-                params = None
-                if args is not None:
-                    params = [(x["name"], x.get("unit")) for x in _items(args)]
-                self.add("activity", c, op["name"], None, None, params)
-            for e in _items(comp.get("events")):
-                self.add("event", c, e["name"])
+        """A spacecraft database: an ``obsw.pus.sdb.Sdb`` or its JSON document (a dict, parsed
+        by that one parser)."""
+        if isinstance(sdb, dict):
+            from obsw.pus.sdb import Sdb
+
+            sdb = Sdb(sdb)
+        for p in sdb.parameters.values():
+            if p.component:
+                self.add("parameter", p.component, p.name, type_code(p.type_spec), p.unit)
+        for op in sdb.operations.values():
+            self.add("activity", op.component, op.name, None, None, list(op.arguments))
+        for e in sdb.events.values():
+            if e.component:
+                self.add("event", e.component, e.name)
 
     def find(self, path):
         """The entry a PLUTO path names, or None."""

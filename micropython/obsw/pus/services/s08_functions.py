@@ -22,6 +22,7 @@ callables given to ``local``.
 from obsw.il.errors import CallTimeoutError, InteractionError, UnavailableError
 from obsw.pus.fields import field
 from obsw.pus.messages import SERVICE_FUNCTION_MANAGEMENT, TC_FUNCTION_PERFORM
+from obsw.pus.sdb import SdbError, field_type
 from obsw.pus.services.base import E16, U8, Service, ServiceUser
 from obsw.pus.services.s01_verification import (
     FAILURE_COMPONENT,
@@ -33,7 +34,6 @@ from obsw.pus.services.s01_verification import (
     app_data_error,
 )
 from obsw.pus.structure import Repeated, Structure
-from obsw.sdb import SdbError, field_type
 
 FUNCTION_ID = E16
 ARGUMENT_COUNT = U8
@@ -81,20 +81,11 @@ class Function:
 
 
 def functions(sdb):
-    """The database's functions by ID (its ``functions`` table; SdbError if malformed)."""
+    """The database's functions by ID, as Functions (from its typed ``functions``)."""
     table = {}
-    names = set()
-    try:
-        for f in sdb.extra.get("functions", ()):
-            fid = f["id"]
-            if not isinstance(fid, int) or not 0 <= fid <= 0xFFFF or fid in table:
-                raise SdbError("function id %r unusable or repeated" % (fid,))
-            if f["name"] in names:
-                raise SdbError("function %s declared twice" % f["name"])
-            names.add(f["name"])
-            table[fid] = Function(fid, f["name"], f.get("arguments", ()))
-    except (KeyError, TypeError, AttributeError) as e:
-        raise SdbError("functions: missing or malformed entry (%r)" % (e,)) from None
+    for fid, fd in sdb.functions.items():
+        args = [{"id": a[0], "name": a[1], "type": a[2], "default": a[3]} for a in fd.arguments]
+        table[fid] = Function(fid, fd.name, args)
     return table
 
 

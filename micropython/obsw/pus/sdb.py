@@ -1,0 +1,491 @@
+"""The spacecraft database: the one place a mission tailors ids, types and APIDs (JSON).
+
+    {
+      "mission": "demo",
+      "apids": {"pus": 10, "cfdp": 100},
+      "components": [
+        {"name": "SolarPanel",
+         "attributes": [{"name": "angle", "parameter": 1, "type": "float32", "unit": "deg"}],
+         "events": [{"name": "angle_reached", "id": 1, "severity": "info",
+                     "data": [{"name": "angle", "type": "float32"}]}]}
+      ],
+      "events": [{"name": "pus.cycle_overrun", "id": 65281, "severity": "medium"}],
+      "housekeeping": [{"sid": 1, "interval": 10, "parameters": [1], "enabled": true}],
+      "filestores": [{"prefix": "SAT", "entity": 2}, {"prefix": "GROUND", "entity": 1}],
+      "memories": [{"id": 1, "name": "image", "file": "memory/image.bin",
+                    "start": 0, "size": 4096, "writable": true}]
+    }
+
+Also parsed here, so nothing else reads the JSON: ``functions`` (service 8: id, name, the
+operation's typed arguments), components' ``operations`` (name and arguments with units, for
+PLUTO's checker), ``position_scheduling`` (service 22's position parameter), ``frames``
+(``tm_vcs``: the TM virtual channel plan, role -> VC ID, and ``scid``), and ``nodes`` (SpaceCAN
+equipment: name, node id, node definition file relative to the database file).
+
+``filestores`` maps the path prefixes of file management (``SAT:/data/x``) to CFDP entity
+ids (the onboard one is the first, unless one says ``"local": true``); ``memories`` declares
+the memory areas service 6 may load, dump and check, by id, start address and size.
+
+A type is a name (``uint8`` .. ``uint64``, ``int8`` .. ``int64``, ``float32``, ``float64``,
+``bool``, ``enum8``, ``enum16``, ``string`` for a 16-bit-length character string,
+``octets``) or a ``[ptc, pfc]`` pair. ``load``/``loads`` check that every id is unique.
+"""
+
+import json
+
+from obsw.pus.fields import field
+from obsw.pus.structure import Structure
+
+SEVERITIES = {"info": 1, "low": 2, "medium": 3, "high": 4}
+SEVERITY_NAMES = {1: "info", 2: "low", 3: "medium", 4: "high"}
+
+TYPES = {
+    "bool": (1, 8),
+    "enum8": (2, 8),
+    "enum16": (2, 16),
+    "uint8": (3, 4),
+    "uint16": (3, 12),
+    "uint32": (3, 14),
+    "uint64": (3, 16),
+    "int8": (4, 4),
+    "int16": (4, 12),
+    "int32": (4, 14),
+    "int64": (4, 16),
+    "float32": (5, 1),
+    "float64": (5, 2),
+    "string": (8, 0),
+    "octets": (7, 0),
+}
+
+
+class SdbError(ValueError):
+    """A spacecraft database that is malformed or gives one id to two things."""
+
+
+def field_type(spec, where="type"):
+    """The packet field type for a type name or a [ptc, pfc] pair."""
+    if isinstance(spec, str):
+        pair = TYPES.get(spec)
+        if pair is None:
+            raise SdbError(
+                "%s: unknown type %r, expected one of %s" % (where, spec, sorted(TYPES))
+            )
+    elif isinstance(spec, (list, tuple)) and len(spec) == 2:
+        pair = tuple(spec)
+    else:
+        raise SdbError("%s: type %r, expected a name or [ptc, pfc]" % (where, spec))
+    try:
+        return field(pair[0], pair[1])
+    except ValueError as e:
+        raise SdbError("%s: %s" % (where, e)) from None
+
+
+class Parameter:
+    """An attribute of a component as a PUS parameter."""
+
+    def __init__(self, id, component, name, type_spec, unit=None, writable=False, default=None):
+        self.id = id
+        self.component = component
+        self.name = name  # the attribute name
+        self.type_spec = type_spec
+        self.type = field_type(type_spec, "parameter %s.%s" % (component, name))
+        self.unit = unit
+        self.writable = writable
+        self.default = default
+
+    @property
+    def qualified(self):
+        return "%s.%s" % (self.component, self.name) if self.component else self.name
+
+    def __repr__(self):
+        return "Parameter(%d, %s, %s)" % (self.id, self.qualified, self.type.name)
+
+
+class EventDef:
+    """An event with its PUS event ID, severity (1..4) and auxiliary data layout."""
+
+    def __init__(self, id, component, name, severity, data=()):
+        self.id = id
+        self.component = component
+        self.name = name
+        self.severity = severity
+        self.fields = [
+            (f["name"], field_type(f["type"], "event %s field %s" % (name, f.get("name"))))
+            for f in data
+        ]
+        self.layout = Structure(self.fields)
+
+    @property
+    def qualified(self):
+        return "%s.%s" % (self.component, self.name) if self.component else self.name
+
+    def pack(self, payload):
+        """Auxiliary data for ``payload``: a dict, a list in field order, or a single value."""
+        if not self.fields:
+            return b""
+        if not isinstance(payload, dict):
+            if not isinstance(payload, (list, tuple)):
+                payload = (payload,)
+            payload = dict(zip([n for n, _ in self.fields], payload))
+        return self.layout.pack(payload)
+
+    def unpack(self, data):
+        return self.layout.unpack(data) if self.fields else {}
+
+    def __repr__(self):
+        return "EventDef(%d, %s, %s)" % (self.id, self.qualified, SEVERITY_NAMES[self.severity])
+
+
+def _int(value, what):
+    if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+        raise SdbError("%s must be an integer >= 0, got %r" % (what, value))
+    return value
+
+
+def _severity(value, what):
+    if isinstance(value, str):
+        s = SEVERITIES.get(value.lower())
+    else:
+        s = value if value in (1, 2, 3, 4) else None
+    if s is None:
+        raise SdbError("%s: severity %r, expected info, low, medium or high" % (what, value))
+    return s
+
+
+class FunctionDef:
+    """A service 8 function: ``arguments`` are (id, name, type spec, default) in call order."""
+
+    __slots__ = ("id", "name", "arguments")
+
+    def __init__(self, id, name, arguments):
+        self.id = id
+        self.name = name
+        self.arguments = arguments
+
+    def __repr__(self):
+        return "FunctionDef(%d, %s)" % (self.id, self.name)
+
+
+class OperationDef:
+    """An operation of a component: ``arguments`` are (name, unit) pairs (None: not given)."""
+
+    __slots__ = ("component", "name", "arguments")
+
+    def __init__(self, component, name, arguments):
+        self.component = component
+        self.name = name
+        self.arguments = arguments
+
+    @property
+    def qualified(self):
+        return "%s.%s" % (self.component, self.name)
+
+
+class NodeDef:
+    """A SpaceCAN equipment node: its component name, node id and definition file."""
+
+    __slots__ = ("name", "node_id", "definition")
+
+    def __init__(self, name, node_id, definition):
+        self.name = name
+        self.node_id = node_id
+        self.definition = definition
+
+    def __repr__(self):
+        return "NodeDef(%s, %d)" % (self.name, self.node_id)
+
+
+class Sdb:
+    """The parsed database: every section as typed objects, by id and by name."""
+
+    def __init__(self, doc, base=""):
+        if not isinstance(doc, dict):
+            raise SdbError("spacecraft database must be a JSON object")
+        self.mission = doc.get("mission", "")
+        self.apids = {}
+        self.components = []
+        self.parameters = {}  # id -> Parameter
+        self.events = {}  # id -> EventDef
+        self.housekeeping = []  # initial report structures as dicts
+        self.filestores = {}  # path prefix ('SAT') -> CFDP entity id
+        self.local_filestore = None  # the prefix of the onboard filestore
+        self.memories = {}  # memory id -> dict (name, file, start, size, writable)
+        self.functions = {}  # function id -> FunctionDef
+        self.operations = {}  # "Component.operation" -> OperationDef
+        self.position_parameter = None  # service 22's position parameter (a Parameter)
+        self.tm_vcs = None  # TM virtual channel plan (role -> VC ID), None: the default
+        self.scid = None  # spacecraft id, when the database gives it
+        self.nodes = {}  # SpaceCAN equipment name -> NodeDef
+        self.base = base  # the folder relative paths start from
+        self._params_by_name = {}
+        self._events_by_name = {}
+        self._functions_by_name = {}
+        unknown = [k for k in doc if k not in _KNOWN]
+        if unknown:
+            raise SdbError("spacecraft database: unknown section %s" % ", ".join(sorted(unknown)))
+        try:
+            self._load(doc)
+        except (KeyError, TypeError, AttributeError) as e:
+            raise SdbError("spacecraft database: missing or malformed entry (%r)" % (e,)) from None
+
+    def _load(self, doc):
+        used = {}
+        for name, apid in doc.get("apids", {}).items():
+            _int(apid, "APID of %s" % name)
+            if apid > 0x7FF:
+                raise SdbError("APID of %s is %d, above 2047" % (name, apid))
+            if apid in used:
+                raise SdbError("APID %d given to both %s and %s" % (apid, used[apid], name))
+            used[apid] = name
+            self.apids[name] = apid
+        for comp in doc.get("components", []):
+            cname = comp["name"]
+            if cname in self.components:
+                raise SdbError("component %s declared twice" % cname)
+            self.components.append(cname)
+            seen = set()
+            for a in comp.get("attributes", []):
+                if a["name"] in seen:
+                    raise SdbError("%s declares attribute %s twice" % (cname, a["name"]))
+                seen.add(a["name"])
+                self._add_parameter(
+                    Parameter(
+                        _int(a["parameter"], "parameter id of %s.%s" % (cname, a["name"])),
+                        cname,
+                        a["name"],
+                        a["type"],
+                        a.get("unit"),
+                        bool(a.get("writable", False)),
+                        a.get("default"),
+                    )
+                )
+            for e in comp.get("events", []):
+                self._add_event(cname, e)
+            for op in comp.get("operations", []):
+                args = [(a["name"], a.get("unit")) for a in op.get("arguments", ())]
+                self.operations["%s.%s" % (cname, op["name"])] = OperationDef(
+                    cname, op["name"], args
+                )
+        for p in doc.get("parameters", []):  # parameters of no component (process-local)
+            self._add_parameter(
+                Parameter(
+                    _int(p["id"], "parameter id of %s" % p["name"]),
+                    None,
+                    p["name"],
+                    p["type"],
+                    p.get("unit"),
+                    bool(p.get("writable", False)),
+                    p.get("default"),
+                )
+            )
+        for e in doc.get("events", []):
+            self._add_event(None, e)
+        sids = set()
+        for hk in doc.get("housekeeping", []):
+            sid = _int(hk["sid"], "housekeeping structure id")
+            if sid in sids:
+                raise SdbError("housekeeping structure %d declared twice" % sid)
+            sids.add(sid)
+            pids = [self.parameter(p).id for p in hk["parameters"]]
+            self.housekeeping.append(
+                {
+                    "sid": sid,
+                    "interval": _int(hk.get("interval", 1), "interval of structure %d" % sid),
+                    "parameters": pids,
+                    "enabled": bool(hk.get("enabled", False)),
+                }
+            )
+        self._load_files(doc)
+        self._load_functions(doc)
+        self._load_spacecraft(doc)
+
+    def _load_functions(self, doc):
+        for f in doc.get("functions", []):
+            fid = f["id"]
+            if not isinstance(fid, int) or not 0 <= fid <= 0xFFFF or fid in self.functions:
+                raise SdbError("function id %r unusable or repeated" % (fid,))
+            name = f["name"]
+            if name in self._functions_by_name:
+                raise SdbError("function %s declared twice" % name)
+            args = []
+            seen = set()
+            for a in f.get("arguments", ()):
+                aid = a["id"]
+                if not isinstance(aid, int) or not 0 <= aid <= 255 or aid in seen:
+                    raise SdbError(
+                        "function %s: argument id %r unusable or repeated" % (name, aid)
+                    )
+                seen.add(aid)
+                field_type(a["type"], "%s.%s" % (name, a["name"]))
+                args.append((aid, a["name"], a["type"], a.get("default")))
+            fd = FunctionDef(fid, name, args)
+            self.functions[fid] = fd
+            self._functions_by_name[name] = fd
+
+    def _load_spacecraft(self, doc):
+        pos = doc.get("position_scheduling")
+        if pos:
+            self.position_parameter = self.parameter(pos["parameter"])
+        frames = doc.get("frames") or {}
+        if "tm_vcs" in frames:
+            self.tm_vcs = {str(k): _int(v, "TM VC of %s" % k) for k, v in frames["tm_vcs"].items()}
+        if "scid" in frames:
+            self.scid = _int(frames["scid"], "spacecraft id")
+        ids = set()
+        for n in doc.get("nodes", []):
+            nid = _int(n["node_id"], "node id of %s" % n["name"])
+            if not 1 <= nid <= 127 or nid in ids or n["name"] in self.nodes:
+                raise SdbError("node %s: id %d unusable or repeated" % (n["name"], nid))
+            ids.add(nid)
+            path = n.get("definition")
+            if path and self.base and not path.startswith("/"):
+                path = self.base + "/" + path
+            self.nodes[n["name"]] = NodeDef(n["name"], nid, path)
+
+    def function(self, key):
+        """The FunctionDef with this id or name ('SolarPanel.set_angle')."""
+        f = self.functions.get(key) if isinstance(key, int) else self._functions_by_name.get(key)
+        if f is None:
+            raise KeyError("no function %r in the spacecraft database" % (key,))
+        return f
+
+    def _load_files(self, doc):
+        for fs in doc.get("filestores", []):
+            prefix = fs["prefix"]
+            if not isinstance(prefix, str) or not prefix or ":" in prefix or "/" in prefix:
+                raise SdbError("filestore prefix %r, expected a name like 'SAT'" % (prefix,))
+            if prefix in self.filestores:
+                raise SdbError("filestore prefix %s declared twice" % prefix)
+            self.filestores[prefix] = _int(fs["entity"], "CFDP entity id of %s" % prefix)
+            if fs.get("local") or self.local_filestore is None:
+                self.local_filestore = prefix
+        for m in doc.get("memories", []):
+            mid = _int(m["id"], "memory id")
+            if mid in self.memories:
+                raise SdbError("memory %d declared twice" % mid)
+            size = _int(m["size"], "size of memory %d" % mid)
+            if size == 0:
+                raise SdbError("memory %d has size 0" % mid)
+            self.memories[mid] = {
+                "id": mid,
+                "name": m.get("name", "memory%d" % mid),
+                "file": m.get("file"),
+                "start": _int(m.get("start", 0), "start of memory %d" % mid),
+                "size": size,
+                "writable": bool(m.get("writable", False)),
+            }
+
+    def filestore_entity(self, prefix):
+        """The CFDP entity id of path prefix ``prefix`` ('SAT', 'GROUND')."""
+        try:
+            return self.filestores[prefix]
+        except KeyError:
+            raise KeyError("no filestore %r in the spacecraft database" % (prefix,)) from None
+
+    def _add_parameter(self, p):
+        if p.id in self.parameters:
+            raise SdbError(
+                "parameter id %d given to both %s and %s"
+                % (p.id, self.parameters[p.id].qualified, p.qualified)
+            )
+        if p.qualified in self._params_by_name:
+            raise SdbError("parameter %s declared twice" % p.qualified)
+        self.parameters[p.id] = p
+        self._params_by_name[p.qualified] = p
+
+    def _add_event(self, component, e):
+        what = "event %s" % e.get("name")
+        ev = EventDef(
+            _int(e["id"], "id of " + what),
+            component,
+            e["name"],
+            _severity(e.get("severity", "info"), what),
+            e.get("data", ()),
+        )
+        if ev.id in self.events:
+            raise SdbError(
+                "event id %d given to both %s and %s"
+                % (ev.id, self.events[ev.id].qualified, ev.qualified)
+            )
+        if ev.qualified in self._events_by_name:
+            raise SdbError("event %s declared twice" % ev.qualified)
+        self.events[ev.id] = ev
+        self._events_by_name[ev.qualified] = ev
+
+    def parameter(self, key):
+        """The Parameter with this id or qualified name ('SolarPanel.angle')."""
+        p = self.parameters.get(key) if isinstance(key, int) else self._params_by_name.get(key)
+        if p is None:
+            raise KeyError("no parameter %r in the spacecraft database" % (key,))
+        return p
+
+    def event(self, key):
+        """The EventDef with this id or qualified name ('SolarPanel.angle_reached')."""
+        e = self.events.get(key) if isinstance(key, int) else self._events_by_name.get(key)
+        if e is None:
+            raise KeyError("no event %r in the spacecraft database" % (key,))
+        return e
+
+    def apid(self, name):
+        try:
+            return self.apids[name]
+        except KeyError:
+            raise KeyError("no APID named %r in the spacecraft database" % (name,)) from None
+
+    def check_interfaces(self, interfaces):
+        """Raise SdbError if an entry names an attribute or event its interface lacks."""
+        by_name = {i.name: i for i in interfaces}
+        for p in self.parameters.values():
+            itf = by_name.get(p.component)
+            if itf is None:
+                continue
+            m = itf.members.get(p.name)
+            if m is None or m.member != 1:
+                raise SdbError("%s has no attribute %s" % (p.component, p.name))
+            if p.writable and not m.writable:
+                raise SdbError(
+                    "%s is writable in the database, read-only in the interface" % p.qualified
+                )
+        for e in self.events.values():
+            itf = by_name.get(e.component)
+            if itf is None:
+                continue
+            m = itf.members.get(e.name)
+            if m is None or m.member != 3:
+                raise SdbError("%s has no event %s" % (e.component, e.name))
+
+
+_KNOWN = (
+    "mission",
+    "apids",
+    "components",
+    "parameters",
+    "events",
+    "housekeeping",
+    "filestores",
+    "memories",
+    "functions",
+    "position_scheduling",
+    "frames",
+    "nodes",
+)
+
+
+def parse_json(text):
+    """The one place the database's JSON text is parsed."""
+    try:
+        return json.loads(text)
+    except ValueError as e:
+        raise SdbError("spacecraft database is not valid JSON: %s" % e) from None
+
+
+def loads(text, base=""):
+    """Parse a spacecraft database from JSON text (``base``: folder of relative paths)."""
+    return Sdb(parse_json(text), base)
+
+
+def load(path):
+    with open(path) as f:
+        text = f.read()
+    i = path.rfind("/")
+    return loads(text, path[:i] if i > 0 else ("/" if i == 0 else ""))

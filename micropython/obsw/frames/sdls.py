@@ -39,7 +39,7 @@ TOO_SHORT = const(5)
 OUTCOME_NAMES = ("ok", "bad_spi", "sa_not_operational", "bad_mac", "replay", "too_short")
 
 # The PUS event ID raised for each rejection (the spacecraft database names them frames.tc_*)
-EVENT_IDS = (0, 0xFF21, 0xFF22, 0xFF23, 0xFF24, 0xFF25)
+EVENT_IDS = (0, 0xFF31, 0xFF32, 0xFF33, 0xFF34, 0xFF35)
 
 SPI_MIN = const(1)  # SPI 0 and 0xFFFF are reserved (355.0-B-2 4.1.1.2)
 SPI_MAX = const(0xFFFE)

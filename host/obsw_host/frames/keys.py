@@ -96,3 +96,11 @@ class StateFile:
             os.fsync(f.fileno())
         os.replace(tmp, self.path)
         self.saves += 1
+
+
+def signed_frame(security, scid, vcid, packet, map_id=1, seq=0, bypass=True):
+    """One TC frame carrying ``packet`` on MAP ``map_id``, signed with the channel's SA."""
+    from obsw.frames.tc import Segment, TcFrame
+
+    data = security.apply(scid, vcid, Segment(map_id, packet).pack(), bypass)
+    return TcFrame(scid, vcid, data, seq, bypass).pack()

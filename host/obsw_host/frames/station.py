@@ -14,13 +14,14 @@ from collections import deque
 from obsw.frames import fop as F
 
 from obsw_host.frames.ground import Ground
+from obsw_host.net import DEFAULT_HOST
 
 
 class GroundStation:
     """``Ground`` (FOP-1, CLTUs, TM decoding) between ``links`` and one UDP socket."""
 
     def __init__(
-        self, links, scid, host="127.0.0.1", port=0, mcs=None, keep=10000, clock=None, **options
+        self, links, scid, host=DEFAULT_HOST, port=0, mcs=None, keep=10000, clock=None, **options
     ):
         self.ground = Ground(links, scid, **options)
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)

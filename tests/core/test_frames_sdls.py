@@ -378,6 +378,43 @@ class TestTcSecurity(unittest.TestCase):
         self.assertRaises(sdls.SdlsError, r.frame, tc_packet(0x21, b"cmd"))
 
 
+class TestEssentialCommands(unittest.TestCase):
+    """The reconfiguration module's HPCs are authenticated with the essential MAP's own SA."""
+
+    def setUp(self):
+        from obsw.reconfig import essential as E
+
+        self.E = E
+        self.ground = security()
+        self.unit = E.Essential(SCID, security=security())
+
+    def hpc_frame(self, hpc, sign=True, map_id=63):
+        data = tc.Segment(map_id, hpc.packet()).pack()
+        if sign:
+            data = self.ground.apply(SCID, 0, data, True)
+        return cltu.encode(tc.TcFrame(SCID, 0, data, 0, True).pack())
+
+    def test_signed_executed_others_rejected(self):
+        E = self.E
+        hpc = E.Hpc(E.HPC_LINES, (0x3, 0x1), E.TARGET_BOTH)
+        self.unit.feed(self.hpc_frame(hpc), 0.0)
+        self.assertEqual(self.unit.counters["hpcs"], 1)
+        self.assertEqual(self.ground.sas[2].sn_sent, 1)  # the essential MAP's SA
+        self.unit.feed(self.hpc_frame(hpc), 0.0)  # a new SN: executed again
+        self.assertEqual(self.unit.counters["hpcs"], 2)
+        replay = self.hpc_frame(hpc)
+        self.unit.feed(replay, 0.0)
+        self.unit.feed(replay, 0.0)
+        self.unit.feed(self.hpc_frame(hpc, sign=False), 0.0)
+        self.assertEqual(self.unit.counters["hpcs"], 3)
+        c = self.unit.frames.security.counters
+        self.assertEqual((c["ok"], c["replay"], c["bad_spi"]), (3, 1, 1))
+        self.assertEqual(self.unit.frames.counters["tc_rejected"], 2)
+
+    def test_security_from_file(self):
+        self.assertIsNone(self.E.security_from_file("/nonexistent/tc.keys"))
+
+
 class TestKeyFile(unittest.TestCase):
     def test_round_trip(self):
         sas = security(mac_length=12, window=32).sas

@@ -96,6 +96,8 @@ class FrameProcessor:
         self.segment_header = segment_header
         self.tm_randomize = tm_randomize
         self.clcw_period = clcw_period
+        if security is not None and security.segment_header != segment_header:
+            raise ValueError("TC security and frame processor disagree on segment headers")
         self.security = security
         self.rejected_listeners = []  # callables(outcome, vcid, spi, sn)
         self.farms = {}

@@ -181,3 +181,24 @@ def test_key_files(tmp_path):
         keys.load(path)
     with pytest.raises(sdls.SdlsError):  # never into a repository
         keys.generate(os.path.join(os.path.dirname(__file__), "x.keys"))
+
+
+def test_station_signs_and_refuses_without_operational_sa(tmp_path):
+    from obsw_host.frames.station import GroundStation
+
+    path = str(tmp_path / "k.keys")
+    keys.generate(path)
+    security, state = keys.load(path)
+    station = GroundStation([], SCID, security=security, state=state)
+    mcs = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        mcs.sendto(tc_packet(1, b"one"), station.address)
+        station.step(0)
+        security.sas[1].stop()
+        mcs.sendto(tc_packet(2, b"two"), station.address)
+        station.step(0)
+        assert (station.uplinked, station.refused) == (1, 1)
+        assert security.sas[1].sn_sent == 1
+    finally:
+        mcs.close()
+        station.close()

@@ -136,6 +136,8 @@ def processor(args):
     if args.keys:
         print("TC security: %d SA(s) from %s, events on APID %d" % (
             len(security["security"].sas), args.keys, security["event_apid"]))  # fmt: skip
+    else:
+        print("TC security: off (no --keys): every well-formed TC frame is accepted")
     try:
         host.run(duration=args.duration)
     finally:

@@ -12,6 +12,7 @@ import time
 from collections import deque
 
 from obsw.frames import fop as F
+from obsw.frames.errors import FrameError
 
 from obsw_host.frames.ground import Ground
 from obsw_host.net import DEFAULT_HOST
@@ -33,6 +34,7 @@ class GroundStation:
         self.clock = clock or time.monotonic
         self._t0 = self.clock()
         self.uplinked = 0
+        self.refused = 0  # packets that could not go up (too long, or no operational SA)
         self._initiated = False
 
     def now(self):
@@ -51,7 +53,11 @@ class GroundStation:
                 break
             if self.mcs is None or self.mcs != sender:
                 self.mcs = sender
-            self.ground.send(packet, now)
+            try:
+                self.ground.send(packet, now)
+            except FrameError:
+                self.refused += 1
+                continue
             self.uplinked += 1
         self.ground.poll(now, timeout)
         ch = self.ground.channel_packets

@@ -91,8 +91,12 @@ class TestReplayWindow(unittest.TestCase):
     def test_edges(self):
         w = sdls.ReplayWindow(8)
         self.assertFalse(w.acceptable(0))  # sequence numbers start at 1
-        self.assertTrue(w.acceptable(8))  # top + size: the last one ahead
-        self.assertFalse(w.acceptable(9))
+        self.assertTrue(w.acceptable(1000))  # nothing accepted yet: any number from 1
+        w.commit(1)
+        self.assertFalse(w.acceptable(1))
+        self.assertTrue(w.acceptable(9))  # top + size: the last one ahead
+        self.assertFalse(w.acceptable(10))
+        w = sdls.ReplayWindow(8, 0)
         w.commit(8)
         self.assertFalse(w.acceptable(8))
         self.assertTrue(w.acceptable(1))  # top - size + 1: the oldest one behind
@@ -255,9 +259,17 @@ class TestTcSecurity(unittest.TestCase):
 
     def test_out_of_window_rejected(self):
         r = Rig(window=4)
+        r.send(r.frame(tc_packet(0x21, b"cmd")))
         r.ground.sas[1].sn_sent = 10
         r.send(r.frame(tc_packet(0x21, b"cmd")))
         self.assertEqual(r.rejected, [(sdls.REPLAY, 0, 1, 11)])
+
+    def test_fresh_receiver_takes_up_the_senders_numbers(self):
+        r = Rig(window=4)
+        r.ground.sas[1].sn_sent = 500  # the receiver restarted without its state
+        r.send(r.frame(tc_packet(0x21, b"cmd")))
+        self.assertEqual(len(r.routed), 1)
+        self.assertEqual(r.onboard.sas[1].window.top, 501)
 
     def test_older_in_window_accepted_once(self):
         r = Rig()

@@ -55,7 +55,12 @@ class SdlsError(FrameError):
 class ReplayWindow:
     """Anti-replay sequence numbers of one SA: the highest accepted (``top``) and which of the
     ``size`` numbers below it were seen. A number is acceptable when it was not seen, is above
-    ``top - size`` and at most ``size`` above ``top`` (the SDLS sequence number window)."""
+    ``top - size`` and at most ``size`` above ``top`` (the SDLS sequence number window).
+
+    Before anything was accepted or restored (``top`` 0) any number from 1 is: a receiver that
+    restarts without its saved state takes up the sender's numbers instead of locking the
+    channel out, at the price of accepting, once, frames sent before the restart. Keeping the
+    state (``TcSecurity.context``) closes that gap."""
 
     __slots__ = ("size", "top", "_seen")
 
@@ -69,7 +74,7 @@ class ReplayWindow:
     def acceptable(self, sn):
         top = self.top
         if sn > top:
-            return sn - top <= self.size
+            return top == 0 or sn - top <= self.size
         back = top - sn
         return back < self.size and not (self._seen >> back) & 1
 
@@ -78,7 +83,10 @@ class ReplayWindow:
         top = self.top
         if sn > top:
             shift = sn - top
-            self._seen = ((self._seen << shift) | 1) & ((1 << self.size) - 1)
+            if shift >= self.size:
+                self._seen = 1
+            else:
+                self._seen = ((self._seen << shift) | 1) & ((1 << self.size) - 1)
             self.top = sn
         else:
             self._seen |= 1 << (top - sn)

@@ -16,7 +16,7 @@ from obsw.pus.tm import PusTm
 from obsw_host.frames import keys
 from obsw_host.frames.ground import Ground
 from obsw_host.frames.links import FdLink, SerialLink, open_pty_pair
-from obsw_host.frames.processor import FrameProcessorHost, sdb_events
+from obsw_host.frames.processor import FrameProcessorHost, sdb_events, security_options
 from obsw_host.pus.demo import SDB_PATH
 
 SCID = 0x33
@@ -33,9 +33,9 @@ def tc_packet(seq, payload):
 def rig(tmp_path):
     key_file = str(tmp_path / "tc.keys")
     keys.generate(key_file)
-    onboard_security, onboard_state = keys.load(key_file, str(tmp_path / "onboard.state"))
-    ground_security, ground_state = keys.load(key_file, str(tmp_path / "ground.state"))
     db = sdb_module.load(SDB_PATH)
+    secured = security_options(key_file, db, str(tmp_path / "onboard.state"))
+    ground_security, ground_state = keys.load(key_file, str(tmp_path / "ground.state"))
     event_apid, event_ids = sdb_events(db)
     ctrl_a, dev_a = open_pty_pair()
     ctrl_b, dev_b = open_pty_pair()
@@ -51,10 +51,7 @@ def rig(tmp_path):
         tm_port=0,
         tm_frame_length=LENGTH,
         clcw_period=0.2,
-        security=onboard_security,
-        state=onboard_state,
-        event_apid=event_apid,
-        event_ids=event_ids,
+        **secured,
     )
     stop = threading.Event()
     worker = threading.Thread(target=obc.run, args=(stop,), daemon=True)

@@ -61,6 +61,11 @@ def add_parser(sub):
     sign.add_argument("--cltu", action="store_true", help="print the CLTU instead")
     sign.set_defaults(func=sign_frame)
 
+    ver = s.add_parser("verify", help="check a signed TC frame or CLTU (hex) against a key file")
+    ver.add_argument("hex")
+    ver.add_argument("--keys", required=True, help="SDLS key file")
+    ver.set_defaults(func=verify_frame)
+
     cltu = s.add_parser("cltu", help="encode or decode a CLTU")
     cs = cltu.add_subparsers(dest="cltu_action", metavar="ACTION")
     cs.required = True
@@ -101,14 +106,12 @@ def processor(args):
     if args.keys:
         from obsw import sdb as sdb_module
 
-        from obsw_host.frames import keys
-        from obsw_host.frames.processor import sdb_events
+        from obsw_host.frames.processor import security_options
         from obsw_host.pus.demo import SDB_PATH
 
         try:
-            security["security"], security["state"] = keys.load(args.keys, args.key_state)
             db = sdb_module.load(args.sdb or SDB_PATH)
-            security["event_apid"], security["event_ids"] = sdb_events(db)
+            security = security_options(args.keys, db, args.key_state)
         except (OSError, ValueError, KeyError) as e:
             raise SystemExit("obsw frames processor: %s" % e) from None
     try:
@@ -246,6 +249,30 @@ def tm_decode(args):
     }
     print(json.dumps(out))
     return 0
+
+
+def verify_frame(args):
+    from obsw.frames.cltu import decode
+    from obsw.frames.errors import FrameError
+    from obsw.frames.sdls import OUTCOME_NAMES
+    from obsw.frames.tc import TcFrame
+
+    from obsw_host.frames import keys
+
+    raw = _hex(args.hex)
+    try:
+        security, _ = keys.load(args.keys, False)  # no state: any fresh number is taken
+        if raw[:2] == b"\xeb\x90":
+            raw, _ = decode(raw)
+        frame = TcFrame.unpack(raw, trailing=True)
+    except (OSError, FrameError) as e:
+        raise SystemExit("obsw frames verify: %s" % e) from None
+    outcome, sa, sn, clear = security.process(raw, len(frame))
+    out = _frame_json(frame)
+    out.update(outcome=OUTCOME_NAMES[outcome], spi=None if sa is None else sa.spi, sn=sn)
+    out["data"] = None if clear is None else binascii.hexlify(clear).decode()
+    print(json.dumps(out))
+    return 0 if clear is not None else 1
 
 
 def run_demo(args):

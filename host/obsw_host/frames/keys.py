@@ -53,13 +53,16 @@ def state_path(key_path):
 
 
 def load(path, state=None, segment_header=True):
-    """The TcSecurity of key file ``path``, with its sequence numbers restored from ``state``
-    (a path; by default ``path + '.state'``; missing is fine: a fresh file starts at 0)."""
+    """(TcSecurity, StateFile) of key file ``path``, with its sequence numbers restored from
+    ``state`` (a path; by default ``path + '.state'``; missing is fine: a fresh file starts at
+    0; False: no state file, and the StateFile is None)."""
     mode = os.stat(path).st_mode
     if mode & (stat.S_IRWXG | stat.S_IRWXO):
         raise KeyFileError("%s can be read by others (chmod 600 it)" % path)
     with open(path) as f:
         security = load_security(f.read(), segment_header)
+    if state is False:
+        return security, None
     keeper = StateFile(state or state_path(path), security)
     keeper.load()
     return security, keeper

@@ -40,6 +40,16 @@ def sdb_events(sdb):
     return sdb.apid("frames"), tuple(ids)
 
 
+def security_options(key_path, sdb, state_path=None):
+    """The FrameProcessorHost options that authenticate TC frames with the key file at
+    ``key_path`` and report rejections as the events of ``sdb`` (a spacecraft database)."""
+    from obsw_host.frames import keys
+
+    security, state = keys.load(key_path, state_path)
+    event_apid, event_ids = sdb_events(sdb)
+    return {"security": security, "state": state, "event_apid": event_apid, "event_ids": event_ids}
+
+
 class _Clock:
     def __init__(self, fn):
         self.now = fn

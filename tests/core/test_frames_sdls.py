@@ -89,14 +89,14 @@ class TestHmac(unittest.TestCase):
 
 class TestReplayWindow(unittest.TestCase):
     def test_edges(self):
-        w = sdls.ReplayWindow(8)
+        w = sdls.ReplayWindow(8, 8)
         self.assertFalse(w.acceptable(0))  # sequence numbers start at 1
         self.assertTrue(w.acceptable(1000))  # nothing accepted yet: any number from 1
         w.commit(1)
         self.assertFalse(w.acceptable(1))
-        self.assertTrue(w.acceptable(9))  # top + size: the last one ahead
+        self.assertTrue(w.acceptable(9))  # top + ahead: the last one ahead
         self.assertFalse(w.acceptable(10))
-        w = sdls.ReplayWindow(8, 0)
+        w = sdls.ReplayWindow(8, 8)
         w.commit(8)
         self.assertFalse(w.acceptable(8))
         self.assertTrue(w.acceptable(1))  # top - size + 1: the oldest one behind
@@ -106,6 +106,15 @@ class TestReplayWindow(unittest.TestCase):
         self.assertTrue(w.acceptable(5))
         self.assertTrue(w.acceptable(16))
         self.assertFalse(w.acceptable(17))
+
+    def test_without_ahead_any_jump_is_taken(self):
+        w = sdls.ReplayWindow(8)
+        w.commit(1)
+        self.assertTrue(w.acceptable(1 << 40))
+        w.commit(1 << 40)
+        self.assertFalse(w.acceptable(1))
+        self.assertTrue(w.acceptable((1 << 40) - 7))
+        self.assertFalse(w.acceptable((1 << 40) - 8))
 
     def test_sliding_forgets_what_falls_out(self):
         w = sdls.ReplayWindow(4)
@@ -123,6 +132,7 @@ class TestReplayWindow(unittest.TestCase):
     def test_size_bounds(self):
         self.assertRaises(sdls.SdlsError, sdls.ReplayWindow, 0)
         self.assertRaises(sdls.SdlsError, sdls.ReplayWindow, sdls.MAX_WINDOW + 1)
+        self.assertRaises(sdls.SdlsError, sdls.ReplayWindow, 8, 0)
 
 
 class TestSecurityAssociation(unittest.TestCase):
@@ -258,7 +268,7 @@ class TestTcSecurity(unittest.TestCase):
         self.assertEqual(r.rejected, [(sdls.REPLAY, 0, 1, 1)])
 
     def test_out_of_window_rejected(self):
-        r = Rig(window=4)
+        r = Rig(window=4, ahead=4)
         r.send(r.frame(tc_packet(0x21, b"cmd")))
         r.ground.sas[1].sn_sent = 10
         r.send(r.frame(tc_packet(0x21, b"cmd")))
@@ -429,13 +439,15 @@ class TestEssentialCommands(unittest.TestCase):
 
 class TestKeyFile(unittest.TestCase):
     def test_round_trip(self):
-        sas = security(mac_length=12, window=32).sas
+        sas = security(mac_length=12, window=32, ahead=100).sas
         text = dump_sas([sas[1], sas[2]])
         back = load_sas(text)
         self.assertEqual([(s.spi, s.vcid, s.map_id) for s in back], [(1, 0, None), (2, 0, 63)])
         self.assertEqual(back[0].key, KEY)
         self.assertEqual(back[0].mac_length, 12)
         self.assertEqual(back[0].window.size, 32)
+        self.assertEqual(back[0].window.ahead, 100)
+        self.assertIsNone(back[1].window.ahead)
         self.assertEqual(back[1].state, sdls.SA_OPERATIONAL)
         self.assertEqual(len(load_security(text).sas), 2)
 

@@ -73,14 +73,16 @@ def test_random_frames_never_raise(raw):
 
 
 @SETTINGS
-@given(st.integers(1, 40), st.lists(st.integers(0, 200), max_size=80))
-def test_replay_window_matches_a_model(size, numbers):
-    window = sdls.ReplayWindow(size)
+@given(
+    st.integers(1, 40), st.none() | st.integers(1, 40), st.lists(st.integers(0, 200), max_size=80)
+)
+def test_replay_window_matches_a_model(size, ahead, numbers):
+    window = sdls.ReplayWindow(size, ahead)
     seen = set()
     top = 0
     for sn in numbers:
-        ahead = top == 0 or sn - top <= size
-        expected = sn not in seen and sn > top - size and ahead and sn > 0
+        near = top == 0 or ahead is None or sn - top <= ahead
+        expected = sn not in seen and sn > top - size and near and sn > 0
         assert window.acceptable(sn) == expected
         if expected:
             window.commit(sn)

@@ -55,26 +55,31 @@ class SdlsError(FrameError):
 class ReplayWindow:
     """Anti-replay sequence numbers of one SA: the highest accepted (``top``) and which of the
     ``size`` numbers below it were seen. A number is acceptable when it was not seen, is above
-    ``top - size`` and at most ``size`` above ``top`` (the SDLS sequence number window).
+    ``top - size`` and, with ``ahead``, at most ``ahead`` above ``top`` (the SDLS sequence
+    number window: set it to refuse jumps; without it, any authentic number above ``top`` is
+    taken, so frames lost on the way, however many, never lock the channel out).
 
     Before anything was accepted or restored (``top`` 0) any number from 1 is: a receiver that
     restarts without its saved state takes up the sender's numbers instead of locking the
     channel out, at the price of accepting, once, frames sent before the restart. Keeping the
     state (``TcSecurity.context``) closes that gap."""
 
-    __slots__ = ("size", "top", "_seen")
+    __slots__ = ("size", "ahead", "top", "_seen")
 
-    def __init__(self, size=64, top=0):
+    def __init__(self, size=64, ahead=None, top=0):
         if not 1 <= size <= MAX_WINDOW:
             raise SdlsError("anti-replay window %d outside 1..%d" % (size, MAX_WINDOW))
+        if ahead is not None and ahead < 1:
+            raise SdlsError("sequence number window ahead %d below 1" % ahead)
         self.size = size
+        self.ahead = ahead
         self.top = top
         self._seen = 1  # bit i: top - i was accepted (top itself counts as seen)
 
     def acceptable(self, sn):
         top = self.top
         if sn > top:
-            return top == 0 or sn - top <= self.size
+            return top == 0 or self.ahead is None or sn - top <= self.ahead
         back = top - sn
         return back < self.size and not (self._seen >> back) & 1
 
@@ -94,7 +99,8 @@ class ReplayWindow:
 
 class SecurityAssociation:
     """One SA: SPI, the channel it secures (VC, optionally one MAP), key, lengths, state, and
-    the sequence numbers of both ends (``sn_sent`` sending, ``window`` receiving)."""
+    the sequence numbers of both ends (``sn_sent`` sending, ``window`` receiving; ``window`` and
+    ``ahead`` as in ReplayWindow)."""
 
     def __init__(
         self,
@@ -106,6 +112,7 @@ class SecurityAssociation:
         sn_length=4,
         window=64,
         state=None,
+        ahead=None,
     ):
         if not SPI_MIN <= spi <= SPI_MAX:
             raise SdlsError("SPI %r outside %d..%d" % (spi, SPI_MIN, SPI_MAX))
@@ -123,7 +130,7 @@ class SecurityAssociation:
         self.mac_length = mac_length
         self.sn_length = sn_length
         self.sn_max = (1 << (8 * sn_length)) - 1
-        self.window = ReplayWindow(window)
+        self.window = ReplayWindow(window, ahead)
         self.sn_sent = 0
         self._mac = None
         self.key = None

@@ -2,9 +2,12 @@
 
     {"format": "obsw-sdls-keys", "version": 1,
      "sas": [{"spi": 1, "vcid": 0, "map_id": null, "key": "<hex, 32 octets>",
-              "mac_length": 16, "sn_length": 4, "window": 64, "state": "operational"}]}
+              "mac_length": 16, "sn_length": 4, "window": 64, "ahead": null,
+              "state": "operational"}]}
 
-``map_id`` null: the SA secures every MAP of its VC that has no SA of its own. ``state`` is
+``map_id`` null: the SA secures every MAP of its VC that has no SA of its own. ``window``: how
+far below the highest accepted sequence number a number not seen yet is still taken;
+``ahead``: how far above it (null: any). ``state`` is
 "operational" (default), "keyed" (loaded but not started), "unkeyed" or "expired" (no
 key: nothing is sent or accepted with it).
 """
@@ -31,7 +34,17 @@ _STATES = {
     "unkeyed": SA_UNKEYED,
     "expired": SA_EXPIRED,
 }
-_FIELDS = ("spi", "vcid", "map_id", "key", "mac_length", "sn_length", "window", "state")
+_FIELDS = (
+    "spi",
+    "vcid",
+    "map_id",
+    "key",
+    "mac_length",
+    "sn_length",
+    "window",
+    "ahead",
+    "state",
+)
 
 
 class KeyFileError(SdlsError):
@@ -40,7 +53,7 @@ class KeyFileError(SdlsError):
 
 def _number(entry, name, default, where):
     v = entry.get(name, default)
-    if v is None and name == "map_id":
+    if v is None and name in ("map_id", "ahead"):
         return None
     if not isinstance(v, int) or isinstance(v, bool):
         raise KeyFileError("%s: %s must be an integer, got %r" % (where, name, v))
@@ -88,6 +101,7 @@ def load_sas(text):
                 _number(e, "sn_length", 4, where),
                 _number(e, "window", 64, where),
                 state,
+                _number(e, "ahead", None, where),
             )
         except SdlsError as err:
             raise KeyFileError("%s: %s" % (where, err)) from None
@@ -118,6 +132,7 @@ def dump_sas(sas):
                 "mac_length": sa.mac_length,
                 "sn_length": sa.sn_length,
                 "window": sa.window.size,
+                "ahead": sa.window.ahead,
                 "state": SA_STATE_NAMES[sa.state],
             }
         )

@@ -47,6 +47,7 @@ def add_parser(sub):
     kg.add_argument("--no-essential", action="store_true", help="no SA for essential TCs")
     kg.add_argument("--mac-length", type=int, default=16, help="MAC octets, 8..32 (16)")
     kg.add_argument("--window", type=int, default=64, help="anti-replay window (64)")
+    kg.add_argument("--ahead", type=int, help="refuse numbers this far above the last (none)")
     kg.set_defaults(func=keygen)
 
     sign = s.add_parser("sign", help="a signed TC frame (hex, or a CLTU) carrying a packet")
@@ -161,6 +162,7 @@ def keygen(args):
             None if args.no_essential else args.essential_map,
             args.mac_length,
             args.window,
+            args.ahead,
         )
     except (OSError, ValueError) as e:
         raise SystemExit("obsw frames keygen: %s" % e) from None

@@ -28,18 +28,29 @@ def inside_git_tree(path):
         d = parent
 
 
-def generate(path, vcids=(0,), essential_map=63, mac_length=16, window=64, allow_git=False):
+def generate(
+    path, vcids=(0,), essential_map=63, mac_length=16, window=64, ahead=None, allow_git=False
+):
     """Write a new key file: one SA per VC (SPI = VC ID + 1) and, unless ``essential_map`` is
     None, one for the essential MAP of the first VC (SPI 63), each with a fresh 256-bit key."""
     if not allow_git and inside_git_tree(path):
         raise KeyFileError("%s is inside a git work tree: keep keys out of repositories" % path)
     sas = [
-        SecurityAssociation(v + 1, v, os.urandom(32), None, mac_length, 4, window) for v in vcids
+        SecurityAssociation(v + 1, v, os.urandom(32), None, mac_length, 4, window, None, ahead)
+        for v in vcids
     ]
     if essential_map is not None:
         sas.append(
             SecurityAssociation(
-                ESSENTIAL_SPI, vcids[0], os.urandom(32), essential_map, mac_length, 4, window
+                ESSENTIAL_SPI,
+                vcids[0],
+                os.urandom(32),
+                essential_map,
+                mac_length,
+                4,
+                window,
+                None,
+                ahead,
             )
         )
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)

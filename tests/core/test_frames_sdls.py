@@ -360,8 +360,8 @@ class TestTcSecurity(unittest.TestCase):
             SCID, lambda a, p: r.routed.append(p), tc_vcids=(0, 1), security=r.onboard
         )
         r.p.rejected_listeners.append(lambda *a: r.rejected.append(a))
-        frame = r.frame(tc_packet(0x21, b"cmd"), vcid=1)  # VC 1 has no SA: sent in clear
-        r.send(frame)
+        self.assertRaises(sdls.SdlsError, r.frame, tc_packet(0x21, b"cmd"), vcid=1)
+        r.send(r.frame(tc_packet(0x21, b"cmd"), vcid=1, sign=False))  # VC 1 has no SA
         self.assertEqual(r.routed, [])
         self.assertEqual(r.rejected[0][0], sdls.BAD_SPI)
 
@@ -398,6 +398,13 @@ class TestTcSecurity(unittest.TestCase):
         r = Rig(sn_length=1)
         r.ground.sas[1].sn_sent = 255
         self.assertRaises(sdls.SdlsError, r.frame, tc_packet(0x21, b"cmd"))
+
+    def test_too_long_refused_without_using_a_number(self):
+        r = Rig()
+        self.assertRaises(sdls.SdlsError, r.frame, bytes(1024 - 5 - 1 - 6 - 16 - 2 + 1))
+        self.assertEqual(r.ground.sas[1].sn_sent, 0)
+        r.frame(bytes(1024 - 5 - 1 - 6 - 16 - 2))
+        self.assertEqual(r.ground.sas[1].sn_sent, 1)
 
 
 class TestEssentialCommands(unittest.TestCase):

@@ -178,9 +178,6 @@ class SecurityAssociation:
     def mac(self, *parts):
         return self._mac.digest(*parts)[: self.mac_length]
 
-    def covers(self, vcid, map_id):
-        return self.vcid == vcid and (self.map_id is None or self.map_id == map_id)
-
     def __repr__(self):
         return "SecurityAssociation(spi=%d vc=%d map=%s %s)" % (
             self.spi,
@@ -208,9 +205,9 @@ def _int(buf):
 class TcSecurity:
     """The SA database of a TC receiver or sender, and SDLS Apply/ProcessSecurity on TC frames.
 
-    ``counters`` counts the verification outcomes by name. Channels (VC, MAP) with no SA at all
-    are not secured on the sending end, and on the receiving end every frame but a control
-    command must pass verification: a frame no SA can verify is rejected as a bad SPI.
+    ``counters`` counts the verification outcomes by name. Every frame but a control command is
+    secured: sending on a channel (VC, MAP) with no operational SA is refused, and a received
+    frame no SA can verify is rejected as a bad SPI.
     """
 
     def __init__(self, sas=(), segment_header=True):
@@ -241,26 +238,20 @@ class TcSecurity:
         return True
 
     def sa_for(self, vcid, map_id=None):
-        """The operational SA that secures (vcid, map_id) when sending, or None when the
-        channel has no SA; SdlsError when it has SAs but none is operational."""
-        found = None
+        """The operational SA that secures (vcid, map_id) when sending (the lowest SPI);
+        SdlsError when there is none."""
         for spi in sorted(self.sas):
             sa = self.sas[spi]
-            if self._valid_for(sa, vcid, map_id):
-                if sa.state == SA_OPERATIONAL:
-                    return sa
-                found = sa
-        if found is not None:
-            raise SdlsError("no operational SA for VC %d MAP %s" % (vcid, map_id))
-        return None
+            if self._valid_for(sa, vcid, map_id) and sa.state == SA_OPERATIONAL:
+                return sa
+        raise SdlsError("no operational SA for VC %d MAP %s" % (vcid, map_id))
 
     # -- sending end --------------------------------------------------------------------------
 
     def apply(self, scid, vcid, data, bypass=False, sa=None):
         """ApplySecurity: the frame data field ``data`` (segment header first, when the VC has
-        them) with the security header and trailer of the channel's SA; ``data`` unchanged
-        when the channel has no SA. The frame is then made with ``TcFrame(scid, vcid, result,
-        N(S), bypass)``, with FECF."""
+        them) with the security header and trailer of the channel's SA (or of ``sa``). The
+        frame is then made with ``TcFrame(scid, vcid, result, N(S), bypass)``, with FECF."""
         map_id = None
         if self.segment_header:
             if len(data) < 1:
@@ -268,18 +259,16 @@ class TcSecurity:
             map_id = data[0] & 0x3F
         if sa is None:
             sa = self.sa_for(vcid, map_id)
-            if sa is None:
-                return bytes(data)
         elif sa.state != SA_OPERATIONAL or not self._valid_for(sa, vcid, map_id):
             raise SdlsError("SA %d cannot secure VC %d MAP %s" % (sa.spi, vcid, map_id))
         if sa.sn_sent >= sa.sn_max:
             raise SdlsError("SA %d: sequence numbers exhausted, re-key it" % sa.spi)
-        sa.sn_sent += 1
         lead = 1 if self.segment_header else 0
-        sec_header = _be(sa.spi, 2) + _be(sa.sn_sent, sa.sn_length)
-        n = 5 + len(data) + len(sec_header) + sa.mac_length + 2
+        n = 5 + len(data) + sa.header_length + sa.mac_length + 2
         if n > 1024:
             raise SdlsError("secured TC frame of %d octets, above 1024" % n)
+        sa.sn_sent += 1
+        sec_header = _be(sa.spi, 2) + _be(sa.sn_sent, sa.sn_length)
         header = bytes(
             (
                 (0x20 if bypass else 0) | (scid >> 8),

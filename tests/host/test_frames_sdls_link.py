@@ -199,3 +199,11 @@ def test_station_signs_and_refuses_without_operational_sa(tmp_path):
     finally:
         mcs.close()
         station.close()
+
+
+def test_sample_database_names_the_core_event_ids():
+    db = sdb_module.load(SDB_PATH)
+    apid, ids = sdb_events(db)
+    assert ids == sdls.EVENT_IDS
+    assert apid == db.apid("frames")
+    assert {db.event(i).severity for i in ids[1:]} == {3}  # medium: TM[5,3]

@@ -442,6 +442,20 @@ class TestEssentialCommands(unittest.TestCase):
 
     def test_security_from_file(self):
         self.assertIsNone(self.E.security_from_file("/nonexistent/tc.keys"))
+        path = "/tmp/obsw_test_frames_sdls_bad.keys"
+        with open(path, "w") as f:
+            f.write("{not a key file")
+        try:
+            broken = self.E.security_from_file(path)
+        finally:
+            import os
+
+            os.remove(path)
+        self.assertEqual(broken.sas, {})  # fail secure, keep running
+        unit = self.E.Essential(SCID, security=broken)
+        unit.feed(self.hpc_frame(self.E.Hpc(self.E.HPC_REPORT, ())), 0.0)
+        self.assertEqual(unit.counters["hpcs"], 0)
+        self.assertEqual(broken.counters["bad_spi"], 1)
 
 
 class TestKeyFile(unittest.TestCase):

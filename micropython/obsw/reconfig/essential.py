@@ -161,15 +161,21 @@ class Report:
 
 
 def security_from_file(path):
-    """The TcSecurity of the SDLS key file at ``path``, or None when there is none."""
+    """The TcSecurity of the SDLS key file at ``path``, or None when there is none. A key file
+    that cannot be read as one gives a TcSecurity with no SA: every TC frame is then rejected,
+    but the module keeps running (a boot that raised would reset it forever)."""
     try:
         f = open(path)
     except OSError:
         return None
+    from obsw.frames.sdls import SdlsError, TcSecurity
     from obsw.frames.sdls_keys import load_security
 
-    with f:
-        return load_security(f.read())
+    try:
+        with f:
+            return load_security(f.read())
+    except (SdlsError, OSError, ValueError):
+        return TcSecurity(())
 
 
 class Essential:

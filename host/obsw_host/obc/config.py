@@ -20,6 +20,8 @@ key and what was expected.
 import json
 import os
 
+from obsw_host.net import DEFAULT_HOST
+
 KINDS = ("pus", "cfdp", "obcp", "spacecan", "frames", "solar_panel")
 WITH_PUS = ("cfdp", "obcp")
 SAMPLE = os.path.join(os.path.dirname(__file__), "data", "spacecraft.json")
@@ -60,7 +62,7 @@ class MissionConfig:
         self.path = os.path.abspath(path)
         self.dir = os.path.dirname(self.path)
         self.name = str(doc.get("name", os.path.splitext(os.path.basename(path))[0]))
-        self.host = str(doc.get("host", "127.0.0.1"))
+        self.host = str(doc.get("host", DEFAULT_HOST))
         self.sdb_path = self.resolve(self._str("sdb"))
         self.state = self.resolve(doc.get("state", "state"))
         il = doc.get("il_directory")

@@ -120,7 +120,12 @@ class Chain:
             retries=3,
         )
         doc["frames"].update(
-            uart_a=uart_a, uart_b=uart_b, scid=SCID, tm_port=self.tm_port, clcw_period=0.2
+            uart_a=uart_a,
+            uart_b=uart_b,
+            scid=SCID,
+            tm_port=self.tm_port,
+            clcw_period=0.2,
+            keys=self.sim.key_file,  # the mission's TC keys: the OBC's and the module's
         )
         doc["platform"].update(heartbeat=0.2, deadline=2.0, start_timeout=30.0, max_failures=20)
         with open(self.config_path, "w") as f:
@@ -134,6 +139,7 @@ class Chain:
     def start(self):
         from obsw.pus import sdb as sdb_module
 
+        from obsw_host.frames import keys
         from obsw_host.obc.config import load
         from obsw_host.pus.ground import Ground
         from obsw_host.pus.obcp_ground import ObcpGround
@@ -144,13 +150,15 @@ class Chain:
         ends = [self._pty(), self._pty()]
         self.uart_paths = [path for _, path in ends]
         self.links = [FdLink(ends[0][0], "A"), FdLink(ends[1][0], "B")]
-        self.station = _station_class()(self.links, SCID, tm_frame_length=256)
+        sim_dir = os.path.join(self.work, "reconfig")
+        os.makedirs(sim_dir, exist_ok=True)
+        self.sim = ReconfigSim(sim_dir, obc_command=self._obc_command, out=self.out)
+        security, state = keys.load(self.sim.key_file, os.path.join(self.work, "station.state"))
+        self.station = _station_class()(
+            self.links, SCID, tm_frame_length=256, security=security, state=state
+        )
         self._thread = threading.Thread(target=self.station.run, args=(self._stop,), daemon=True)
         self._thread.start()
-        self.sim = ReconfigSim(
-            os.path.join(self.work, "reconfig"), obc_command=self._obc_command, out=self.out
-        )
-        os.makedirs(self.sim.dir, exist_ok=True)
         self.sim.start()
         if not self.sim.wait_for(lambda: os.path.exists(self.config_path), 20.0):
             raise TimeoutError("the OBC was never powered")

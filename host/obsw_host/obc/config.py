@@ -3,9 +3,9 @@
 Every path in it is relative to the file. Top level:
 
 - ``name``: the spacecraft's name; ``sdb``: the spacecraft database; ``host``: the address
-  every UDP service binds (default 127.0.0.1); ``state``: the folder for the context store,
-  the onboard filestore and the packet stores; ``il_directory``: the interaction layer's
-  name directory (default: a folder under ``state``).
+  every UDP service binds (default loopback, ``obsw_host.net.DEFAULT_HOST``); ``state``: the
+  folder for the context store, the onboard filestore and the packet stores;
+  ``il_directory``: the interaction layer's name directory (default: a folder under ``state``).
 - ``processes``: process name -> list of component kinds it runs (``pus``, ``cfdp``,
   ``obcp``, ``spacecan``, ``frames``, ``solar_panel``); one process or several. ``cfdp`` and
   ``obcp`` run with ``pus`` (services 23 and 18 use them directly).

@@ -24,9 +24,7 @@ def equipment_interfaces(config):
     """The interfaces of the SpaceCAN equipment components the mission has."""
     from obsw.spacecan.equipment import equipment_interface
 
-    return [
-        equipment_interface(eq.name, eq.node_id, eq.nodedef) for eq in equipments(config)
-    ]
+    return [equipment_interface(eq.name, eq.node_id, eq.nodedef) for eq in equipments(config)]
 
 
 def equipments(config):
@@ -40,14 +38,12 @@ def equipments(config):
     listed = config.section("spacecan").get("nodes")
     if listed:
         nodes = [
-            NodeDef(n["name"], int(n["node_id"]), config.resolve(n["definition"]))
-            for n in listed
+            NodeDef(n["name"], int(n["node_id"]), config.resolve(n["definition"])) for n in listed
         ]
     else:
         nodes = list(load_sdb(config.sdb_path).nodes.values())
     return [
-        Equipment(n.name, n.node_id, NodeDefinition.load(n.definition, n.node_id))
-        for n in nodes
+        Equipment(n.name, n.node_id, NodeDefinition.load(n.definition, n.node_id)) for n in nodes
     ]
 
 
@@ -326,7 +322,8 @@ class SpaceCanUnit:
 
 class FramesUnit:
     """The frame processor on two UARTs (device paths, or ``pty``: a pseudo-terminal pair
-    whose other end's path is written to ``STATE/uart_a`` and ``STATE/uart_b``)."""
+    whose other end's path is written to ``STATE/uart_a`` and ``STATE/uart_b``); with
+    ``keys`` (a key file) TC frames are authenticated."""
 
     def __init__(self, config, sdb, out=print):
         from obsw_host.frames.links import FdLink
@@ -352,6 +349,12 @@ class FramesUnit:
         port = int(pus.get("port", 5000 + apid))
         tm_port = int(opts.get("tm_port", 4999))
         plan = sdb.tm_vcs
+        security = {}
+        if opts.get("keys"):  # TC frames authenticated (SDLS) with this key file
+            from obsw_host.frames.processor import security_options
+
+            state = os.path.join(config.state, "frames.keys.state")
+            security = security_options(config.resolve(opts["keys"]), sdb, state)
         self.fp = FrameProcessorHost(
             links[0],
             links[1],
@@ -363,6 +366,7 @@ class FramesUnit:
             tm_plan=plan,
             tm_frame_length=int(opts.get("tm_frame_length", 256)),
             clcw_period=float(opts.get("clcw_period", 0.5)),
+            **security,
         )
         self.last_step = time.monotonic()
         self._stop = threading.Event()

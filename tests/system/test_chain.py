@@ -136,6 +136,7 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
         assert led.lost() == []  # no TC that was accepted went without its completion
 
         # the OBC killed: only an essential TC to the reconfiguration module brings it back
+        chain.platform.update(max_failures=2, window=120.0)  # for the OBC's next boot
         boots = chain.sim.obc_boots
         chain.sim.kill_obc()
         assert not led.ping(timeout=1.0)
@@ -148,6 +149,20 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
         tx, end = chain.switch(0x005, name="after_power_cycle", timeout=20.0)
         assert (tx.ok, end) == (True, "obcp.finished")
         assert wait_for(lambda: chain.lines() == 0x005 | OBC_LINE)
+
+        # a process failing again and again: the platform manager asks the reconfiguration
+        # module, through the CPDU node, to power-cycle the whole OBC
+        boots = chain.sim.obc_boots
+        t = time.monotonic()
+        for _ in range(2):
+            pid = chain.pid_of("core")
+            os.kill(pid, signal.SIGKILL)
+            assert wait_for(lambda p=pid: chain.pid_of("core") not in (None, p))
+        assert chain.sim.wait_for(lambda: chain.sim.obc_boots == boots + 1, WAIT)
+        assert chain.sim.seen("asking CpduN to power-cycle the OBC")
+        tries = led.ping_until_ok()
+        figures.append(("2 failures: platform manager had the OBC power-cycled (%d pings)"
+                        % tries, time.monotonic() - t))  # fmt: skip
     with capsys.disabled():
         print("\n  12-step chain and faults, %.1f s in all:" % (time.monotonic() - t_start))
         for what, seconds in figures:

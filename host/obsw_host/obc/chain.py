@@ -77,6 +77,7 @@ class Chain:
         self.sdb = None
         self._uarts = []
         self._hk = set()  # structures defined on board
+        self.platform = {}  # platform manager settings for the OBC's next boot
         self._stop = threading.Event()
         self._thread = None
 
@@ -128,6 +129,7 @@ class Chain:
             keys=self.sim.key_file,  # the mission's TC keys: the OBC's and the module's
         )
         doc["platform"].update(heartbeat=0.2, deadline=2.0, start_timeout=30.0, max_failures=20)
+        doc["platform"].update(self.platform)
         with open(self.config_path, "w") as f:
             json.dump(doc, f, indent=2)
         return doc

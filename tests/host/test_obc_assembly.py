@@ -10,6 +10,7 @@ import time
 
 import pytest
 from obsw.pus import sdb as sdb_module
+from obsw.pus.services.s02_device_access import DeviceUser
 from obsw.pus.tm import PusTm
 from obsw_host.obc import config as obc_config
 from obsw_host.obc.platform import PlatformManager
@@ -131,6 +132,13 @@ def test_platform_manager_restarts_killed_and_hung_processes(tmp_path):
         ground = Ground(db, target=("127.0.0.1", pus_port), timeout=5.0)
         assert ground.ping().ok
         assert wait_for(lambda: sink.poll().count(ids["started"]) >= 2), sink.events
+        # service 2 reaches the CPDU node through the SpaceCAN process: a SpaceCAN
+        # connection test (17,1) answered by the node's (17,2) in TM[2,12]
+        dev = ground.proc.register(DeviceUser())
+        tx = ground.wait(dev.logical_acquire(db.apid("pus"), [(10, 17, 1, b"")]))
+        assert tx.ok, tx.verification()
+        items = tx.reply["items"]
+        assert [i[:3] for i in items] == [(10, 17, 2)]
 
         can = pm.child("can")
         old = can.pid

@@ -81,6 +81,22 @@ class _Waker:
                 pass
 
 
+class _MasterWithAccess:
+    """The bus node the adapter drives when device access runs too: every frame is shown to
+    the device access component (the reports of its requests), then handed to the master."""
+
+    def __init__(self, master, access):
+        self.master = master
+        self.access = access
+
+    def receive(self, bus, can_id, data, now):
+        self.access.observe(bus, can_id, data, now)
+        self.master.receive(bus, can_id, data, now)
+
+    def __getattr__(self, name):
+        return getattr(self.master, name)
+
+
 class ObcSpaceCan:
     """SpaceCanMaster and equipment components on IL ``node``, over two python-can buses.
 
@@ -118,9 +134,16 @@ class ObcSpaceCan:
             self.controller.add_node(eq.node_id, eq.nodedef)
         check_unique_ids([MASTER] + [eq.interface for eq in self.equipment])
         self.master = SpaceCanMaster(self.controller)
+        self.access = None
+        bus_node = self.master
+        if device_access:  # PUS service 2's way to the equipment (packet mode)
+            from obsw.spacecan.device_access import SpaceCanDeviceAccess
+
+            self.access = SpaceCanDeviceAccess(self.controller, timeout=timeout * (retries + 1))
+            bus_node = _MasterWithAccess(self.master, self.access)
         self._waker = _Waker()
         self.adapter = CanAdapter(
-            self.master,
+            bus_node,
             interface=interface,
             channels=channels,
             buses=buses,
@@ -136,11 +159,9 @@ class ObcSpaceCan:
             t._fds[self._waker.fileno()] = self._waker
             t._poll.register(self._waker.fileno(), select.POLLIN)
         self.node.provide(MASTER, self.master)
-        self.access = None
-        if device_access:  # PUS service 2's way to the equipment (packet mode)
-            from obsw.spacecan.device_access import DEVICE_ACCESS, SpaceCanDeviceAccess
+        if self.access is not None:
+            from obsw.spacecan.device_access import DEVICE_ACCESS
 
-            self.access = SpaceCanDeviceAccess(self.controller, timeout=timeout * (retries + 1))
             self.node.provide(DEVICE_ACCESS, self.access)
         for eq in self.equipment:
             eq.provide(self.node)

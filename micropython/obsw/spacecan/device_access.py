@@ -132,9 +132,15 @@ class SpaceCanDeviceAccess:
             self.raw_replies += 1
             w[0].succeed(bytes(data))
             return
-        if self._requests and can_id & FUNCTION_MASK == ID_REP:
-            self._collect(node, bus, can_id, data, now)
+        self.observe(bus, can_id, data, now)
         self.controller.receive(bus, can_id, data, now)
+
+    def observe(self, bus, can_id, data, now):
+        """See a frame on its way to the controller (when another bus node, e.g. the
+        SpaceCAN master, gets the frames): keep the reports of this component's requests."""
+        self.now = now
+        if self._requests and can_id & FUNCTION_MASK == ID_REP:
+            self._collect(can_id & NODE_MASK, bus, can_id, data, now)
 
     def _collect(self, node, bus, can_id, data, now):
         """Keep the report packets (not the verification ones) a node sends for a request."""

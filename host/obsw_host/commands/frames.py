@@ -57,7 +57,9 @@ def add_parser(sub):
 
 
 def _hex(text):
-    return binascii.unhexlify("".join(text.split()))
+    from obsw_host.errors import hex_bytes
+
+    return hex_bytes(text, "frame")
 
 
 def processor(args):

@@ -8,6 +8,8 @@ from obsw.pluto.lexer import PlutoError, line_col
 from obsw.pluto.system import SimulatedSystem, run_virtual
 from obsw.pluto.units import Quantity
 
+from obsw_host.errors import read_json
+
 _KEYWORDS = {
     "set": "assignment",
     "if": "if",
@@ -94,9 +96,9 @@ def _errors(e):
 def check_cmd(args):
     resolver = None
     if args.sdb:
-        resolver = SdbResolver(json.loads(_read(args.sdb)))
+        resolver = SdbResolver(read_json(args.sdb, "spacecraft database"))
     elif args.system:
-        resolver = SimulatedSystem(json.loads(_read(args.system)))
+        resolver = SimulatedSystem(read_json(args.system, "system file"))
     try:
         load(_read(args.file), resolver)
     except PlutoError as e:
@@ -182,7 +184,7 @@ def _arg(text):
 
 
 def run_cmd(args):
-    spec = json.loads(_read(args.system)) if args.system else {}
+    spec = read_json(args.system, "system file") if args.system else {}
     arguments = dict(_arg(a) for a in args.arg)
 
     def show(t, line, what):

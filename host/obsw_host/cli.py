@@ -10,6 +10,7 @@ import argparse
 import importlib
 import logging
 import sys
+import time
 
 from obsw_host.errors import user_message
 
@@ -39,6 +40,18 @@ class Parser(argparse.ArgumentParser):
     def error(self, message):
         self.exit(
             USAGE_ERROR, "%s: error: %s (see `%s --help`)\n" % (self.prog, message, self.prog)
+        )
+
+
+class UtcFormatter(logging.Formatter):
+    """Log times in UTC, ISO 8601 with milliseconds and a Z."""
+
+    converter = time.gmtime
+
+    def formatTime(self, record, datefmt=None):
+        return "%s.%03dZ" % (
+            time.strftime("%Y-%m-%dT%H:%M:%S", self.converter(record.created)),
+            record.msecs,
         )
 
 
@@ -95,11 +108,9 @@ def main(argv=None):
     args.json = getattr(args, "json", False) or "--json" in found
     debug = args.debug or "--debug" in found
     level = args.log_level or ("warning" if args.command == "demo" else "info")
-    logging.basicConfig(
-        level=getattr(logging, level.upper()),
-        stream=sys.stderr,
-        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
-    )
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(UtcFormatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    logging.basicConfig(level=getattr(logging, level.upper()), handlers=[handler])
     try:
         return args.func(args) or 0
     except KeyboardInterrupt:

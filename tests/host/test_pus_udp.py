@@ -144,7 +144,7 @@ def test_ground_commands(system, capsys):
     status, out = _cli(system, capsys, "params", "set", "SolarPanel.speed=6")
     assert status == 0
     status, out = _cli(system, capsys, "params", "get", "SolarPanel.speed")
-    assert "SolarPanel.speed = 6.0" in out
+    assert "SolarPanel.speed = 6 deg/s" in out
     status, out = _cli(system, capsys, "--json", "events", "disabled")
     assert json.loads(out)["replies"] == [{"ids": []}]
     status, out = _cli(system, capsys, "params", "set", "SolarPanel.angle=3")

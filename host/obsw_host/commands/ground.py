@@ -350,9 +350,10 @@ def _run(args, fn):
 
 def _no_answer(args, tx):
     if not tx.verification():
-        return (
-            "no report from %s:%s within %ss: is `obsw obc serve` running there?"
-            % (args.host, args.port if args.port is not None else 5000 + tx.tc.apid, args.timeout)
+        return "no report from %s:%s within %ss: is `obsw obc serve` running there?" % (
+            args.host,
+            args.port if args.port is not None else 5000 + tx.tc.apid,
+            args.timeout,
         )
     return "no completion report within %ss" % args.timeout
 

@@ -1,6 +1,9 @@
 """pytest configuration shared by every test directory."""
 
+import atexit
 import os
+import shutil
+import tempfile
 
 from hypothesis import HealthCheck, settings
 
@@ -16,3 +19,9 @@ settings.register_profile(
     suppress_health_check=[HealthCheck.too_slow],
 )
 settings.load_profile("obsw")
+
+# Per-user state (CFDP transaction sequence numbers) goes to a folder of this test run, removed
+# at the end, never to the user's own state folder; subprocesses inherit it.
+if "OBSW_STATE" not in os.environ:
+    os.environ["OBSW_STATE"] = tempfile.mkdtemp(prefix="obsw-test-state-")
+    atexit.register(shutil.rmtree, os.environ["OBSW_STATE"], True)

@@ -59,6 +59,14 @@ def _library_error(e):
     return None
 
 
+_LISTINGS = (
+    ("parameter", "parameters"),
+    ("function", "functions"),
+    ("event", "events"),
+    ("housekeeping", "hk"),
+)
+
+
 class NoAnswer(TimeoutError):
     """Nothing answered in time; the message says where and what to start (exit status 1)."""
 
@@ -83,7 +91,11 @@ def user_message(e):
     if text:
         return text
     if isinstance(e, KeyError):
-        return "unknown name: %s" % (e.args[0] if e.args else "")
+        text = str(e.args[0]) if e.args else "unknown name"
+        for kind, listing in _LISTINGS:
+            if text.startswith("no %s " % kind):
+                return "%s; expected one of `obsw ground list %s`" % (text, listing)
+        return text
     if isinstance(e, ValueError):
         return str(e)
     return None

@@ -42,6 +42,8 @@ import argparse
 import json
 import sys
 
+from obsw_host.errors import UserError
+
 
 def add_parser(sub):
     p = sub.add_parser(
@@ -410,8 +412,7 @@ def _params_set(args):
     for a in args.assignments:
         name, sep, value = a.partition("=")
         if not sep:
-            print("obsw ground params set: expected NAME=VALUE, got %r" % a, file=sys.stderr)
-            return 2
+            raise UserError("parameter assignment %r" % a, expected="NAME=VALUE")
         values[_key(name)] = _value(value)
     return _run(args, lambda g: g.set_parameters(values))
 
@@ -490,7 +491,7 @@ def _assignments(words):
     for w in words:
         name, sep, value = w.partition("=")
         if not sep:
-            raise KeyError("expected NAME=VALUE, got %r" % w)
+            raise UserError("assignment %r" % w, expected="NAME=VALUE")
         out[_key(name)] = _value(value)
     return out
 
@@ -505,8 +506,9 @@ def _request(g, words):
         return g.function_request(_key(words[1]), **args)
     if kind == "set" and len(words) >= 2:
         return g.parameter_request(_assignments(words[1:]))
-    raise KeyError(
-        "request: ping | function NAME [ARG=VALUE..] | set NAME=VALUE.., got %r" % words
+    raise UserError(
+        "request %r" % " ".join(words),
+        expected="ping | function NAME [ARG=VALUE..] | set NAME=VALUE..",
     )
 
 
@@ -514,7 +516,7 @@ def _rid(text):
     try:
         source, apid, seq = (int(x) for x in text.split(":"))
     except ValueError:
-        raise KeyError("activity SOURCE:APID:SEQ, got %r" % text) from None
+        raise UserError("activity %r" % text, expected="SOURCE:APID:SEQ") from None
     return (source, apid, seq)
 
 
@@ -635,7 +637,7 @@ def _sequence_load(args):
             try:
                 delay = float(words[0])
             except (ValueError, IndexError):
-                raise KeyError("sequence step 'DELAY REQUEST..', got %r" % step) from None
+                raise UserError("sequence step %r" % step, expected="'DELAY REQUEST..'") from None
             items.append((_request(g, words[1:]), delay))
         return g.load_sequence(args.name, items)
 

@@ -1,6 +1,7 @@
 """`obsw il`: serve, call, read, write and watch components over the interaction layer."""
 
 import json
+import sys
 
 SERVABLE = {"solar-panel": "obsw_host.solar_panel"}
 
@@ -70,9 +71,8 @@ def _run(args, action):
     except InteractionError as e:
         code = getattr(e, "code", None)
         kind = type(e).__name__ + ("" if code is None else " " + str(code))
-        print("error: %s: %s" % (kind, e))
-        if e.data is not None:
-            print("data: %r" % (e.data,))
+        data = "" if e.data is None else " (data %r)" % (e.data,)
+        print("obsw il: %s: %s%s" % (kind, e, data), file=sys.stderr)
         return 1
     finally:
         transport.close()

@@ -1,6 +1,7 @@
 """`obsw obc serve`: run the on-board PUS application process on UDP port 5000 + APID."""
 
 import sys
+import threading
 
 
 def add_parser(sub):
@@ -42,14 +43,17 @@ def serve(args):
         store=Store(args.store) if args.store else None,
         components=components,
     )
+    onboard.start()  # bound (or OSError) before "serving" is printed
     print(
         "PUS application process APID %d serving on udp %s:%d (Ctrl-C stops)"
-        % (onboard.apid, onboard.host, onboard.port),
+        % (onboard.apid, onboard.host, onboard.address[1]),
         file=sys.stderr,
         flush=True,
     )
     try:
-        onboard.serve()
+        threading.Event().wait()
     except KeyboardInterrupt:
         pass
+    finally:
+        onboard.stop()
     return 0

@@ -175,19 +175,12 @@ def _run(args, fn):
     from obsw_host.pus.ground import PusTimeout
     from obsw_host.pus.obcp_ground import explain
 
-    try:
-        ground, obcp = _client(args)
-    except (OSError, KeyError, ValueError) as e:
-        print("obsw obcp: %s" % e, file=sys.stderr)
-        return 2
+    ground, obcp = _client(args)  # bad input: typed errors, one line from obsw_host.cli
     with ground:
         try:
             tx = fn(obcp)
         except PusTimeout as e:
             tx = e.transaction
-        except (OSError, ValueError) as e:
-            print("obsw obcp: %s" % e, file=sys.stderr)
-            return 2
     if args.json:
         result = text.plain(text.transaction(tx))
         result["explained"] = explain(tx)

@@ -342,7 +342,9 @@ def _run(args, fn):
         print(json.dumps(result))
         return 0 if tx.ok else 1
     for line in tx.verification():
-        print("  " + line + ((" (%s)" % detail) if "failure" in line and detail else ""))
+        if "failure" in line and detail:  # the data decoded replaces its hex
+            line = "%s (%s)" % (line.split(" data ")[0], detail)
+        print("  " + line)
     for reply in tx.replies:
         print(text.readable(reply, sdb))
     if not tx.done:
@@ -444,6 +446,12 @@ def _listen(args):
     with _ground(args) as g:
         display = Display(g.sdb)
         g.subscribe()
+        print(
+            "listening for TM[%s,%s] from %s:%d for %gs"
+            % (service, subtype or "*", g.target[0], g.target[1], args.seconds),
+            file=sys.stderr,
+            flush=True,
+        )
         end = time.monotonic() + args.seconds
         seen = len(g.received)
         while time.monotonic() < end:

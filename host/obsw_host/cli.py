@@ -15,20 +15,21 @@ import time
 from obsw_host.errors import user_message
 
 # Each module has add_parser(subparsers); the chosen subcommand's function gets the parsed args
-# and returns the exit status. Modules are imported lazily so one area's extras stay optional.
-COMMANDS = (
-    "demo",
-    "packet",
-    "obc",
-    "ground",
-    "obcp",
-    "il",
-    "spacecan",
-    "frames",
-    "cfdp",
-    "pluto",
-    "board",
-)
+# and returns the exit status. Only the chosen command's module is imported (the others get a
+# placeholder with their help line), so one area's extras stay optional and startup is quick.
+COMMANDS = {
+    "demo": "run the all-on-one-machine demo",
+    "packet": "decode or encode space packets",
+    "obc": "on-board processes",
+    "ground": "send PUS requests to an on-board process, monitor its TM",
+    "obcp": "PLUTO OBCPs on board (PUS service 18)",
+    "il": "interaction layer: serve and use components",
+    "spacecan": "SpaceCAN bus tools",
+    "frames": "CCSDS TC/TM frames, CLTUs, frame processor",
+    "cfdp": "CFDP file transfer (put, get, status, serve)",
+    "pluto": "check or dry-run PLUTO procedures",
+    "board": "Pyboard firmware for the reconfiguration module",
+}
 ANYWHERE = ("--json", "--debug")  # flags accepted at any position before "--"
 USAGE_ERROR = 2
 NO_ANSWER = 1
@@ -64,7 +65,8 @@ def version():
         return "unknown"
 
 
-def build_parser():
+def build_parser(only=None):
+    """The parser; with ``only`` (a command name), only that command's module is imported."""
     parser = Parser(
         prog="obsw", description="Open onboard software for CubeSats: host tools, OBC and ground."
     )
@@ -82,9 +84,24 @@ def build_parser():
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for name in COMMANDS:
-        importlib.import_module("obsw_host.commands." + name).add_parser(sub)
+    for name, text in COMMANDS.items():
+        if only is None or only == name:
+            importlib.import_module("obsw_host.commands." + name).add_parser(sub)
+        else:
+            sub.add_parser(name, help=text)
     return parser
+
+
+def _command(argv):
+    """The command named on the line, or None (then every command's module is loaded)."""
+    for i, word in enumerate(argv):
+        if word == "--log-level":
+            continue
+        if i and argv[i - 1] == "--log-level":
+            continue
+        if not word.startswith("-"):
+            return word if word in COMMANDS else None
+    return None
 
 
 def _split_anywhere(argv):
@@ -104,7 +121,7 @@ def _split_anywhere(argv):
 def main(argv=None):
     argv = list(sys.argv[1:] if argv is None else argv)
     argv, found = _split_anywhere(argv)
-    args = build_parser().parse_args(argv)
+    args = build_parser(_command(argv)).parse_args(argv)
     args.json = getattr(args, "json", False) or "--json" in found
     debug = args.debug or "--debug" in found
     level = args.log_level or ("warning" if args.command == "demo" else "info")

@@ -48,7 +48,7 @@ from obsw_host.errors import UserError
 def add_parser(sub):
     p = sub.add_parser(
         "ground",
-        help="send PUS requests to an on-board process",
+        help="send PUS requests to an on-board process, monitor its TM",
         description=__doc__,
         formatter_class=_raw(),
     )

@@ -3,6 +3,7 @@
 import atexit
 import os
 import shutil
+import sys
 import tempfile
 
 from hypothesis import HealthCheck, settings
@@ -19,6 +20,10 @@ settings.register_profile(
     suppress_health_check=[HealthCheck.too_slow],
 )
 settings.load_profile("obsw")
+
+# The examples (demos and samples) are not part of the product; tests import them from there.
+EXAMPLES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "examples")
+sys.path.insert(0, EXAMPLES)
 
 # Per-user state (CFDP transaction sequence numbers) goes to a folder of this test run, removed
 # at the end, never to the user's own state folder; subprocesses inherit it.

@@ -18,7 +18,6 @@ from obsw_host.errors import user_message
 # and returns the exit status. Only the chosen command's module is imported (the others get a
 # placeholder with their help line), so one area's extras stay optional and startup is quick.
 COMMANDS = {
-    "demo": "run the all-on-one-machine demo",
     "packet": "decode or encode space packets",
     "obc": "on-board processes",
     "ground": "send PUS requests to an on-board process, monitor its TM",
@@ -80,7 +79,7 @@ def build_parser(only=None):
     parser.add_argument(
         "--log-level",
         choices=("debug", "info", "warning", "error"),
-        help="level of the on-board processes' logs on stderr (default info; demo: warning)",
+        help="level of the on-board processes' logs on stderr (default info)",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
@@ -124,7 +123,7 @@ def main(argv=None):
     args = build_parser(_command(argv)).parse_args(argv)
     args.json = getattr(args, "json", False) or "--json" in found
     debug = args.debug or "--debug" in found
-    level = args.log_level or ("warning" if args.command == "demo" else "info")
+    level = args.log_level or "info"
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(UtcFormatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
     logging.basicConfig(level=getattr(logging, level.upper()), handlers=[handler])

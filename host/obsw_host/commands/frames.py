@@ -1,4 +1,4 @@
-"""`obsw frames`: the frame processor on two UARTs, CLTU and TM frame tools, the link demo."""
+"""`obsw frames`: the frame processor on two UARTs, CLTU and TM frame tools."""
 
 import binascii
 import json
@@ -51,9 +51,6 @@ def add_parser(sub):
     tdec.add_argument("hex")
     tdec.add_argument("--randomized", action="store_true", help="frame is TM-randomized")
     tdec.set_defaults(func=tm_decode)
-
-    demo = s.add_parser("demo", help="ground and frame processor over two pseudo-UARTs")
-    demo.set_defaults(func=run_demo)
 
 
 def _hex(text):
@@ -159,9 +156,3 @@ def tm_decode(args):
     }
     print(json.dumps(out))
     return 0
-
-
-def run_demo(args):
-    from obsw_host.frames import demo
-
-    return demo.run()

@@ -42,9 +42,6 @@ def add_parser(sub):
     ls = isub.add_parser("list", help="components that are provided right now")
     ls.set_defaults(func=_list)
 
-    d = isub.add_parser("demo", help="the solar panel in its own process, used through a proxy")
-    d.set_defaults(func=_demo)
-
 
 def _value(text):
     try:
@@ -138,9 +135,3 @@ def _list(args):
     for name in Directory(args.dir).names():
         print(name)
     return 0
-
-
-def _demo(args):
-    from obsw_host import il_demo
-
-    return il_demo.run(directory=args.dir)

@@ -25,8 +25,8 @@ def serve(args):
     from obsw import sdb as sdb_module
     from obsw.store import Store
 
-    from obsw_host.pus.demo import SDB_PATH
     from obsw_host.pus.onboard import Onboard
+    from obsw_host.sample import SDB_PATH
 
     sdb = sdb_module.load(args.sdb or SDB_PATH)
     components = []

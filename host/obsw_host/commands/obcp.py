@@ -17,7 +17,6 @@
     obsw obcp abort-all                     (TC[18,17] -> TM[18,18])
     obsw obcp engine start|stop             (TC[18,21] / TC[18,22])
     obsw obcp listen [--seconds S]          OBCP events (service 5) as they come
-    obsw obcp demo                          upload and run a procedure end to end
 
 ``--json`` prints one JSON object per command instead of text; ``-v`` shows every packet.
 """
@@ -36,7 +35,7 @@ _SIMPLE = {
 
 
 def add_parser(sub):
-    """``obsw obcp ...``: the client actions, plus ``serve`` and ``demo``."""
+    """``obsw obcp ...``: the client actions, plus ``serve``."""
     p = sub.add_parser(
         "obcp", help="PLUTO OBCPs on board (PUS service 18)", description=__doc__,
         formatter_class=_raw(),
@@ -49,7 +48,6 @@ def add_parser(sub):
     x.add_argument("--files", help="filestore folder for loads by reference")
     x.add_argument("--period", type=float, default=0.1, help="activity loop cycle, seconds")
     x.set_defaults(func=_serve)
-    s.add_parser("demo", help="upload and run a procedure end to end").set_defaults(func=_demo)
 
 
 def add_to_ground(ground_actions):
@@ -129,7 +127,7 @@ def _raw():
 def _sdb(args):
     from obsw import sdb as sdb_module
 
-    from obsw_host.pus.demo import SDB_PATH
+    from obsw_host.sample import SDB_PATH
 
     return sdb_module.load(args.sdb or SDB_PATH)
 
@@ -291,7 +289,7 @@ def _listen(args):
 
 
 def _serve(args):
-    from obsw_host.pus.obcp_demo import onboard_with_obcp
+    from obsw_host.pus.obcp_onboard import onboard_with_obcp
 
     sdb = _sdb(args)
     onboard, engine = onboard_with_obcp(
@@ -311,9 +309,3 @@ def _serve(args):
         engine.abort_all("on-board process stopped")
         engine.system.close()
     return 0
-
-
-def _demo(args):
-    from obsw_host.pus.obcp_demo import run
-
-    return run()

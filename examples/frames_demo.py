@@ -2,12 +2,12 @@
 
 import select
 import socket
+import sys
 import threading
 import time
 
 from obsw.frames import fop as F
 from obsw.frames.farm import STATE_NAMES
-
 from obsw_host.frames.ground import Ground
 from obsw_host.frames.links import FdLink, SerialLink, open_pty_pair
 from obsw_host.frames.processor import FrameProcessorHost
@@ -134,3 +134,7 @@ def run(out=print, timeout=5.0):
             link.close()
         app.close()
     return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(run())

@@ -242,11 +242,12 @@ def _raw():
 def _ground(args):
     from obsw_host.pus.ground import Ground
     from obsw_host.pus.monitor import SessionLog
+    from obsw_host.pus.onboard import port_for
     from obsw_host.sample import load_sdb
 
     sdb = load_sdb(args.sdb)
     apid = args.apid if args.apid is not None else sdb.apid("pus")
-    target = (args.host, args.port if args.port is not None else 5000 + apid)
+    target = (args.host, args.port if args.port is not None else port_for(apid))
     log = (lambda s: print(s, file=sys.stderr)) if args.verbose else None
     session = SessionLog(args.log) if getattr(args, "log", None) else None
     g = Ground(sdb, apid=apid, target=target, timeout=args.timeout, log=log, session=session)
@@ -350,6 +351,12 @@ def _run(args, fn):
     if not tx.done:
         print(_no_answer(args, tx))
     return 0 if tx.ok else 1
+
+
+def _port(apid):
+    from obsw_host.pus.onboard import port_for
+
+    return port_for(apid)
 
 
 def _no_answer(args, tx):

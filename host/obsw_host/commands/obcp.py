@@ -135,10 +135,11 @@ def _sdb(args):
 def _client(args):
     from obsw_host.pus.ground import Ground
     from obsw_host.pus.obcp_ground import ObcpGround
+    from obsw_host.pus.onboard import port_for
 
     sdb = _sdb(args)
     apid = args.apid if args.apid is not None else sdb.apid("pus")
-    target = (args.host, args.port if args.port is not None else 5000 + apid)
+    target = (args.host, args.port if args.port is not None else port_for(apid))
     log = (lambda s: print(s, file=sys.stderr)) if args.verbose else None
     ground = Ground(sdb, apid=apid, target=target, timeout=args.timeout, log=log)
     return ground, ObcpGround(ground)

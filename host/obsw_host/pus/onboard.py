@@ -13,6 +13,7 @@ calling thread until stopped (``obsw obc serve``).
 """
 
 import asyncio
+import os
 import threading
 import time
 
@@ -37,7 +38,7 @@ from obsw.pus.services.s22_position_scheduling import PositionScheduling
 from obsw_host.pus.tm_fanout import TmFanout
 from obsw_host.pus.tm_log import TmLog
 
-PORT_BASE = 5000
+PORT_BASE = int(os.environ.get("OBSW_PORT_BASE", "5000"))  # another base for a second system
 TAI_MINUS_UNIX = 378691200 + 37  # seconds from 1958-01-01 TAI to 1970-01-01 UTC, now
 
 

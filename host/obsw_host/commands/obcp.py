@@ -23,6 +23,7 @@
 
 import json
 import sys
+import threading
 
 _SIMPLE = {
     "stop": "stop",
@@ -286,7 +287,9 @@ def _listen(args):
                     print(json.dumps({"event": name, "data": text.plain(data)}), flush=True)
                 else:
                     print("%-13s %s" % (name, json.dumps(text.plain(data))), flush=True)
-    return 0 if n else 1
+    if not n:
+        print("no OBCP events within %gs" % args.seconds, file=sys.stderr)
+    return 0
 
 
 def _serve(args):
@@ -296,17 +299,19 @@ def _serve(args):
     onboard, engine = onboard_with_obcp(
         sdb, files=args.files, apid=args.apid, host=args.host, port=args.port, period=args.period
     )
+    onboard.start()  # bound (or OSError) before "serving" is printed
     print(
         "PUS application process APID %d with service 18 serving on udp %s:%d (Ctrl-C stops)"
-        % (onboard.apid, onboard.host, onboard.port),
+        % (onboard.apid, onboard.host, onboard.address[1]),
         file=sys.stderr,
         flush=True,
     )
     try:
-        onboard.serve()
+        threading.Event().wait()
     except KeyboardInterrupt:
         pass
     finally:
+        onboard.stop()
         engine.abort_all("on-board process stopped")
         engine.system.close()
     return 0

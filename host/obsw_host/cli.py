@@ -8,10 +8,9 @@ accepted anywhere on the line. ``--log-level`` sets the level of the processes' 
 
 import argparse
 import importlib
-import logging
 import sys
-import time
 
+from obsw_host import logs
 from obsw_host.errors import user_message
 
 # Each module has add_parser(subparsers); the chosen subcommand's function gets the parsed args
@@ -40,18 +39,6 @@ class Parser(argparse.ArgumentParser):
     def error(self, message):
         self.exit(
             USAGE_ERROR, "%s: error: %s (see `%s --help`)\n" % (self.prog, message, self.prog)
-        )
-
-
-class UtcFormatter(logging.Formatter):
-    """Log times in UTC, ISO 8601 with milliseconds and a Z."""
-
-    converter = time.gmtime
-
-    def formatTime(self, record, datefmt=None):
-        return "%s.%03dZ" % (
-            time.strftime("%Y-%m-%dT%H:%M:%S", self.converter(record.created)),
-            record.msecs,
         )
 
 
@@ -123,14 +110,16 @@ def main(argv=None):
     args = build_parser(_command(argv)).parse_args(argv)
     args.json = getattr(args, "json", False) or "--json" in found
     debug = args.debug or "--debug" in found
-    level = args.log_level or "info"
-    handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(UtcFormatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
-    logging.basicConfig(level=getattr(logging, level.upper()), handlers=[handler])
+    logs.setup(args.log_level)
     try:
         return args.func(args) or 0
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:  # the reader went away (`obsw ... | head`): nothing more to say
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except Exception as e:
         text = user_message(e)
         if text is None or debug:

@@ -30,7 +30,7 @@ MISTAKES = [
     ("bad request", "ground action add monitoring.speed_high jump", "expected ping | function"),
     ("missing session log", "ground replay {d}/none.log", "none.log: no such file"),
     ("bad session log", "ground replay {d}/bad.json", "expected a session log record"),
-    ("port in use, obc", "obc serve --port {port}", "address already in use"),
+    ("missing mission", "obc serve {d}/none.json", "none.json"),
     ("port in use, cfdp", "cfdp serve --port {port} --root {d}/fs", "address already in use"),
     ("bad --peer", "cfdp put a.bin --peer 2=localhost --root {d}/fs", "expected ID=HOST:PORT"),
     ("bad peer id", "cfdp put a.bin --peer x=1.2.3.4:5 --root {d}/fs", "expected ID=HOST:PORT"),

@@ -12,6 +12,7 @@ import os
 import pathlib
 import re
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -53,9 +54,13 @@ def free_base():
     raise RuntimeError("no free port base")
 
 
+READY = {"obsw obc serve": " up: "}  # a server's ready line (else: its first line)
+
+
 class Server:
     def __init__(self, line, env, cwd):
         self.line = line
+        self.ready_text = next((t for k, t in READY.items() if line.startswith(k)), "")
         self.proc = subprocess.Popen(
             ["bash", "-c", "exec " + line],
             env=env,
@@ -63,6 +68,7 @@ class Server:
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,
+            start_new_session=True,  # its children (the OBC's processes) stop with it
         )
         self.ready = threading.Event()
         self.output = []
@@ -71,15 +77,16 @@ class Server:
     def _read(self):
         for text in self.proc.stdout:
             self.output.append(text)
-            self.ready.set()
+            if self.ready_text in text:
+                self.ready.set()
         self.ready.set()
 
     def stop(self):
-        self.proc.terminate()
+        os.killpg(self.proc.pid, signal.SIGTERM)
         try:
-            self.proc.wait(10)
+            self.proc.wait(15)
         except subprocess.TimeoutExpired:
-            self.proc.kill()
+            os.killpg(self.proc.pid, signal.SIGKILL)
             self.proc.wait()
 
 
@@ -104,9 +111,11 @@ def test_every_readme_example_runs(tmp_path):
         OBSW_PORT_BASE=str(base),
         OBSW_IL_DIR=str(tmp_path / "il"),
         TMPDIR=str(tmp_path),
+        HOME=str(tmp_path / "home"),  # what the examples write under ~ stays here
         PYTHONPATH=os.pathsep.join([str(work), str(ROOT / "micropython"), str(ROOT / "host")]),
     )
     os.makedirs(env["OBSW_IL_DIR"])
+    os.makedirs(env["HOME"])
     ports = {"5100": str(base + 100), "5101": str(base + 101)}
     servers, ran, skipped = [], 0, []
     try:

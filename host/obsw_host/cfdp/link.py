@@ -14,6 +14,8 @@ from obsw.cfdp.entity import CfdpEntity
 from obsw.cfdp.mib import Mib, RemoteEntity
 from obsw.spp import TYPE_TC, TYPE_TM, SpacePacket, SppError
 
+from obsw_host.net import DEFAULT_HOST
+
 CFDP_APID = int(os.environ.get("OBSW_CFDP_APID", "100"))
 BASE_PORT = 5000  # the project's convention: UDP port 5000 + APID
 
@@ -32,7 +34,7 @@ def parse_peer(text):
         raise PeerError(
             "--peer %r: expected ID=HOST:PORT, such as 2=127.0.0.1:5100" % text
         ) from None
-    return eid, (host or "127.0.0.1", port)
+    return eid, (host or DEFAULT_HOST, port)
 
 
 class PeerError(ValueError):

@@ -4,6 +4,8 @@ import os
 import sys
 import time
 
+from obsw_host.net import DEFAULT_HOST
+
 DEFAULT_PEER = "2=127.0.0.1:5100"
 
 
@@ -73,6 +75,9 @@ def add_parser(sub):
 
 def _serve_args(p):
     _common(p, 2, 5000 + 100)
+    p.add_argument(
+        "--host", default=DEFAULT_HOST, help="address to listen on (default %(default)s)"
+    )
     p.add_argument("--ground", action="store_true", help="send TC packets (default TM)")
 
 
@@ -85,7 +90,7 @@ def _setup(args, onboard=False):
     ent = make_entity(args.id, peers, fs, mode=2 - args.cls, segment=args.segment, persist=onboard)
     udp = UdpEntity(
         ent,
-        ("0.0.0.0" if onboard else "127.0.0.1", args.port),
+        (getattr(args, "host", DEFAULT_HOST), args.port),
         peers,
         packet_type=packet_type_for(onboard),
         loss=args.loss,

@@ -1,6 +1,10 @@
 """pytest configuration shared by every test directory."""
 
+import atexit
 import os
+import shutil
+import sys
+import tempfile
 
 from hypothesis import HealthCheck, settings
 
@@ -16,3 +20,13 @@ settings.register_profile(
     suppress_health_check=[HealthCheck.too_slow],
 )
 settings.load_profile("obsw")
+
+# The examples (demos and samples) are not part of the product; tests import them from there.
+EXAMPLES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "examples")
+sys.path.insert(0, EXAMPLES)
+
+# Per-user state (CFDP transaction sequence numbers) goes to a folder of this test run, removed
+# at the end, never to the user's own state folder; subprocesses inherit it.
+if "OBSW_STATE" not in os.environ:
+    os.environ["OBSW_STATE"] = tempfile.mkdtemp(prefix="obsw-test-state-")
+    atexit.register(shutil.rmtree, os.environ["OBSW_STATE"], True)

@@ -1,43 +1,131 @@
-"""The `obsw` command line: one subcommand per area, each in obsw_host.commands."""
+"""The `obsw` command line: one subcommand per area, each in obsw_host.commands.
+
+Errors have one style everywhere: a user mistake (``obsw_host.errors.user_message``) prints one
+line, ``obsw COMMAND: what was wrong; expected ...``, and exits with status 2 (1 when nothing
+answered in time); ``--debug`` shows the traceback instead. ``--json`` and ``--debug`` are
+accepted anywhere on the line. ``--log-level`` sets the level of the processes' logs.
+"""
 
 import argparse
 import importlib
 import sys
 
+from obsw_host import logs
+from obsw_host.errors import user_message
+
 # Each module has add_parser(subparsers); the chosen subcommand's function gets the parsed args
-# and returns the exit status. Modules are imported lazily so one area's extras stay optional.
-COMMANDS = (
-    "demo",
-    "packet",
-    "obc",
-    "ground",
-    "obcp",
-    "il",
-    "spacecan",
-    "frames",
-    "cfdp",
-    "pluto",
-    "board",
-)
+# and returns the exit status. Only the chosen command's module is imported (the others get a
+# placeholder with their help line), so one area's extras stay optional and startup is quick.
+COMMANDS = {
+    "packet": "decode or encode space packets",
+    "obc": "on-board processes",
+    "ground": "send PUS requests to an on-board process, monitor its TM",
+    "obcp": "PLUTO OBCPs on board (PUS service 18)",
+    "il": "interaction layer: serve and use components",
+    "spacecan": "SpaceCAN bus tools",
+    "frames": "CCSDS TC/TM frames, CLTUs, frame processor",
+    "cfdp": "CFDP file transfer (put, get, status, serve)",
+    "pluto": "check or dry-run PLUTO procedures",
+    "board": "Pyboard firmware for the reconfiguration module",
+}
+ANYWHERE = ("--json", "--debug")  # flags accepted at any position before "--"
+USAGE_ERROR = 2
+NO_ANSWER = 1
 
 
-def build_parser():
-    parser = argparse.ArgumentParser(
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``obsw ground ping: error: ... (see --help)``."""
+
+    def error(self, message):
+        self.exit(
+            USAGE_ERROR, "%s: error: %s (see `%s --help`)\n" % (self.prog, message, self.prog)
+        )
+
+
+def version():
+    try:
+        from importlib.metadata import version as dist_version
+
+        return dist_version("obsw")
+    except Exception:  # not installed as a distribution: running from the source tree
+        return "unknown"
+
+
+def build_parser(only=None):
+    """The parser; with ``only`` (a command name), only that command's module is imported."""
+    parser = Parser(
         prog="obsw", description="Open onboard software for CubeSats: host tools, OBC and ground."
+    )
+    parser.add_argument("--version", action="version", version="obsw " + version())
+    parser.add_argument(
+        "--debug", action="store_true", help="show the traceback of an error (also anywhere)"
+    )
+    parser.add_argument(
+        "--json", action="store_true", help="print JSON for scripts (also anywhere on the line)"
+    )
+    parser.add_argument(
+        "--log-level",
+        choices=("debug", "info", "warning", "error"),
+        help="level of the on-board processes' logs on stderr (default info)",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for name in COMMANDS:
-        importlib.import_module("obsw_host.commands." + name).add_parser(sub)
+    for name, text in COMMANDS.items():
+        if only is None or only == name:
+            importlib.import_module("obsw_host.commands." + name).add_parser(sub)
+        else:
+            sub.add_parser(name, help=text)
     return parser
 
 
+def _command(argv):
+    """The command named on the line, or None (then every command's module is loaded)."""
+    for i, word in enumerate(argv):
+        if word == "--log-level":
+            continue
+        if i and argv[i - 1] == "--log-level":
+            continue
+        if not word.startswith("-"):
+            return word if word in COMMANDS else None
+    return None
+
+
+def _split_anywhere(argv):
+    """``argv`` without the flags of ANYWHERE, and the set of those present."""
+    rest, found = [], set()
+    for i, word in enumerate(argv):
+        if word == "--":
+            rest.extend(argv[i:])
+            break
+        if word in ANYWHERE:
+            found.add(word)
+        else:
+            rest.append(word)
+    return rest, found
+
+
 def main(argv=None):
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    argv, found = _split_anywhere(argv)
+    args = build_parser(_command(argv)).parse_args(argv)
+    args.json = getattr(args, "json", False) or "--json" in found
+    debug = args.debug or "--debug" in found
+    logs.setup(args.log_level)
     try:
         return args.func(args) or 0
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:  # the reader went away (`obsw ... | head`): nothing more to say
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
+    except Exception as e:
+        text = user_message(e)
+        if text is None or debug:
+            raise
+        print("obsw %s: %s" % (args.command, text), file=sys.stderr)
+        return NO_ANSWER if isinstance(e, TimeoutError) else USAGE_ERROR
 
 
 if __name__ == "__main__":

@@ -85,7 +85,7 @@ def test_decode_plain_space_packet(capsys):
 )
 def test_decode_malformed(capsys, hexstr, words):
     code, out, err = run(capsys, "decode", hexstr)
-    assert code == 1 and out == ""
+    assert code == (2 if "hex" in words else 1) and out == ""  # 2: the hex itself is wrong
     assert err.startswith("obsw packet decode: ") and err.count("\n") == 1
     assert words in err
 
@@ -141,7 +141,7 @@ def test_encode_without_pec(capsys):
 )
 def test_encode_errors(capsys, argv, words):
     code, out, err = run(capsys, "encode", *argv)
-    assert code == 1 and out == ""
+    assert code == 2 and out == ""  # a user mistake
     assert err.startswith("obsw packet encode: ") and words in err
 
 

@@ -158,7 +158,7 @@ def test_high_priority_command_goes_to_essential_sink(rig):
 
 
 def test_demo_runs():
-    from obsw_host.frames import demo
+    import frames_demo as demo
 
     lines = []
     assert demo.run(lines.append) == 0

@@ -7,7 +7,7 @@ import threading
 import time
 
 import pytest
-from obsw import sdb as sdb_module
+from obsw.pus import sdb as sdb_module
 from obsw.frames import fop as F
 from obsw.frames import sdls
 from obsw.frames.cltu import encode
@@ -17,7 +17,7 @@ from obsw_host.frames import keys
 from obsw_host.frames.ground import Ground
 from obsw_host.frames.links import FdLink, SerialLink, open_pty_pair
 from obsw_host.frames.processor import FrameProcessorHost, sdb_events, security_options
-from obsw_host.pus.demo import SDB_PATH
+from obsw_host.sample import SDB_PATH
 
 SCID = 0x33
 APID = 0x40

@@ -16,8 +16,8 @@ from obsw.il.errors import (
 )
 from obsw.il.node import Node
 from obsw_host.il.directory import Directory
+from obsw_host.il.processes import python_path, spawn, stop
 from obsw_host.il.transport import SocketTransport
-from obsw_host.il_demo import python_path, spawn, stop
 from obsw_host.solar_panel import SOLAR_PANEL
 
 HERE = os.path.dirname(os.path.abspath(__file__))

@@ -9,9 +9,9 @@ from obsw_host.frames.links import SerialLink, open_pty_pair
 from obsw_host.frames.processor import FrameProcessorHost
 from obsw_host.frames.station import GroundStation
 from obsw_host.net import DEFAULT_HOST
-from obsw_host.pus.demo import load_sdb
 from obsw_host.pus.onboard import Onboard
 from obsw_host.reconfig.canhub import CanHub
+from obsw_host.sample import load_sdb
 from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 
 HOST_TREE = os.path.join(os.path.dirname(__file__), "..", "..", "host", "obsw_host")

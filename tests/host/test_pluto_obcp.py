@@ -7,13 +7,13 @@ import sys
 import time
 
 import pytest
+from obcp_engine_demo import DEMO_PROCEDURE, demo
 from obsw.il.errors import ComponentError
 from obsw.il.node import Node
 from obsw.pluto.obcp import ENGINE
 from obsw_host.il.directory import Directory
+from obsw_host.il.processes import python_path, spawn, stop
 from obsw_host.il.transport import SocketTransport
-from obsw_host.il_demo import python_path, spawn, stop
-from obsw_host.obcp import DEMO_PROCEDURE, demo
 from obsw_host.solar_panel import SOLAR_PANEL
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="needs Unix processes")

@@ -4,11 +4,12 @@ database's OBCP events, and the `obsw obcp` command's value parsing."""
 import argparse
 import json
 
+import obcp_demo
 from obsw.pluto.obcp import ENGINE
 from obsw.pus.services.s18_layouts import sdb_events
 from obsw_host.commands import obcp as obcp_command
-from obsw_host.pus import obcp_demo
-from obsw_host.pus.demo import SDB_PATH
+from obsw_host.pus.obcp_onboard import onboard_with_obcp
+from obsw_host.sample import SDB_PATH
 
 
 def test_demo_uploads_runs_and_reports():
@@ -63,7 +64,7 @@ def test_step_commands_run_a_procedure_one_step_at_a_time(tmp_path, capsys):
     from obsw.pus import sdb as sdb_module
 
     sdb = sdb_module.load(SDB_PATH)
-    onboard, engine = obcp_demo.onboard_with_obcp(sdb, port=0, period=0.05)
+    onboard, engine = onboard_with_obcp(sdb, port=0, period=0.05)
     path = tmp_path / "two.plt"
     path.write_text(TWO_STEPS)
     p = argparse.ArgumentParser()

@@ -4,7 +4,7 @@ service 15 comes down unchanged on the playback VC, live telemetry on the real-t
 
 from obsw.frames.tm_plan import PLAYBACK_VCID, REALTIME_VCID
 from obsw_host.pus.onboard import tai_now
-from obsw_host.pus.storage_demo import Segment
+from storage_demo import Segment
 
 STORE = 3
 

@@ -4,7 +4,7 @@ byte-identical; paths outside the filestore root refused with a failure report."
 import pytest
 from obsw.pus.messages import FAILURE_PATH
 from obsw.pus.services.s23_layouts import COPY_COMPLETED
-from obsw_host.pus.storage_demo import Segment
+from storage_demo import Segment
 
 
 @pytest.fixture
@@ -61,7 +61,7 @@ def test_file_management_stays_inside_the_root(segment, tmp_path):
 
 
 def test_storage_demo_section():
-    from obsw_host.pus.storage_demo import run
+    from storage_demo import run
 
     lines = []
     assert run(lines.append)

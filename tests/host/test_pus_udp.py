@@ -6,9 +6,9 @@ import json
 import pytest
 from obsw.store import Store
 from obsw_host.commands import ground as ground_command
-from obsw_host.pus.demo import load_sdb
 from obsw_host.pus.ground import Ground, PusTimeout
 from obsw_host.pus.onboard import Onboard, port_for
+from obsw_host.sample import load_sdb
 from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 
 
@@ -144,7 +144,7 @@ def test_ground_commands(system, capsys):
     status, out = _cli(system, capsys, "params", "set", "SolarPanel.speed=6")
     assert status == 0
     status, out = _cli(system, capsys, "params", "get", "SolarPanel.speed")
-    assert "SolarPanel.speed = 6.0" in out
+    assert "SolarPanel.speed = 6 deg/s" in out
     status, out = _cli(system, capsys, "--json", "events", "disabled")
     assert json.loads(out)["replies"] == [{"ids": []}]
     status, out = _cli(system, capsys, "params", "set", "SolarPanel.angle=3")
@@ -154,7 +154,7 @@ def test_ground_commands(system, capsys):
 
 
 def test_demo():
-    from obsw_host.pus import demo
+    import pus_demo as demo
 
     lines = []
     assert demo.run(out=lines.append) == 0

@@ -96,7 +96,7 @@ def test_every_obc_example_of_the_readme(tmp_path, capsys):
     assert any(c.startswith(SERVER) for c, _ in cases), "no `obsw obc serve` example"
     commands = [(c, e) for c, e in cases if " serve" not in c]
     assert len(commands) >= 20
-    from obsw_host.obcp import DEMO_PROCEDURE
+    from obcp_engine_demo import DEMO_PROCEDURE
 
     for name in ("turn.plt",):
         (tmp_path / name).write_text(DEMO_PROCEDURE)

@@ -15,8 +15,8 @@ from obsw.il.node import Node  # noqa: E402
 from obsw.spacecan.equipment import Equipment, equipment_interface  # noqa: E402
 from obsw.spacecan.master import MASTER  # noqa: E402
 from obsw.spacecan.nodedef import NodeDefinition  # noqa: E402
+from obsw_host.il.processes import spawn, stop  # noqa: E402
 from obsw_host.il.transport import SocketTransport  # noqa: E402
-from obsw_host.il_demo import spawn, stop  # noqa: E402
 from obsw_host.spacecan.adapter import BusFaults  # noqa: E402
 from obsw_host.spacecan.obc import (  # noqa: E402
     ObcSpaceCan,
@@ -166,7 +166,7 @@ def test_cli_has_master_subcommand():
 
 
 def test_demo_shows_the_equipment_component():
-    from obsw_host.spacecan import demo
+    import spacecan_demo as demo
 
     lines = []
     assert demo.run(out=lines.append) == 0

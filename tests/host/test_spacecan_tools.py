@@ -2,9 +2,9 @@
 
 import argparse
 
+import spacecan_demo as demo
 from obsw.spacecan.nodedef import NodeDefinition
 from obsw_host.commands import spacecan as command
-from obsw_host.spacecan import demo
 from obsw_host.spacecan.monitor import Monitor
 
 NODE = {

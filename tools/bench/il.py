@@ -56,7 +56,7 @@ class Panel:
 
 
 def _env():
-    from obsw_host.il_demo import python_path
+    from obsw_host.il.processes import python_path
 
     return dict(os.environ, PYTHONPATH=python_path())
 

@@ -21,10 +21,24 @@ BASE_PORT = 5000  # the project's convention: UDP port 5000 + APID
 
 
 def parse_peer(text):
-    """'2=127.0.0.1:5101' -> (2, ('127.0.0.1', 5101))."""
-    eid, _, addr = text.partition("=")
+    """'2=127.0.0.1:5101' -> (2, ('127.0.0.1', 5101)); PeerError if it is not that form."""
+    eid, sep, addr = text.partition("=")
     host, _, port = addr.rpartition(":")
-    return int(eid, 0), (host or DEFAULT_HOST, int(port))
+    try:
+        if not sep:
+            raise ValueError
+        eid, port = int(eid, 0), int(port)
+        if not (0 <= eid and 0 < port < 65536):
+            raise ValueError
+    except ValueError:
+        raise PeerError(
+            "--peer %r: expected ID=HOST:PORT, such as 2=127.0.0.1:5100" % text
+        ) from None
+    return eid, (host or DEFAULT_HOST, port)
+
+
+class PeerError(ValueError):
+    """A peer given in a form other than ID=HOST:PORT."""
 
 
 class UdpEntity:
@@ -166,8 +180,10 @@ def make_entity(
     nak_interval=1.0,
     limit=10,
     inactivity=60.0,
+    keep_alive=0.5,
 ):
-    """A CfdpEntity with one MIB entry per peer and timer values suited to a UDP link."""
+    """A CfdpEntity with one MIB entry per peer and timer values suited to a UDP link (a
+    receiver reports its progress in a keep-alive PDU every ``keep_alive`` seconds)."""
     remotes = [
         RemoteEntity(
             eid,
@@ -179,6 +195,7 @@ def make_entity(
             nak_limit=limit,
             inactivity=inactivity,
             check_interval=ack_interval,
+            keep_alive_interval=keep_alive,
         )
         for eid in peers
     ]

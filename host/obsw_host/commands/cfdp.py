@@ -4,14 +4,9 @@ import os
 import sys
 import time
 
-from obsw.cfdp import msgs
-from obsw.cfdp.defs import CONDITION_NAMES, NO_ERROR
-
 from obsw_host.net import DEFAULT_HOST
 
 DEFAULT_PEER = "2=127.0.0.1:5100"
-STATUS_NAMES = {0: "undefined", 1: "active", 2: "terminated", 3: "unrecognized"}
-FILE_STATUS = {0: "discarded", 1: "discarded by filestore", 2: "retained", 3: "unreported"}
 
 
 def _common(p, local_id, port):
@@ -40,7 +35,16 @@ def _common(p, local_id, port):
         help="CFDP class: 1 unacknowledged, 2 acknowledged (default 2)",
     )
     p.add_argument("--segment", type=int, default=1024, help="file segment size in octets")
-    p.add_argument("--timeout", type=float, default=600.0, help="give up after seconds")
+    p.add_argument(
+        "--timeout", type=float, default=60.0, help="give up after seconds (default 60)"
+    )
+    p.add_argument(
+        "--answer-timeout",
+        type=float,
+        default=5.0,
+        help="seconds to wait for the remote entity's first answer (default 5)",
+    )
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--loss", type=float, default=0.0, help="drop this fraction of sent PDUs")
 
 
@@ -84,10 +88,6 @@ def _setup(args, onboard=False):
     peers = dict(parse_peer(t) for t in (args.peer or [DEFAULT_PEER]))
     fs = RootedFilestore(args.root)
     ent = make_entity(args.id, peers, fs, mode=2 - args.cls, segment=args.segment, persist=onboard)
-    if not onboard:
-        # keep transaction ids unique across runs of the command
-        ent.persist = True
-        ent.load_seq()
     udp = UdpEntity(
         ent,
         (getattr(args, "host", DEFAULT_HOST), args.port),
@@ -99,158 +99,104 @@ def _setup(args, onboard=False):
 
 
 class Progress:
-    """A one-line progress bar on stderr and the transfer summary."""
+    """A one-line progress bar on stderr: bytes the receiver confirmed (class 2)."""
 
     def __init__(self, out=sys.stderr, width=30):
         self.out = out
         self.width = width
-        self.start = time.monotonic()
         self.last = 0.0
+        self.shown = False
 
     def show(self, done, total, force=False):
         now = time.monotonic()
-        if not force and now - self.last < 0.1:
+        if not self.out.isatty() or (not force and now - self.last < 0.1):
             return
         self.last = now
         frac = done / total if total else 1.0
         n = int(frac * self.width)
-        rate = done / max(now - self.start, 1e-6) / 1e6
         self.out.write(
-            "\r[%s%s] %5.1f%% %d/%d B %.2f MB/s"
-            % ("#" * n, "." * (self.width - n), frac * 100, done, total, rate)
+            "\r[%s%s] %5.1f%% %d/%d B confirmed"
+            % ("#" * n, "." * (self.width - n), frac * 100, done, total)
         )
         self.out.flush()
+        self.shown = True
 
     def end(self):
-        self.out.write("\n")
+        if self.shown:
+            self.out.write("\n")
 
 
-def summary(udp, started, fin, nbytes):
-    st = udp.entity.stats
-    dt = time.monotonic() - started
-    cond = fin.get("condition", NO_ERROR) if fin else None
-    lines = [
-        "result: %s" % (CONDITION_NAMES.get(cond, cond) if fin else "no answer"),
-        "bytes: %d in %.2f s (%.2f MB/s)" % (nbytes, dt, nbytes / max(dt, 1e-6) / 1e6),
-        "PDUs: %d sent, %d received, %d dropped on purpose"
-        % (udp.sent, udp.received, udp.dropped),
-        "retransmissions: %d file data PDUs (%d octets), %d NAKs sent, %d NAKs received"
-        % (
-            st["retransmitted_pdus"],
-            st["retransmitted_bytes"],
-            st["naks_sent"],
-            st["naks_received"],
-        ),
-    ]
-    if fin:
-        lines.append("file status: %s" % FILE_STATUS.get(fin.get("file_status"), "?"))
-    return "\n".join(lines)
+def _client(args):
+    from obsw_host.cfdp.client import CfdpClient
+    from obsw_host.cfdp.link import parse_peer
+
+    peers = dict(parse_peer(t) for t in (args.peer or [DEFAULT_PEER]))
+    return CfdpClient(
+        args.id,
+        peers,
+        args.root,
+        cls=args.cls,
+        segment=args.segment,
+        port=args.port,
+        loss=args.loss,
+        timeout=args.timeout,
+        answer_timeout=args.answer_timeout,
+    )
+
+
+def _report(args, result):
+    import json
+
+    if args.json:
+        print(json.dumps(result.as_dict()))
+    else:
+        print(result.line())
+        if result.kind != "status" and result.stats:
+            st = result.stats
+            print(
+                "PDUs: %d sent, %d received, %d dropped on purpose; %d retransmitted, "
+                "%d NAKs received"
+                % (
+                    st["pdus_sent"],
+                    st["pdus_received"],
+                    st["pdus_dropped"],
+                    st["retransmitted_pdus"],
+                    st["naks_received"],
+                )
+            )
+    return 0 if result.delivered else 1
+
+
+def _transfer(args, method, *names):
+    bar = None if args.json else Progress()
+    with _client(args) as c:
+        try:
+            result = getattr(c, method)(*names, on_progress=bar.show if bar else None)
+            if bar and result.delivered:
+                bar.show(result.size, result.size, True)
+        finally:
+            if bar:
+                bar.end()
+    return _report(args, result)
 
 
 def cmd_put(args):
-    udp, peers = _setup(args)
-    remote = next(iter(peers))
-    ent = udp.entity
-    tid = ent.put(remote, args.source, args.dest or args.source, now=time.monotonic())
-    size = ent.find(tid).size
-    bar = Progress()
-    fin = {}
-    started = time.monotonic()
-
-    def on(ind):
-        if ind.kind == "finished" and ind.tid == tid:
-            fin.update(ind.info)
-
-    udp.on_indication = on
-
-    def done():
-        tx = ent.find(tid)
-        if tx is not None:
-            bar.show(tx.progress, size)
-        return bool(fin)
-
-    ok = udp.run_until(done, args.timeout)
-    bar.show(size if fin else 0, size, True)
-    bar.end()
-    print(summary(udp, started, fin, size))
-    udp.close()
-    return 0 if ok and fin.get("condition") == NO_ERROR else 1
+    return _transfer(args, "put", args.source, args.dest)
 
 
 def cmd_get(args):
-    udp, peers = _setup(args)
-    remote = next(iter(peers))
-    ent = udp.entity
-    dest = args.dest or args.source.replace("\\", "/").split("/")[-1]
-    req = ent.put(
-        remote, messages=[msgs.proxy_put_request(args.id, args.source, dest)], now=time.monotonic()
-    )
-    bar = Progress()
-    fin = {}
-    resp = {}
-    started = time.monotonic()
-
-    def on(ind):
-        origin = ind.info.get("origin") == req
-        if ind.kind == "finished" and origin and ind.info.get("dest_name"):
-            fin.update(ind.info)
-        elif ind.kind == "proxy_response" and origin and "condition" in ind.info["fields"]:
-            resp.update(ind.info["fields"])
-
-    udp.on_indication = on
-
-    def done():
-        for tx in ent.tx.values():
-            if tx.role == "R" and tx.origin == req and tx.meta:
-                bar.show(tx.progress_of(), tx.meta["size"])
-        if resp and resp.get("condition", 0) != NO_ERROR:
-            return True
-        return bool(fin) and bool(resp)
-
-    ok = udp.run_until(done, args.timeout)
-    size = fin.get("size", 0)
-    bar.show(size, size, True)
-    bar.end()
-    print(summary(udp, started, fin or resp, size))
-    udp.close()
-    good = ok and fin.get("condition") == NO_ERROR and resp.get("condition") == NO_ERROR
-    return 0 if good else 1
+    return _transfer(args, "get", args.source, args.dest)
 
 
 def cmd_status(args):
-    udp, peers = _setup(args)
-    remote = next(iter(peers))
-    ent = udp.entity
-    now = time.monotonic()
-    if ":" in args.what:
-        src, seq = (int(x, 0) for x in args.what.split(":"))
-        req = ent.put(
-            remote, messages=[msgs.remote_status_report_request((src, seq), "")], now=now
-        )
-    else:
-        listing = "listing-%d.txt" % int(now)
-        req = ent.put(
-            remote, messages=[msgs.directory_listing_request(args.what, listing)], now=now
-        )
-    resp = {}
-    fin = {}
-
-    def on(ind):
-        if ind.kind == "proxy_response" and ind.info.get("origin") == req:
-            resp.update(ind.info["fields"])
-        elif ind.kind == "finished" and ind.info.get("origin") == req:
-            fin.update(ind.info)
-
-    udp.on_indication = on
-    ok = udp.run_until(lambda: bool(resp) and (":" in args.what or bool(fin)), args.timeout)
-    udp.close()
-    if not ok:
-        print("no answer from entity %d" % remote)
+    with _client(args) as c:
+        result = c.status(args.what)
+    if args.json:
+        return _report(args, result)
+    if result.answer is None:
+        print("failed: no answer from entity %d within %gs" % (result.remote, args.timeout))
         return 1
-    if ":" in args.what:
-        print("transaction %s: %s" % (args.what, STATUS_NAMES.get(resp["status"], "?")))
-    else:
-        print(ent.fs.read_bytes(listing).decode(), end="")
+    print(result.answer, end="" if result.answer.endswith("\n") else "\n")
     return 0
 
 

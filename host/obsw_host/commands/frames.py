@@ -1,5 +1,5 @@
 """`obsw frames`: the frame processor on two UARTs, CLTU and TM frame tools, TC security keys
-and signing (SDLS), the link demo."""
+and signing (SDLS)."""
 
 import binascii
 import json
@@ -87,12 +87,11 @@ def add_parser(sub):
     tdec.add_argument("--randomized", action="store_true", help="frame is TM-randomized")
     tdec.set_defaults(func=tm_decode)
 
-    demo = s.add_parser("demo", help="ground and frame processor over two pseudo-UARTs")
-    demo.set_defaults(func=run_demo)
-
 
 def _hex(text):
-    return binascii.unhexlify("".join(text.split()))
+    from obsw_host.errors import hex_bytes
+
+    return hex_bytes(text, "frame")
 
 
 def processor(args):
@@ -105,10 +104,10 @@ def processor(args):
         playback = args.tm_port + 1 if args.tm_port else 0
     security = {}
     if args.keys:
-        from obsw import sdb as sdb_module
+        from obsw.pus import sdb as sdb_module
 
         from obsw_host.frames.processor import security_options
-        from obsw_host.pus.demo import SDB_PATH
+        from obsw_host.sample import SDB_PATH
 
         try:
             db = sdb_module.load(args.sdb or SDB_PATH)
@@ -275,9 +274,3 @@ def verify_frame(args):
     out["data"] = None if clear is None else binascii.hexlify(clear).decode()
     print(json.dumps(out))
     return 0 if clear is not None else 1
-
-
-def run_demo(args):
-    from obsw_host.frames import demo
-
-    return demo.run()

@@ -18,6 +18,10 @@
     obsw ground schedule list | summary | shift 30 | delete 0:10:5 | enable | disable | reset
     obsw ground position insert 120 set SolarPanel.speed=2      service 22
     obsw ground position list
+    obsw ground monitor [--log session.log] [--seconds N] [--count N]   live TM view
+    obsw ground replay session.log          a session log, decoded again
+    obsw ground list parameters|functions|events|hk    from the database
+    obsw ground list obcps | files [REPOSITORY]         from the on-board process
     obsw ground monitor add 1 SolarPanel.speed 0.5 10 --high-event monitoring.speed_high
     obsw ground monitor list | out-of-limits | enable 1 | disable 1 | delete 1
     obsw ground action add monitoring.speed_high set SolarPanel.speed=5
@@ -28,19 +32,24 @@
 A request to schedule, sequence or run as an action is ``ping``, ``function NAME
 [ARG=VALUE..]`` or ``set NAME=VALUE..``; activities are named SOURCE:APID:SEQ.
 
-``--json`` prints one JSON object per command instead of text; ``-v`` shows every packet.
+Every ground client receives all TM the on-board process sends (events, verification,
+housekeeping), whichever client's TC caused it. ``--log FILE`` appends every TC and TM of the
+command (raw and decoded) to a session log. ``--json`` prints one JSON object per command (per
+packet for ``monitor``) instead of text; ``-v`` shows every packet.
 """
 
+import argparse
 import json
 import sys
 
+from obsw_host.errors import UserError
 from obsw_host.net import DEFAULT_HOST
 
 
 def add_parser(sub):
     p = sub.add_parser(
         "ground",
-        help="send PUS requests to an on-board process",
+        help="send PUS requests to an on-board process, monitor its TM",
         description=__doc__,
         formatter_class=_raw(),
     )
@@ -51,6 +60,7 @@ def add_parser(sub):
     p.add_argument("--timeout", type=float, default=2.0, help="seconds per request")
     p.add_argument("--json", action="store_true", help="print JSON for scripts")
     p.add_argument("-v", "--verbose", action="store_true", help="print every packet")
+    p.add_argument("--log", metavar="FILE", help="append every TC and TM to this session log")
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
     from obsw_host.commands import cfdp, obcp
@@ -58,6 +68,7 @@ def add_parser(sub):
     obcp.add_to_ground(s)
     cfdp.add_parser(s)  # obsw ground cfdp put|get|status|serve
 
+    _add_operator(s)
     s.add_parser("ping", help="TC[17,1] are-you-alive").set_defaults(func=_ping)
     c = s.add_parser("connection", help="TC[17,3] on-board connection test")
     c.add_argument("target", type=int, help="APID of the process to test")
@@ -156,8 +167,18 @@ def _add_automation(s):
         x.add_argument("ids", nargs="+", metavar="SOURCE:APID:SEQ")
         x.set_defaults(func=_sched_delete, service=svc)
 
-    mo = s.add_parser("monitor", help="service 12 on-board monitoring").add_subparsers(dest="mon")
-    mo.required = True
+    mo = s.add_parser(
+        "monitor",
+        help="live TM view (no ACTION); or service 12 on-board monitoring (ACTION)",
+        description="Without ACTION: print every TM as it arrives until Ctrl-C (or --seconds, "
+        "--count). With ACTION: service 12 on-board monitoring.",
+    )
+    mo.add_argument("--seconds", type=float, help="stop after this many seconds")
+    mo.add_argument("--count", type=int, help="stop after this many TM packets")
+    mo.add_argument("--colour", choices=("auto", "always", "never"), default="auto")
+    mo.add_argument("--log", metavar="FILE", default=argparse.SUPPRESS, help="session log")
+    mo.set_defaults(func=_monitor_live)
+    mo = mo.add_subparsers(dest="mon", metavar="ACTION")
     x = mo.add_parser("add", help="TC[12,5] add a limit check and enable it")
     x.add_argument("pmon", type=int)
     x.add_argument("parameter")
@@ -200,23 +221,109 @@ def _add_automation(s):
         x.set_defaults(func=_sequence_named, what=action)
 
 
-def _raw():
-    import argparse
+def _add_operator(s):
+    x = s.add_parser("replay", help="print a session log (--log) decoded again")
+    x.add_argument("session_log", metavar="LOG", help="a file written by --log")
+    x.add_argument("--colour", choices=("auto", "always", "never"), default="auto")
+    x.set_defaults(func=_replay)
+    x = s.add_parser("list", help="parameters, functions, events, hk, obcps, files")
+    x.add_argument(
+        "kind",
+        choices=("parameters", "functions", "events", "hk", "obcps", "files"),
+        help="what to list (obcps and files ask the on-board process)",
+    )
+    x.add_argument("repository", nargs="?", default="SAT:/", help="for files (default SAT:/)")
+    x.set_defaults(func=_list)
 
+
+def _raw():
     return argparse.RawDescriptionHelpFormatter
 
 
 def _ground(args):
-    from obsw.pus import sdb as sdb_module
-
-    from obsw_host.pus.demo import SDB_PATH
     from obsw_host.pus.ground import Ground
+    from obsw_host.pus.monitor import SessionLog
+    from obsw_host.pus.onboard import port_for
+    from obsw_host.sample import load_sdb
 
-    sdb = sdb_module.load(args.sdb or SDB_PATH)
+    sdb = load_sdb(args.sdb)
     apid = args.apid if args.apid is not None else sdb.apid("pus")
-    target = (args.host, args.port if args.port is not None else 5000 + apid)
+    target = (args.host, args.port if args.port is not None else port_for(apid))
     log = (lambda s: print(s, file=sys.stderr)) if args.verbose else None
-    return Ground(sdb, apid=apid, target=target, timeout=args.timeout, log=log)
+    session = SessionLog(args.log) if getattr(args, "log", None) else None
+    g = Ground(sdb, apid=apid, target=target, timeout=args.timeout, log=log, session=session)
+    return _fresh(g)
+
+
+def _colour(args):
+    return args.colour == "always" or (args.colour == "auto" and sys.stdout.isatty())
+
+
+def _monitor_live(args):
+    """Every TM as it comes, until Ctrl-C, --seconds or --count."""
+    import time
+
+    from obsw_host.pus import text
+    from obsw_host.pus.monitor import Display
+    from obsw_host.pus.tm_fanout import LINGER
+
+    seen = [0]
+    with _ground(args) as g:
+        display = Display(g.sdb, _colour(args))
+
+        def show(tm, decoded, tx):
+            seen[0] += 1
+            if args.json:
+                record = {"type": [tm.service, tm.subtype], "apid": tm.apid}
+                record["seq_count"] = tm.seq_count
+                record["value"] = text.plain(decoded)
+                print(json.dumps(record), flush=True)
+            else:
+                print(display.tm(tm, decoded), flush=True)
+
+        g.proc.listeners.append(show)
+        g.subscribe()
+        print(
+            "monitoring TM from %s:%d (Ctrl-C stops)" % g.target[:2], file=sys.stderr, flush=True
+        )
+        now = time.monotonic
+        end = None if args.seconds is None else now() + args.seconds
+        refresh = now() + LINGER / 3
+        while end is None or now() < end:
+            if args.count is not None and seen[0] >= args.count:
+                break
+            g.poll(0.2 if end is None else max(0.0, min(0.2, end - now())))
+            if now() >= refresh:
+                g.subscribe()
+                refresh = now() + LINGER / 3
+    return 0
+
+
+def _replay(args):
+    from obsw_host.pus.monitor import replay
+    from obsw_host.sample import load_sdb
+
+    for line in replay(args.session_log, load_sdb(args.sdb), _colour(args)):
+        print(line)
+    return 0
+
+
+def _list(args):
+    from obsw_host.pus.catalog import KINDS, catalog, table
+
+    if args.kind in KINDS:
+        from obsw_host.sample import load_sdb
+
+        rows = catalog(load_sdb(args.sdb), args.kind)
+        print(json.dumps(rows) if args.json else table(rows))
+        return 0
+    if args.kind == "obcps":
+        from obsw_host.pus.obcp_ground import ObcpGround
+
+        return _run(args, lambda g: ObcpGround(g).report_status())
+    from obsw_host.pus.storage_ground import StorageGround
+
+    return _run(args, lambda g: StorageGround(g).directory(args.repository))
 
 
 def _run(args, fn):
@@ -228,34 +335,39 @@ def _run(args, fn):
             tx = fn(g)
         except PusTimeout as e:
             tx = e.transaction
-        except KeyError as e:
-            print("obsw ground: %s" % e.args[0], file=sys.stderr)
-            return 2
-        except ValueError as e:  # a value the request's field cannot carry
-            print("obsw ground: %s" % e, file=sys.stderr)
-            return 2
+        sdb = g.sdb
     result = text.transaction(tx)
+    detail = text.failure_detail(tx, sdb)
     if args.json:
+        if detail:
+            result["failure_detail"] = detail
         print(json.dumps(result))
-    else:
-        for line in tx.verification():
-            print("  " + line)
-        for reply in tx.replies:
-            print(_format(reply))
-        if not tx.done:
-            print("no completion report within %ss" % args.timeout)
+        return 0 if tx.ok else 1
+    for line in tx.verification():
+        if "failure" in line and detail:  # the data decoded replaces its hex
+            line = "%s (%s)" % (line.split(" data ")[0], detail)
+        print("  " + line)
+    for reply in tx.replies:
+        print(text.readable(reply, sdb))
+    if not tx.done:
+        print(_no_answer(args, tx))
     return 0 if tx.ok else 1
 
 
-def _format(value):
-    from obsw_host.pus import text
+def _port(apid):
+    from obsw_host.pus.onboard import port_for
 
-    v = text.plain(value)
-    if isinstance(v, dict) and "values" in v and isinstance(v["values"], dict):
-        lines = ["%s = %s" % (k, x) for k, x in v["values"].items()]
-        head = "structure %s" % v["sid"] if "sid" in v else None
-        return "\n".join(([head] if head else []) + lines)
-    return json.dumps(v)
+    return port_for(apid)
+
+
+def _no_answer(args, tx):
+    if not tx.verification():
+        return "no report from %s:%s within %ss: is `obsw obc serve` running there?" % (
+            args.host,
+            args.port if args.port is not None else 5000 + tx.tc.apid,
+            args.timeout,
+        )
+    return "no completion report within %ss" % args.timeout
 
 
 def _ping(args):
@@ -310,8 +422,7 @@ def _params_set(args):
     for a in args.assignments:
         name, sep, value = a.partition("=")
         if not sep:
-            print("obsw ground params set: expected NAME=VALUE, got %r" % a, file=sys.stderr)
-            return 2
+            raise UserError("parameter assignment %r" % a, expected="NAME=VALUE")
         values[_key(name)] = _value(value)
     return _run(args, lambda g: g.set_parameters(values))
 
@@ -332,19 +443,23 @@ def _time_rate(args):
 
 
 def _listen(args):
-    """Print unsolicited TM of one type for a while (after a ping, so TM finds the way)."""
+    """Print TM of one type for a while (subscribed: TM caused by any client comes too)."""
+    import time
+
     from obsw_host.pus import text
+    from obsw_host.pus.monitor import Display
 
     service, subtype = args.listen
     n = 0
     with _ground(args) as g:
-        try:
-            g.ping()
-        except Exception as e:
-            print("obsw ground: on-board process does not answer: %s" % e, file=sys.stderr)
-            return 1
-        import time
-
+        display = Display(g.sdb)
+        g.subscribe()
+        print(
+            "listening for TM[%s,%s] from %s:%d for %gs"
+            % (service, subtype or "*", g.target[0], g.target[1], args.seconds),
+            file=sys.stderr,
+            flush=True,
+        )
         end = time.monotonic() + args.seconds
         seen = len(g.received)
         while time.monotonic() < end:
@@ -355,15 +470,14 @@ def _listen(args):
                 if tm.service == service and (subtype is None or tm.subtype == subtype):
                     n += 1
                     if args.json:
-                        print(
-                            json.dumps(
-                                {"type": [tm.service, tm.subtype], "value": text.plain(decoded)}
-                            )
-                        )
+                        value = {"type": [tm.service, tm.subtype], "value": text.plain(decoded)}
+                        print(json.dumps(value), flush=True)
                     else:
-                        print(text.tm_line(tm, decoded))
+                        print(display.tm(tm, decoded), flush=True)
             seen = len(g.received)
-    return 0 if n else 1
+    if not n:
+        print("no TM[%s,%s] within %ss" % (service, subtype or "*", args.seconds), file=sys.stderr)
+    return 0
 
 
 def _learn(g, tm, decoded):
@@ -393,7 +507,7 @@ def _assignments(words):
     for w in words:
         name, sep, value = w.partition("=")
         if not sep:
-            raise KeyError("expected NAME=VALUE, got %r" % w)
+            raise UserError("assignment %r" % w, expected="NAME=VALUE")
         out[_key(name)] = _value(value)
     return out
 
@@ -408,8 +522,9 @@ def _request(g, words):
         return g.function_request(_key(words[1]), **args)
     if kind == "set" and len(words) >= 2:
         return g.parameter_request(_assignments(words[1:]))
-    raise KeyError(
-        "request: ping | function NAME [ARG=VALUE..] | set NAME=VALUE.., got %r" % words
+    raise UserError(
+        "request %r" % " ".join(words),
+        expected="ping | function NAME [ARG=VALUE..] | set NAME=VALUE..",
     )
 
 
@@ -417,7 +532,7 @@ def _rid(text):
     try:
         source, apid, seq = (int(x) for x in text.split(":"))
     except ValueError:
-        raise KeyError("activity SOURCE:APID:SEQ, got %r" % text) from None
+        raise UserError("activity %r" % text, expected="SOURCE:APID:SEQ") from None
     return (source, apid, seq)
 
 
@@ -538,7 +653,7 @@ def _sequence_load(args):
             try:
                 delay = float(words[0])
             except (ValueError, IndexError):
-                raise KeyError("sequence step 'DELAY REQUEST..', got %r" % step) from None
+                raise UserError("sequence step %r" % step, expected="'DELAY REQUEST..'") from None
             items.append((_request(g, words[1:]), delay))
         return g.load_sequence(args.name, items)
 

@@ -1,6 +1,7 @@
 """`obsw il`: serve, call, read, write and watch components over the interaction layer."""
 
 import json
+import sys
 
 SERVABLE = {"solar-panel": "obsw_host.solar_panel"}
 
@@ -41,9 +42,6 @@ def add_parser(sub):
     ls = isub.add_parser("list", help="components that are provided right now")
     ls.set_defaults(func=_list)
 
-    d = isub.add_parser("demo", help="the solar panel in its own process, used through a proxy")
-    d.set_defaults(func=_demo)
-
 
 def _value(text):
     try:
@@ -70,9 +68,8 @@ def _run(args, action):
     except InteractionError as e:
         code = getattr(e, "code", None)
         kind = type(e).__name__ + ("" if code is None else " " + str(code))
-        print("error: %s: %s" % (kind, e))
-        if e.data is not None:
-            print("data: %r" % (e.data,))
+        data = "" if e.data is None else " (data %r)" % (e.data,)
+        print("obsw il: %s: %s%s" % (kind, e, data), file=sys.stderr)
         return 1
     finally:
         transport.close()
@@ -138,9 +135,3 @@ def _list(args):
     for name in Directory(args.dir).names():
         print(name)
     return 0
-
-
-def _demo(args):
-    from obsw_host import il_demo
-
-    return il_demo.run(directory=args.dir)

@@ -99,4 +99,7 @@ def show(args):
 def main(argv=None):
     p = argparse.ArgumentParser(prog="python -m obsw_host.obc", description=__doc__)
     add_serve_arguments(p)
+    from obsw_host import logs
+
+    logs.setup()  # the level obsw --log-level gave the parent ($OBSW_LOG_LEVEL)
     return serve(p.parse_args(argv))

@@ -17,13 +17,13 @@
     obsw obcp abort-all                     (TC[18,17] -> TM[18,18])
     obsw obcp engine start|stop             (TC[18,21] / TC[18,22])
     obsw obcp listen [--seconds S]          OBCP events (service 5) as they come
-    obsw obcp demo                          upload and run a procedure end to end
 
 ``--json`` prints one JSON object per command instead of text; ``-v`` shows every packet.
 """
 
 import json
 import sys
+import threading
 
 from obsw_host.net import DEFAULT_HOST
 
@@ -38,7 +38,7 @@ _SIMPLE = {
 
 
 def add_parser(sub):
-    """``obsw obcp ...``: the client actions, plus ``serve`` and ``demo``."""
+    """``obsw obcp ...``: the client actions, plus ``serve``."""
     p = sub.add_parser(
         "obcp", help="PLUTO OBCPs on board (PUS service 18)", description=__doc__,
         formatter_class=_raw(),
@@ -51,7 +51,6 @@ def add_parser(sub):
     x.add_argument("--files", help="filestore folder for loads by reference")
     x.add_argument("--period", type=float, default=0.1, help="activity loop cycle, seconds")
     x.set_defaults(func=_serve)
-    s.add_parser("demo", help="upload and run a procedure end to end").set_defaults(func=_demo)
 
 
 def add_to_ground(ground_actions):
@@ -131,7 +130,7 @@ def _raw():
 def _sdb(args):
     from obsw.pus import sdb as sdb_module
 
-    from obsw_host.pus.demo import SDB_PATH
+    from obsw_host.sample import SDB_PATH
 
     return sdb_module.load(args.sdb or SDB_PATH)
 
@@ -139,10 +138,11 @@ def _sdb(args):
 def _client(args):
     from obsw_host.pus.ground import Ground
     from obsw_host.pus.obcp_ground import ObcpGround
+    from obsw_host.pus.onboard import port_for
 
     sdb = _sdb(args)
     apid = args.apid if args.apid is not None else sdb.apid("pus")
-    target = (args.host, args.port if args.port is not None else 5000 + apid)
+    target = (args.host, args.port if args.port is not None else port_for(apid))
     log = (lambda s: print(s, file=sys.stderr)) if args.verbose else None
     ground = Ground(sdb, apid=apid, target=target, timeout=args.timeout, log=log)
     return ground, ObcpGround(ground)
@@ -177,19 +177,12 @@ def _run(args, fn):
     from obsw_host.pus.ground import PusTimeout
     from obsw_host.pus.obcp_ground import explain
 
-    try:
-        ground, obcp = _client(args)
-    except (OSError, KeyError, ValueError) as e:
-        print("obsw obcp: %s" % e, file=sys.stderr)
-        return 2
+    ground, obcp = _client(args)  # bad input: typed errors, one line from obsw_host.cli
     with ground:
         try:
             tx = fn(obcp)
         except PusTimeout as e:
             tx = e.transaction
-        except (OSError, ValueError) as e:
-            print("obsw obcp: %s" % e, file=sys.stderr)
-            return 2
     if args.json:
         result = text.plain(text.transaction(tx))
         result["explained"] = explain(tx)
@@ -296,33 +289,31 @@ def _listen(args):
                     print(json.dumps({"event": name, "data": text.plain(data)}), flush=True)
                 else:
                     print("%-13s %s" % (name, json.dumps(text.plain(data))), flush=True)
-    return 0 if n else 1
+    if not n:
+        print("no OBCP events within %gs" % args.seconds, file=sys.stderr)
+    return 0
 
 
 def _serve(args):
-    from obsw_host.pus.obcp_demo import onboard_with_obcp
+    from obsw_host.pus.obcp_onboard import onboard_with_obcp
 
     sdb = _sdb(args)
     onboard, engine = onboard_with_obcp(
         sdb, files=args.files, apid=args.apid, host=args.host, port=args.port, period=args.period
     )
+    onboard.start()  # bound (or OSError) before "serving" is printed
     print(
         "PUS application process APID %d with service 18 serving on udp %s:%d (Ctrl-C stops)"
-        % (onboard.apid, onboard.host, onboard.port),
+        % (onboard.apid, onboard.host, onboard.address[1]),
         file=sys.stderr,
         flush=True,
     )
     try:
-        onboard.serve()
+        threading.Event().wait()
     except KeyboardInterrupt:
         pass
     finally:
+        onboard.stop()
         engine.abort_all("on-board process stopped")
         engine.system.close()
     return 0
-
-
-def _demo(args):
-    from obsw_host.pus.obcp_demo import run
-
-    return run()

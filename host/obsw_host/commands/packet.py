@@ -112,9 +112,9 @@ def _config(args):
     return PusConfig(source_id_size=args.source_id_size, pec=not args.no_pec)
 
 
-def _fail(action, message):
+def _fail(action, message, status=1):
     sys.stderr.write("obsw packet %s: %s\n" % (action, message))
-    return 1
+    return status
 
 
 def describe(raw, config):
@@ -183,8 +183,11 @@ def describe(raw, config):
 
 
 def decode(args):
+    """Exit status 0, 1 when the packet is malformed, 2 when the hex or options are wrong."""
+    raw = _user_input(lambda: _hex_bytes(" ".join(args.hex), "packet"), "decode")
+    if not isinstance(raw, bytes):
+        return raw
     try:
-        raw = _hex_bytes(" ".join(args.hex), "packet")
         config = _config(args)
         print(json.dumps(describe(raw, config), indent=2, sort_keys=True))
     except ValueError as e:
@@ -207,5 +210,12 @@ def encode(args):
         )
         print(tc.pack().hex())
     except ValueError as e:
-        return _fail("encode", e)
+        return _fail("encode", e, 2)  # the arguments were wrong
     return 0
+
+
+def _user_input(fn, action):
+    try:
+        return fn()
+    except ValueError as e:
+        return _fail(action, e, 2)

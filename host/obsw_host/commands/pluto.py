@@ -3,24 +3,14 @@
 import json
 import sys
 
-from obsw.pluto.interp import Procedure, load
-from obsw.pluto.lexer import PlutoError, line_col
-from obsw.pluto.system import SimulatedSystem, run_virtual
+from obsw.pluto.dryrun import dry_run
+from obsw.pluto.interp import load
+from obsw.pluto.lexer import PlutoError
+from obsw.pluto.system import SimulatedSystem
 from obsw.pluto.units import Quantity
 
-_KEYWORDS = {
-    "set": "assignment",
-    "if": "if",
-    "case": "in case",
-    "while": "while",
-    "repeat": "repeat",
-    "for": "for",
-    "wait": "wait",
-    "par": "in parallel",
-    "log": "log",
-    "inform": "inform user",
-    "ctx": "in the context of",
-}
+from obsw_host.errors import read_json
+
 _TYPES = {"real": "r", "float": "r", "double": "r", "bool": "b", "boolean": "b", "str": "s",
           "string": "s", "int": "i", "integer": "i", "uint": "u", "unsigned": "u"}  # fmt: skip
 
@@ -94,11 +84,11 @@ def _errors(e):
 def check_cmd(args):
     resolver = None
     if args.sdb:
-        from obsw.pus.sdb import load as load_sdb
+        from obsw_host.sample import load_sdb
 
         resolver = SdbResolver(load_sdb(args.sdb))
     elif args.system:
-        resolver = SimulatedSystem(json.loads(_read(args.system)))
+        resolver = SimulatedSystem(read_json(args.system, "system file"))
     try:
         load(_read(args.file), resolver)
     except PlutoError as e:
@@ -109,70 +99,10 @@ def check_cmd(args):
     return 0
 
 
-def describe(s):
-    """One line naming a statement, for the statement-by-statement printout."""
-    k = s[0]
-    if k in ("conf", "init"):
-        return ("initiate and confirm " if k == "conf" else "initiate ") + s[2][0][5]
-    if k == "op":
-        return "operation " + s[2][5]
-    if k == "step":
-        return "initiate and confirm step " + s[2]
-    if k == "set":
-        return "%s := ..." % s[2][2][-1]
-    return _KEYWORDS.get(k, k)
-
-
 def _json_value(v):
     if isinstance(v, Quantity):
         return {"value": v.value, "unit": v.unit}
     return v
-
-
-def dry_run(source, spec=None, arguments=None, on_statement=None):
-    """Check and run a procedure against a simulated system; returns the trace dict."""
-    sim = SimulatedSystem(spec or {})
-    trace = {
-        "accept": False,
-        "error": None,
-        "activity_calls": [],
-        "parameter_reads": [],
-        "events_raised": [],
-        "log": [],
-        "user_messages": [],
-        "user_prompts": [],
-        "step_status": {},
-        "status": None,
-        "end_time_s": 0,
-    }
-    try:
-        prog = load(source, sim if spec else None, arguments)
-    except PlutoError as e:
-        trace["error"] = {"kind": e.kind, "line": e.line, "message": e.msg}
-        return trace
-    trace["accept"] = True
-
-    def show(s):
-        if on_statement:
-            on_statement(sim.elapsed(), line_col(s[1])[0], describe(s))
-
-    proc = Procedure(prog, sim, arguments, trace=show)
-    proc.start(sim.now)
-    end = run_virtual(proc, sim)
-    trace.update(
-        activity_calls=sim.activity_calls,
-        parameter_reads=sim.parameter_reads,
-        events_raised=sim.events_raised,
-        log=sim.logs,
-        user_messages=sim.user_messages,
-        user_prompts=sim.user_prompts,
-        step_status=proc.step_status,
-        status=proc.outcome,
-        end_time_s=end - sim.start,
-    )
-    if proc.error:
-        trace["runtime_error"] = proc.error
-    return trace
 
 
 def _arg(text):
@@ -184,7 +114,7 @@ def _arg(text):
 
 
 def run_cmd(args):
-    spec = json.loads(_read(args.system)) if args.system else {}
+    spec = read_json(args.system, "system file") if args.system else {}
     arguments = dict(_arg(a) for a in args.arg)
 
     def show(t, line, what):

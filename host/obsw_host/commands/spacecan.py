@@ -1,4 +1,4 @@
-"""`obsw spacecan`: the SpaceCAN demo, a bus monitor, a simulated responder node, a ping and
+"""`obsw spacecan`: a bus monitor, a simulated responder node, a ping and
 the OBC's master with its equipment components on the interaction layer."""
 
 
@@ -6,9 +6,6 @@ def add_parser(sub):
     p = sub.add_parser("spacecan", help="SpaceCAN bus tools", description=__doc__)
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
-
-    d = s.add_parser("demo", help="controller and responder on simulated buses, bus A failure")
-    d.set_defaults(func=demo)
 
     def bus_args(q):
         q.add_argument(
@@ -49,12 +46,6 @@ def add_parser(sub):
     g.add_argument("--node-id", type=int, required=True)
     g.add_argument("--count", type=int, default=1)
     g.set_defaults(func=ping)
-
-
-def demo(args):
-    from obsw_host.spacecan import demo as d
-
-    return d.run()
 
 
 def master(args):

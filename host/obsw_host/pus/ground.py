@@ -15,7 +15,10 @@
                           ground.parameter_request({"SolarPanel.speed": 5.0}))  # 19
 
 Each call sends its TC and waits (driving the socket) until the completion report, a
-failure report or the timeout; every packet in either direction can be shown on ``log``.
+failure report or the timeout; every packet in either direction can be shown on ``log`` and
+written to a session log (``session=SessionLog(path)``, ``obsw_host.pus.monitor``). The on-board
+process sends TM to every ground that sent it a TC or ``subscribe()``d, so several grounds see
+the same TM (``obsw_host.pus.tm_fanout``); ``close()`` unsubscribes.
 """
 
 import select
@@ -38,6 +41,7 @@ from obsw.pus.user import UserProcess
 from obsw_host.net import DEFAULT_HOST
 from obsw_host.pus import text
 from obsw_host.pus.onboard import port_for, tai_now
+from obsw_host.pus.tm_fanout import SUBSCRIBE, UNSUBSCRIBE
 
 
 class PusTimeout(TimeoutError):
@@ -64,8 +68,10 @@ class Ground:
         timeout=2.0,
         source_id=None,
         log=None,
+        session=None,
     ):
         self.sdb = sdb
+        self.session = session  # a SessionLog, or None
         self.apid = apid if apid is not None else (sdb.apid("pus") if sdb else 10)
         self.target = target or (host, port_for(self.apid))
         self.timeout = timeout
@@ -101,6 +107,15 @@ class Ground:
 
     def _send(self, raw):
         self.sock.sendto(raw, self.target)
+        if self.session is not None:
+            from obsw.pus.tc import PusTc
+
+            self.session.write("TC", raw, line=text.tc_line(PusTc.unpack(raw)))
+
+    def subscribe(self):
+        """Ask the on-board process for its TM without sending a TC (repeat within its
+        linger time, a minute by default, to keep receiving)."""
+        self.sock.sendto(SUBSCRIBE, self.target)
 
     def _show(self, tm, decoded, tx):
         if tx is None and tm.service != 1:
@@ -131,7 +146,11 @@ class Ground:
                 data = self.sock.recv(65536)
             except OSError:
                 return n
-            self.proc.receive(data)
+            result = self.proc.receive(data)
+            if self.session is not None:
+                decoded = result[1] if result else None
+                line = text.tm_line(result[0], decoded) if result else "malformed"
+                self.session.write("TM", data, decoded, line)
             n += 1
             wait = 0
 
@@ -407,6 +426,10 @@ class Ground:
         return self.apid if apid is None else apid
 
     def close(self):
+        try:
+            self.sock.sendto(UNSUBSCRIBE, self.target)
+        except OSError:
+            pass  # best effort: the on-board process drops a silent client anyway
         self.sock.close()
 
     def __enter__(self):

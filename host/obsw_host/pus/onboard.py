@@ -3,8 +3,9 @@
 ``Onboard(sdb)`` builds the application process with the services the spacecraft database
 calls for (1, 3, 5, 8, 9, 11, 12, 17, 19, 20, 21, and 22 when the database names a
 ``position_scheduling`` parameter), a parameter pool and an event manager on an interaction
-layer node, and serves TCs from UDP. TM goes back to the address the last TC came from
-(and to ``tm_to`` if given). Packets that service 15 retrieves from a packet store go to
+layer node, and serves TCs from UDP. TM goes to every ground client that sent a TC or
+subscribed (``obsw_host.pus.tm_fanout``), and to ``tm_to`` if given; each TM is logged
+(``obsw_host.pus.tm_log``). Packets that service 15 retrieves from a packet store go to
 ``playback_to[vc]`` (a UDP address per virtual channel: the frame processor's input for that
 VC, ``FrameProcessorHost.vc_ports``), or out in real time when the store's VC has none.
 ``start()`` runs it on an asyncio loop in a thread (demo, tests); ``serve()`` runs it in the
@@ -12,6 +13,7 @@ calling thread until stopped (``obsw obc serve``).
 """
 
 import asyncio
+import os
 import threading
 import time
 
@@ -33,8 +35,10 @@ from obsw.pus.services.s21_sequencing import RequestSequencing
 from obsw.pus.services.s22_position_scheduling import PositionScheduling
 
 from obsw_host.net import DEFAULT_HOST
+from obsw_host.pus.tm_fanout import TmFanout
+from obsw_host.pus.tm_log import TmLog
 
-PORT_BASE = 5000
+PORT_BASE = int(os.environ.get("OBSW_PORT_BASE", "5000"))  # another base for a second system
 TAI_MINUS_UNIX = 378691200 + 37  # seconds from 1958-01-01 TAI to 1970-01-01 UTC, now
 
 
@@ -90,7 +94,9 @@ class Onboard:
         self.playback_to = dict(playback_to or {})
         self.node = node if node is not None else Node("pus")
         self.address = None
-        self.ground = None  # where TM goes: the sender of the last TC
+        self.ground = None  # the sender of the last TC
+        self.fanout = TmFanout([tm_to])
+        self.tm_log = TmLog(sdb)
         self._transport = None
         self._loop = None
         self._thread = None
@@ -155,14 +161,8 @@ class Onboard:
         t = self._transport
         if t is None:
             raise OSError("not bound")
-        sent = False
-        if self.ground is not None:
-            t.sendto(raw, self.ground)
-            sent = True
-        if self.tm_to is not None and self.tm_to != self.ground:
-            t.sendto(raw, self.tm_to)
-            sent = True
-        if not sent:
+        self.tm_log.tm(raw)
+        if not self.fanout.send(t.sendto, raw):
             self.app.count("tm_no_ground")
 
     def _playback(self, raw, vc):
@@ -179,8 +179,9 @@ class Onboard:
         self.app.count("playback_sent")
 
     def _received(self, data, addr):
-        self.ground = addr
-        self.app.receive(data)
+        if self.fanout.heard(data, addr):
+            self.ground = addr
+            self.app.receive(data)
 
     async def main(self):
         """Bind, then serve TCs and run the activity loop until ``stop()``."""

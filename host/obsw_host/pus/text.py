@@ -233,3 +233,106 @@ def transaction(tx):
         "replies": plain(tx.replies),
         "failure": plain(tx.failure) if tx.failure else None,
     }
+
+
+# ------------------------------------------------------------------------------ for operators
+
+
+def _utc(tai):
+    from obsw.utc import format_utc
+
+    return format_utc(tai)
+
+
+def _request_text(raw):
+    from obsw.pus.tc import PusTc
+
+    try:
+        tc = PusTc.unpack(bytes.fromhex(raw) if isinstance(raw, str) else bytes(raw))
+    except ValueError:
+        return "(undecodable TC)"
+    return "TC[%d,%d] %s" % (tc.service, tc.subtype, name(tc.service, tc.subtype))
+
+
+def _activity(a):
+    row = {}
+    if "time" in a:
+        row["release (UTC)"] = _utc(a["time"])
+    if "position" in a:
+        row["position"] = a["position"]
+    row["id"] = "%s:%s:%s" % (a.get("source", 0), a.get("apid", 0), a.get("seq_count", 0))
+    if "request" in a:
+        row["request"] = _request_text(a["request"])
+    for k in ("subschedule", "group"):
+        if k in a:
+            row[k] = a[k]
+    return row
+
+
+def _event_name(sdb, eid):
+    try:
+        return sdb.event(eid).qualified
+    except (KeyError, ValueError, AttributeError):
+        return str(eid)
+
+
+def readable(value, sdb=None):
+    """A reply as an operator reads it: names, units, UTC times, tables for lists."""
+    from obsw_host.pus.catalog import table
+
+    v = plain(value)
+    if not isinstance(v, dict):
+        return str(v)
+    if v == {"alive": True}:
+        return "alive"
+    if isinstance(v.get("values"), dict):
+        lines = ["structure %s" % v["sid"]] if "sid" in v else []
+        for k, x in v["values"].items():
+            unit = ""
+            if sdb is not None:
+                try:
+                    unit = sdb.parameter(k).unit or ""
+                except (KeyError, ValueError):
+                    pass
+            lines.append(
+                "%s = %s%s"
+                % (k, "%.6g" % x if isinstance(x, float) else x, (" " + unit) if unit else "")
+            )
+        return "\n".join(lines)
+    if isinstance(v.get("activities"), list):
+        return table([_activity(a) for a in v["activities"]])
+    if set(v) == {"ids"} and isinstance(v["ids"], list):
+        return "disabled events: " + (", ".join(_event_name(sdb, i) for i in v["ids"]) or "none")
+    if set(v) <= {"items", "delay"} and isinstance(v.get("items"), list):
+        rows = [x if isinstance(x, dict) else {"item": x} for x in v["items"]]
+        return table([{k: _cell(x) for k, x in r.items()} for r in rows])
+    return json_text(v)
+
+
+def _cell(x):
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, (dict, list)):
+        return json_text(x)
+    return x
+
+
+def json_text(v):
+    import json
+
+    return json.dumps(v)
+
+
+def failure_detail(tx, sdb=None):
+    """What a failure report's data means for the TC it verifies, or ''."""
+    failure = getattr(tx, "failure", None)
+    if not failure or sdb is None:
+        return ""
+    data = failure.get("data") if isinstance(failure, dict) else None
+    if tx.tc.service == 8 and data and len(data) == 2:
+        fid = int.from_bytes(bytes(data), "big")
+        from obsw.pus.services.s08_functions import functions
+
+        fn = functions(sdb).get(fid)
+        return "function %s" % (fn.name if fn else fid)
+    return ""

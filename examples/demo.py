@@ -7,19 +7,26 @@ import time
 # (title, module, function): each function takes `out` (a print-like callable), runs its part of
 # the system on this machine, prints what happens and cleans up after itself.
 SECTIONS = (
-    ("PUS monitoring & control: ground and onboard over UDP", "obsw_host.pus.demo", "run"),
-    ("Interaction layer: a component in its own process", "obsw_host.il_demo", "run"),
-    ("SpaceCAN: OBC master and equipment, a node on two buses", "obsw_host.spacecan.demo", "run"),
-    ("Space data link: CLTUs and TM frames on two UARTs", "obsw_host.frames.demo", "run"),
-    ("CFDP: class 2 file delivery over a lossy link, and a get", "obsw_host.cfdp.demo", "run"),
-    ("Storage and files: store, pass, CFDP copies", "obsw_host.pus.storage_demo", "run"),
-    ("OBCPs: ground uploads a PLUTO procedure with service 18", "obsw_host.pus.obcp_demo", "run"),
+    ("PUS monitoring & control: ground and onboard over UDP", "pus_demo", "run"),
+    ("Interaction layer: a component in its own process", "il_demo", "run"),
+    ("SpaceCAN: OBC master and equipment, a node on two buses", "spacecan_demo", "run"),
+    ("Space data link: CLTUs and TM frames on two UARTs", "frames_demo", "run"),
+    ("CFDP: class 2 file delivery over a lossy link, and a get", "cfdp_demo", "run"),
+    ("Storage and files: store, pass, CFDP copies", "storage_demo", "run"),
+    ("OBCPs: ground uploads a PLUTO procedure with service 18", "obcp_demo", "run"),
     ("Reconfiguration module: two MicroPython controllers", "obsw_host.reconfig_sim", "demo"),
     ("The whole OBC: the 12-step chain and its faults", "obsw_host.obc.chain", "demo"),
 )
 
 
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt  # so every section's cleanup (finally blocks) runs on SIGTERM too
+
+
 def main(out=print):
+    import signal
+
+    signal.signal(signal.SIGTERM, _interrupt)
     failed = []
     started = time.monotonic()
     for n, (title, module, function) in enumerate(SECTIONS, 1):

@@ -6,16 +6,9 @@ on-board automation: a parameter crossing its limit raises an event (service 12)
 an action (service 19), and a time-tagged TC (service 11) runs at its release time.
 """
 
-import os
+import sys
 
-from obsw.pus import sdb as sdb_module
-
-DATA = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data")
-SDB_PATH = os.path.join(DATA, "sdb.json")
-
-
-def load_sdb(path=None):
-    return sdb_module.load(path or SDB_PATH)
+from obsw_host.sample import SDB_PATH, load_sdb  # noqa: F401
 
 
 def _start_onboard(sdb, out, components):
@@ -143,3 +136,7 @@ def _automation(ground, out):
     ok &= _check(out, tx, "now %s" % values)
     ok &= values.get("SolarPanel.speed") == 5.0 and values.get("SolarPanel.angle") == 15.0
     return ok
+
+
+if __name__ == "__main__":
+    sys.exit(run())

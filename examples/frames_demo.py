@@ -5,24 +5,24 @@ import os
 import select
 import socket
 import struct
+import sys
 import tempfile
 import threading
 import time
 
-from obsw import sdb as sdb_module
+from obsw.pus import sdb as sdb_module
 from obsw.frames import fop as F
 from obsw.frames.cltu import encode
 from obsw.frames.farm import STATE_NAMES
 from obsw.frames.sdls import OUTCOME_NAMES
 from obsw.frames.tc import TcFrame
 from obsw.pus.tm import PusTm
-
 from obsw_host.frames import keys
 from obsw_host.frames.ground import Ground
 from obsw_host.frames.links import FdLink, SerialLink, open_pty_pair
 from obsw_host.frames.processor import FrameProcessorHost, sdb_events
 from obsw_host.net import DEFAULT_HOST
-from obsw_host.pus.demo import SDB_PATH
+from obsw_host.sample import SDB_PATH
 
 SCID = 0x2A
 APID = 0x21
@@ -184,3 +184,7 @@ def _forgery(out, ground, obc, pump, event_apid, event_ids):
     out("ground: TM[5,%d] event 0x%04X (TC frame rejected: %s) VC %d SPI %d" % (
         tm.subtype, event, names.get(event, "?"), vcid, spi))  # fmt: skip
     return names.get(event) == "bad_mac"
+
+
+if __name__ == "__main__":
+    sys.exit(run())

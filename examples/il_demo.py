@@ -5,52 +5,16 @@ receives events and status updates, shows a typed error crossing the process bou
 the provider and sees the user recover once it is restarted, then stops it cleanly.
 """
 
-import os
 import signal
-import subprocess
 import sys
 import tempfile
 
-import obsw
-
-import obsw_host
-
-
-def python_path():
-    """PYTHONPATH that finds the core and the host packages in a child process."""
-    roots = [
-        os.path.dirname(os.path.dirname(os.path.abspath(obsw.__file__))),
-        os.path.dirname(os.path.dirname(os.path.abspath(obsw_host.__file__))),
-    ]
-    old = os.environ.get("PYTHONPATH")
-    return os.pathsep.join(roots + ([old] if old else []))
-
-
-def spawn(module, directory, *args):
-    """Start ``python -m module --dir directory args...`` as a child process."""
-    env = dict(os.environ, PYTHONPATH=python_path(), OBSW_IL_DIR=directory)
-    return subprocess.Popen(
-        [sys.executable, "-m", module, "--dir", directory, "--quiet", *args],
-        env=env,
-        stdin=subprocess.DEVNULL,
-    )
-
-
-def stop(proc, timeout=5.0):
-    """SIGTERM, then SIGKILL if it does not end in ``timeout``; return the exit status."""
-    if proc.poll() is None:
-        proc.send_signal(signal.SIGTERM)
-        try:
-            return proc.wait(timeout)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-    return proc.wait(timeout)
+from obsw_host.il.processes import python_path, remove_tree, spawn, stop  # noqa: F401
 
 
 def run(out=print, directory=None):
     from obsw.il.errors import ComponentError
     from obsw.il.node import Node
-
     from obsw_host.il.transport import SocketTransport
     from obsw_host.solar_panel import SOLAR_PANEL
 
@@ -120,26 +84,8 @@ def run(out=print, directory=None):
         status = stop(panel_proc)
         out("  provider stopped cleanly (exit status %d)" % status)
         if own_dir:
-            _remove_tree(directory)
+            remove_tree(directory)
     return 0
-
-
-def _remove_tree(path):
-    for root, dirs, files in os.walk(path, topdown=False):
-        for f in files:
-            try:
-                os.remove(os.path.join(root, f))
-            except OSError:
-                pass
-        for d in dirs:
-            try:
-                os.rmdir(os.path.join(root, d))
-            except OSError:
-                pass
-    try:
-        os.rmdir(path)
-    except OSError:
-        pass
 
 
 if __name__ == "__main__":

@@ -10,11 +10,12 @@ A procedure with a syntax error is refused with its line and column; a procedure
 on-board filestore is loaded by reference (TC[18,13]). A few seconds; everything is stopped
 and removed at the end.
 
-``onboard_with_obcp(sdb, ...)`` is the on-board part on its own (``obsw obcp serve``).
+The on-board part on its own is ``obsw_host.pus.obcp_onboard`` (``obsw obcp serve``).
 """
 
 import os
 import shutil
+import sys
 import tempfile
 import time
 
@@ -26,46 +27,13 @@ end procedure
 """
 
 
-def onboard_with_obcp(sdb, *, files=None, level=2, components=None, **options):
-    """An ``Onboard`` with the solar panel (unless ``components`` are given), the OBCP engine
-    and the service 18 provider (``files`` is the filestore folder for loads by reference).
-    Returns ``(onboard, engine)``; the caller starts and stops the onboard."""
-    from obsw.cfdp.filestore import OsFilestore
-    from obsw.pluto.engine import provide
-    from obsw.pus.services.s18_obcp import ObcpManagement
-
-    from obsw_host.pus.onboard import Onboard
-    from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
-
-    if components is None:
-        components = [(SOLAR_PANEL, SolarPanel())]
-    onboard = Onboard(sdb, components=components, **options)
-    engine = provide(
-        onboard.node,
-        sdb,
-        [itf for itf, _ in components],
-        timeout=2.0,
-        activity_timeout=30.0,
-        poll=0.1,
-    )
-    onboard.app.register(
-        ObcpManagement(
-            engine,
-            filestore=OsFilestore(files) if files else None,
-            events=sdb.event,
-            level=level,
-            clock=time.time,
-        )
-    )
-    return onboard, engine
-
-
 def run(out=print, timeout=15.0):
     """The demo; returns 0 if every step went as expected."""
-    from obsw_host.obcp import DEMO_PROCEDURE
-    from obsw_host.pus.demo import load_sdb
+    from obcp_engine_demo import DEMO_PROCEDURE
     from obsw_host.pus.ground import Ground
     from obsw_host.pus.obcp_ground import ObcpGround, explain
+    from obsw_host.pus.obcp_onboard import onboard_with_obcp
+    from obsw_host.sample import load_sdb
 
     sdb = load_sdb()
     files = tempfile.mkdtemp(prefix="obsw-obcp-files-")
@@ -176,3 +144,7 @@ def _steps(obcp, out, explain, procedure, timeout):
         ok &= _check(out, obcp.unload(name), "unloaded " + name, explain)
     ok &= obcp.status() == {}
     return bool(ok)
+
+
+if __name__ == "__main__":
+    sys.exit(run())

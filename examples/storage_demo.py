@@ -15,6 +15,7 @@ use ``Segment`` too.
 import asyncio
 import os
 import shutil
+import sys
 import tempfile
 import time
 
@@ -27,7 +28,6 @@ from obsw.pus.services.s15_storage import Storage
 from obsw.pus.services.s23_files import FileManagement
 from obsw.spp import TYPE_TC, TYPE_TM
 from obsw.store import Store
-
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity
 
@@ -50,8 +50,8 @@ class Segment:
         frames=False,
         tm_frame_length=256,
     ):
-        from obsw_host.pus.demo import load_sdb
         from obsw_host.pus.onboard import Onboard
+        from obsw_host.sample import load_sdb
 
         self.sdb = sdb = sdb or load_sdb()
         self.work = work
@@ -320,3 +320,7 @@ def run(out=print, loss=0.05, seed=3, size=48000, frames=True):
         shutil.rmtree(work, ignore_errors=True)
     out("storage and files demo %s" % ("done" if ok else "FAILED"))
     return ok
+
+
+if __name__ == "__main__":
+    sys.exit(run())

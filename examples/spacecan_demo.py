@@ -1,6 +1,7 @@
 """The SpaceCAN part of `obsw demo`: the OBC's master and an equipment component, a responder,
 two simulated CAN buses, and bus A failing."""
 
+import sys
 import time
 import uuid
 
@@ -8,7 +9,6 @@ from obsw.spacecan import events as ev
 from obsw.spacecan.ids import bus_name
 from obsw.spacecan.nodedef import NodeDefinition
 from obsw.spacecan.responder import Responder
-
 from obsw_host.spacecan.adapter import BusFaults, CanAdapter
 
 NODE = {
@@ -47,7 +47,6 @@ def run(out=print, interface="virtual", channels=None):
     from obsw.il.errors import ComponentError
     from obsw.spacecan.equipment import Equipment
     from obsw.spacecan.master import MASTER
-
     from obsw_host.spacecan.obc import ObcSpaceCan
 
     if channels is None:
@@ -226,3 +225,7 @@ def _bin(v):
     for i in range(4):
         s = ("1" if v >> i & 1 else "0") + s
     return s
+
+
+if __name__ == "__main__":
+    sys.exit(run())

@@ -2,12 +2,12 @@
 over a link that drops PDUs (NAKs and retransmissions shown), then a get by proxy put."""
 
 import os
+import sys
 import tempfile
 import time
 
 from obsw.cfdp import msgs
 from obsw.cfdp.defs import CONDITION_NAMES, DIR_NAK
-
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity, packet_type_for
 
@@ -22,8 +22,13 @@ def _directive(pdu):
 
 
 def run(out=print, size=200000, loss=0.05, seed=7, timeout=20.0):
-    """Run the demo; returns True when both transfers delivered identical files."""
-    work = tempfile.mkdtemp(prefix="obsw-cfdp-demo-")
+    """Run the demo; returns True when both transfers delivered identical files. Its files
+    live in a temporary folder removed at the end, also when interrupted."""
+    with tempfile.TemporaryDirectory(prefix="obsw-cfdp-demo-") as work:
+        return _run(work, out, size, loss, seed, timeout)
+
+
+def _run(work, out, size, loss, seed, timeout):
     gfs = RootedFilestore(os.path.join(work, "ground"))
     ofs = RootedFilestore(os.path.join(work, "onboard"))
     payload = os.urandom(size)
@@ -137,3 +142,7 @@ def run(out=print, size=200000, loss=0.05, seed=7, timeout=20.0):
         g.close()
         o.close()
     return ok
+
+
+if __name__ == "__main__":
+    sys.exit(0 if run() else 1)

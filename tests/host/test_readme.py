@@ -1,0 +1,181 @@
+"""Every shell and Python example of README.md runs as written, in order, against the sample
+spacecraft, from a copy of examples/ (the samples the examples use are shipped there).
+
+Each shell block is one terminal: a line ending in ``&`` starts a server, which must print its
+ready line (bound) before the next line runs, and stays up for the Python blocks that follow
+until the next shell block. A line's expected exit status is 0 unless its comment says
+``exit N``. Lines that need hardware, or that are whole suites run elsewhere, are listed in
+SKIP with the reason. Ports move with OBSW_PORT_BASE (PUS) and a substitution (CFDP).
+"""
+
+import os
+import pathlib
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import threading
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+BOUND = 60  # seconds any line may take
+SKIP = {  # a piece of the line -> why it does not run here
+    "tools/demo": "the demo is tests/host/test_demo.py",
+    "tools/test": "this is the test suite",
+    "tools/bench/": "benchmarks run on demand",
+    "socketcan": "needs CAN hardware (the Raspberry Pi's can0, can1)",
+    "/dev/ttyS": "needs serial ports",
+    "obsw board": "needs a Pyboard and a MicroPython checkout",
+    "tools/upy/run.py": "a core test file on the unix port, as tools/test runs them all",
+}
+
+
+def blocks():
+    text = (ROOT / "README.md").read_text()
+    return [(m.group(1), m.group(2)) for m in re.finditer(r"```(sh|python)\n(.*?)```", text, re.S)]
+
+
+def free_base():
+    """A port base B with B+10 (PUS) and B+100, B+101 (CFDP) free."""
+    for base in range(21000, 60000, 337):
+        try:
+            for offset in (10, 100, 101):
+                s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+                try:
+                    s.bind(("127.0.0.1", base + offset))
+                finally:
+                    s.close()
+        except OSError:
+            continue
+        return base
+    raise RuntimeError("no free port base")
+
+
+READY = {"obsw obc serve": " up: "}  # a server's ready line (else: its first line)
+
+
+class Server:
+    def __init__(self, line, env, cwd):
+        self.line = line
+        self.ready_text = next((t for k, t in READY.items() if line.startswith(k)), "")
+        self.proc = subprocess.Popen(
+            ["bash", "-c", "exec " + line],
+            env=env,
+            cwd=cwd,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            start_new_session=True,  # its children (the OBC's processes) stop with it
+        )
+        self.ready = threading.Event()
+        self.output = []
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        for text in self.proc.stdout:
+            self.output.append(text)
+            if self.ready_text in text:
+                self.ready.set()
+        self.ready.set()
+
+    def stop(self):
+        os.killpg(self.proc.pid, signal.SIGTERM)
+        try:
+            self.proc.wait(15)
+        except subprocess.TimeoutExpired:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+            self.proc.wait()
+
+
+def _command(line):
+    """The line without its comment, and the exit status the comment expects."""
+    if line.lstrip().startswith("#"):
+        return "", 0
+    parts = re.split(r"\s#\s", line + " ", maxsplit=1)
+    comment = parts[1] if len(parts) > 1 else ""
+    m = re.search(r"exit (\d+)", comment)
+    return parts[0].strip(), int(m.group(1)) if m else 0
+
+
+def test_every_readme_example_runs(tmp_path):
+    work = tmp_path / "examples"
+    shutil.copytree(ROOT / "examples", work, ignore=shutil.ignore_patterns("__pycache__"))
+    base = free_base()
+    venv_bin = os.path.dirname(sys.executable)
+    env = dict(
+        os.environ,
+        PATH=venv_bin + os.pathsep + os.environ.get("PATH", ""),
+        OBSW_PORT_BASE=str(base),
+        OBSW_IL_DIR=str(tmp_path / "il"),
+        TMPDIR=str(tmp_path),
+        HOME=str(tmp_path / "home"),  # what the examples write under ~ stays here
+        PYTHONPATH=os.pathsep.join([str(work), str(ROOT / "micropython"), str(ROOT / "host")]),
+    )
+    os.makedirs(env["OBSW_IL_DIR"])
+    os.makedirs(env["HOME"])
+    ports = {"5100": str(base + 100), "5101": str(base + 101)}
+    servers, ran, skipped = [], 0, []
+    try:
+        for kind, body in blocks():
+            if kind == "python":
+                res = subprocess.run(
+                    [sys.executable, "-c", body],
+                    env=env,
+                    cwd=work,
+                    capture_output=True,
+                    text=True,
+                    timeout=BOUND,
+                )
+                assert res.returncode == 0, "python block failed:\n%s\n%s" % (body, res.stderr)
+                ran += 1
+                continue
+            for server in servers:
+                server.stop()
+            servers = []
+            for line in body.splitlines():
+                command, expected = _command(line)
+                if not command:
+                    continue
+                reason = next((why for piece, why in SKIP.items() if piece in command), None)
+                if reason:
+                    skipped.append((command, reason))
+                    continue
+                for old, new in ports.items():
+                    command = command.replace(old, new)
+                if command.endswith("&"):
+                    server = Server(command[:-1].strip(), env, work)
+                    servers.append(server)
+                    assert server.ready.wait(BOUND), "no ready line from %r" % command
+                    assert server.proc.poll() is None, "%r ended: %s" % (command, server.output)
+                    ran += 1
+                    continue
+                res = subprocess.run(
+                    ["bash", "-c", command],
+                    env=env,
+                    cwd=work,
+                    capture_output=True,
+                    text=True,
+                    timeout=BOUND,
+                )
+                assert res.returncode == expected, "%r: exit %d\n%s\n%s" % (
+                    command,
+                    res.returncode,
+                    res.stdout[-2000:],
+                    res.stderr[-2000:],
+                )
+                ran += 1
+    finally:
+        for server in servers:
+            server.stop()
+    print("README: %d examples ran, %d skipped: %s" % (ran, len(skipped), skipped))
+    assert ran >= 40
+    assert len(skipped) <= 12
+
+
+@pytest.mark.parametrize("name", ["node.json", "proc.pluto", "system.json", "turn.plt"])
+def test_sample_files_are_shipped(name):
+    assert (ROOT / "examples" / name).is_file()
+    assert name in (ROOT / "README.md").read_text()

@@ -5,8 +5,6 @@ Each target names the errors its decoder declares; an entry point documented nev
 stream parsers) declares none.
 """
 
-import json
-
 from fuzzcore import Target
 from obsw import cbor, spp, store
 from obsw.bits import BitsTooShortError, Decoder
@@ -32,7 +30,7 @@ from obsw.spacecan.fragment import Reassembler, split
 from obsw.spacecan.nodedef import NodeDefinition
 from obsw.spacecan.responder import Responder
 from obsw.spacecan.timeframes import FrameLengthError, ScetTime, UtcTime
-from obsw.timecode import Cuc, TimeCodeError
+from obsw.timecode import TimeCodeError
 
 # -- seeds ----------------------------------------------------------------------------------
 
@@ -339,14 +337,18 @@ _PLUTO_WORDS = (
 def _pluto_generate(rng):
     """Token soup, and the deep nestings an attacker would try first."""
     k = rng.below(4)
-    depth = 1 + rng.below(3000)
+    depth = 1 + rng.below(60 if rng.chance(90) else 2000)
     if k == 0:
-        return ("procedure main log " + "(" * depth + "1" + ")" * depth + "; end main end procedure").encode()
+        return (
+            "procedure main log " + "(" * depth + "1" + ")" * depth + "; end main end procedure"
+        ).encode()
     if k == 1:
         body = "if true then " * depth + "log 1;" + " end if;" * depth
         return ("procedure main " + body + " end main end procedure").encode()
     if k == 2:
-        steps = "initiate and confirm step S main " * depth + "log 1;" + " end main end step;" * depth
+        steps = (
+            "initiate and confirm step S main " * depth + "log 1;" + " end main end step;" * depth
+        )
         return ("procedure main " + steps + " end main end procedure").encode()
     words = [rng.pick(_PLUTO_WORDS) for _ in range(rng.below(40))]
     return (" ".join(words)).encode()
@@ -356,6 +358,26 @@ def _pluto_load(text):
     from obsw.pluto.interp import load
 
     load(text)
+
+
+def _pluto_run(text):
+    """Load, then run on a simulated system for a bounded number of statements: a program
+    that loads may end (finished or aborted) but ``run`` itself never raises."""
+    from obsw.pluto.interp import Procedure, load
+    from obsw.pluto.system import SimulatedSystem
+
+    try:
+        program = load(text)
+    except PlutoError:
+        return
+    proc = Procedure(program, SimulatedSystem({"parameters": {"a of B": 3}}))
+    now = 0
+    proc.start(now)
+    for _ in range(20):
+        w = proc.run(now, 50)
+        if w is None:
+            break
+        now = max(now, w.deadline or now) + 1
 
 
 SDB_SEED = None
@@ -465,33 +487,50 @@ def targets():
         Target("spp", spp.SpacePacket.unpack, pus, (spp.SppError,)),
         Target("spp-stream", _spp_stream_call, [b"".join(pus)], ()),
         Target("pus-tc-tm", unpack_packet, pus, (PusError,)),
-        Target("pus-fields", _fields_call, [bytes([i]) + bytes(16) for i in range(20)], FIELD_ERRORS),
+        Target(
+            "pus-fields", _fields_call, [bytes([i]) + bytes(16) for i in range(20)], FIELD_ERRORS
+        ),
         Target(
             "pus-structure",
             _structure_call,
-            [MESSAGE.pack({"sid": 1, "flag": True, "ids": [1, 2], "params": [
-                {"id": 0, "value": 3}, {"id": 3, "value": "ab"}], "time": (5, 0)})],
+            [
+                MESSAGE.pack(
+                    {
+                        "sid": 1,
+                        "flag": True,
+                        "ids": [1, 2],
+                        "params": [{"id": 0, "value": 3}, {"id": 3, "value": "ab"}],
+                        "time": (5, 0),
+                    }
+                )
+            ],
             FIELD_ERRORS,
         ),
         Target("cbor", cbor.loads, _cbor_seeds(), (cbor.CborDecodeError,), _cbor_generate),
         Target("cfdp-pdu", decode_pdu, pdus, (CfdpError,)),
         Target("cfdp-tlv", unpack_tlvs, [p[-20:] for p in pdus], (CfdpError,)),
         Target("cfdp-entity", cf.call, pdus, (), reset=cf.reset),
-        Target("frames", _frame_call, [b"\x00" + f for f in _tc_frames()]
-               + [b"\x02" + f for f in _tm_frames()], (FrameError,)),
+        Target(
+            "frames",
+            _frame_call,
+            [b"\x00" + f for f in _tc_frames()] + [b"\x02" + f for f in _tm_frames()],
+            (FrameError,),
+        ),
         Target("cltu", _cltu_call, _cltu_seeds(), (FrameError,)),
         Target("farm", fr.call, _farm_seeds(), (), reset=fr.reset),
-        Target("spacecan-payload", _can_payload_call, [b"\x00\x02\x01\x02", b"\x01\x01\x00\x01"],
-               (can_packets.ServicePacketError, FrameLengthError)),
+        Target(
+            "spacecan-payload",
+            _can_payload_call,
+            [b"\x00\x02\x01\x02", b"\x01\x01\x00\x01"],
+            (can_packets.ServicePacketError, FrameLengthError),
+        ),
         Target("spacecan-fragment", can.fragment_call, _can_seeds(), (), reset=can.reset),
         Target("spacecan-responder", can2.responder_call, _can_seeds(), (), reset=can2.reset),
         Target("pluto-lexer", tokenize, pluto, (PlutoError,), _pluto_generate, text=True),
         Target("pluto-parser", parse, pluto, (PlutoError,), _pluto_generate, text=True),
         Target("pluto-load", _pluto_load, pluto, (PlutoError,), _pluto_generate, text=True),
+        Target("pluto-run", _pluto_run, pluto, (), _pluto_generate, text=True),
         Target("sdb", sdb_loads, [_sdb_seed()], (SdbError,), _json_deep, text=True),
         Target("context-store", _store_call, _store_seeds(), (ValueError,), _store_generate),
     ]
 
-
-def _unused():
-    return json

@@ -21,6 +21,11 @@ def targets():
     r = _Reader()
     return [
         Target("il-wire", wire.loads, [wire.dumps(m) for m in msgs], (CborDecodeError,)),
-        Target("il-frames", r.call, [wire.frame(m) for m in msgs], (wire.FrameError, CborDecodeError),
-               reset=r.reset),
+        Target(
+            "il-frames",
+            r.call,
+            [wire.frame(m) for m in msgs],
+            (wire.FrameError, CborDecodeError),
+            reset=r.reset,
+        ),
     ]

@@ -140,7 +140,7 @@ class Procedure(Statements):
         except _Abort as e:
             gen.close()
             self._finish(ABORTED, str(e))
-        except (PlutoRuntimeError, UnitError, TypeError, ValueError, ZeroDivisionError, _Ask) as e:
+        except (PlutoRuntimeError, UnitError, TypeError, ValueError, ArithmeticError, _Ask) as e:
             gen.close()
             self._finish(ABORTED, "runtime error at line %d: %s" % (self._line(), e))
         finally:

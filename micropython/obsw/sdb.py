@@ -25,8 +25,7 @@ A type is a name (``uint8`` .. ``uint64``, ``int8`` .. ``int64``, ``float32``, `
 ``octets``) or a ``[ptc, pfc]`` pair. ``load``/``loads`` check that every id is unique.
 """
 
-import json
-
+from obsw import jsonsafe
 from obsw.pus.fields import field
 from obsw.pus.structure import Structure
 
@@ -354,7 +353,7 @@ _KNOWN = (
 def loads(text):
     """Parse a spacecraft database from JSON text."""
     try:
-        doc = json.loads(text)
+        doc = jsonsafe.loads(text)
     except ValueError as e:
         raise SdbError("spacecraft database is not valid JSON: %s" % e) from None
     return Sdb(doc)

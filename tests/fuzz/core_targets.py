@@ -337,7 +337,7 @@ _PLUTO_WORDS = (
 def _pluto_generate(rng):
     """Token soup, and the deep nestings an attacker would try first."""
     k = rng.below(4)
-    depth = 1 + rng.below(60 if rng.chance(90) else 2000)
+    depth = 1 + rng.below(60 if rng.chance(90) else 400)
     if k == 0:
         return (
             "procedure main log " + "(" * depth + "1" + ")" * depth + "; end main end procedure"
@@ -533,4 +533,3 @@ def targets():
         Target("sdb", sdb_loads, [_sdb_seed()], (SdbError,), _json_deep, text=True),
         Target("context-store", _store_call, _store_seeds(), (ValueError,), _store_generate),
     ]
-

@@ -54,47 +54,49 @@ _WIDE = (0, 1, 0x7FFF, 0x8000, 0xFFFF, 0x7FFFFFFF, 0x80000000, 0xFFFFFFFF, 0xFFF
 
 def mutate(rng, data, others=()):
     """``data`` with one to four random edits: bit flips, interesting values, inserted,
-    deleted and repeated runs, truncation, and splices with another seed."""
-    b = bytearray(data)
+    deleted and repeated runs, truncation, and splices with another seed. (Only edits that
+    keep the length go through a bytearray: MicroPython's cannot grow or shrink a slice.)"""
+    b = bytes(data)
     for _ in range(1 + rng.below(4)):
         op = rng.below(11)
         n = len(b)
-        if op == 0 and n:
+        if op <= 2 and n:
+            m = bytearray(b)
             i = rng.below(n)
-            b[i] ^= 1 << rng.below(8)
-        elif op == 1 and n:
-            b[rng.below(n)] = rng.pick(_INTERESTING)
-        elif op == 2 and n:
-            b[rng.below(n)] = rng.next() & 0xFF
+            if op == 0:
+                m[i] ^= 1 << rng.below(8)
+            elif op == 1:
+                m[i] = rng.pick(_INTERESTING)
+            else:
+                m[i] = rng.next() & 0xFF
+            b = bytes(m)
         elif op == 3:
             i = rng.below(n + 1)
-            b[i:i] = rng.bytes(1 + rng.below(8))
+            b = b[:i] + rng.bytes(1 + rng.below(8)) + b[i:]
         elif op == 4 and n:
             i = rng.below(n)
-            del b[i : i + 1 + rng.below(8)]
+            b = b[:i] + b[i + 1 + rng.below(8) :]
         elif op == 5 and n:
             i = rng.below(n)
             j = min(n, i + 1 + rng.below(16))
-            b[j:j] = b[i:j] * (1 + rng.below(4))
+            b = b[:j] + b[i:j] * (1 + rng.below(4)) + b[j:]
         elif op == 6 and n:
-            del b[rng.below(n) :]
+            b = b[: rng.below(n)]
         elif op == 7 and n >= 2:
             i = rng.below(n - 1)
             v = rng.pick(_WIDE) & 0xFFFF
-            b[i] = v >> 8
-            b[i + 1] = v & 0xFF
+            b = b[:i] + bytes((v >> 8, v & 0xFF)) + b[i + 2 :]
         elif op == 8 and n >= 4:
             i = rng.below(n - 3)
             v = rng.pick(_WIDE)
-            b[i : i + 4] = bytes([(v >> 24) & 0xFF, (v >> 16) & 0xFF, (v >> 8) & 0xFF, v & 0xFF])
+            w = bytes(((v >> 24) & 0xFF, (v >> 16) & 0xFF, (v >> 8) & 0xFF, v & 0xFF))
+            b = b[:i] + w + b[i + 4 :]
         elif op == 9 and others:
             o = rng.pick(others)
-            i = rng.below(n + 1)
-            k = rng.below(len(o) + 1)
-            b = b[:i] + bytearray(o[k:])
+            b = b[: rng.below(n + 1)] + o[rng.below(len(o) + 1) :]
         elif op == 10:
-            b.extend(rng.bytes(rng.below(32)))
-    return bytes(b)
+            b = b + rng.bytes(rng.below(32))
+    return b
 
 
 class Target:

@@ -18,7 +18,7 @@ _TIME_ORDER = ("d", "h", "min", "s")
 SUBJECT = ("subj", 0)  # the value a case statement tests, in its case tags
 # Deepest nesting of blocks, parentheses and operators the parser takes: the parser, the
 # checker and the interpreter walk the tree recursively, and a board's stack is small.
-MAX_NESTING = 24
+MAX_NESTING = 12
 
 
 def _show(tok):

@@ -2,6 +2,8 @@
 
 import sys
 
+from obsw_host.net import DEFAULT_HOST
+
 
 def add_parser(sub):
     p = sub.add_parser("obc", help="on-board processes", description=__doc__)
@@ -9,7 +11,7 @@ def add_parser(sub):
     s.required = True
     x = s.add_parser("serve", help="serve the PUS application process until Ctrl-C")
     x.add_argument("--sdb", help="spacecraft database JSON (default: the sample database)")
-    x.add_argument("--host", default="127.0.0.1", help="address to bind (default %(default)s)")
+    x.add_argument("--host", default=DEFAULT_HOST, help="address to bind (default %(default)s)")
     x.add_argument("--port", type=int, help="UDP port (default 5000 + APID)")
     x.add_argument("--apid", type=int, help="APID (default: the database's 'pus')")
     x.add_argument("--period", type=float, default=0.1, help="activity loop cycle, seconds")

@@ -33,6 +33,8 @@ from obsw.pus.services.s20_parameters import ParameterManagement
 from obsw.pus.services.s21_sequencing import RequestSequencing
 from obsw.pus.services.s22_position_scheduling import PositionScheduling
 
+from obsw_host.net import DEFAULT_HOST
+
 PORT_BASE = 5000
 TAI_MINUS_UNIX = 378691200 + 37  # seconds from 1958-01-01 TAI to 1970-01-01 UTC, now
 
@@ -70,7 +72,7 @@ class Onboard:
         *,
         node=None,
         apid=None,
-        host="127.0.0.1",
+        host=DEFAULT_HOST,
         port=None,
         period=0.1,
         store=None,

@@ -26,6 +26,7 @@ from obsw.reconfig.hal import RESET_NAMES, RESET_POWER, RESET_STUCK, RESET_WATCH
 from obsw.reconfig.models import Tps3813Model
 
 import obsw_host
+from obsw_host.frames import keys
 from obsw_host.frames.links import open_pty_pair
 from obsw_host.reconfig import simhal as W
 from obsw_host.reconfig.canhub import CanHub
@@ -142,6 +143,7 @@ class ReconfigSim:
         watchdog_timeout_ms=3000,
         heapsize="1M",
         out=None,
+        key_file=None,
     ):
         self.own_dir = directory is None
         self.dir = directory or tempfile.mkdtemp(prefix="obsw-reconfig-")
@@ -155,6 +157,11 @@ class ReconfigSim:
         self.wd = (watchdog_open_ms, watchdog_timeout_ms)
         self.heapsize = heapsize
         self.out = out
+        # TC frames to the controllers are signed (SDLS); keys made for the run unless given
+        self.key_file = key_file or os.path.join(self.dir, "tc.keys")
+        if key_file is None and not os.path.exists(self.key_file):
+            keys.generate(self.key_file)
+        self.security, _ = keys.load(self.key_file, os.path.join(self.dir, "ground.state"))
         self.events = []
         self.ctrl = [None, None]
         self.obc = None
@@ -270,6 +277,7 @@ class ReconfigSim:
             self.dir,
             str(cause),
             str(self.bit_error_gap),
+            self.key_file,
         ]
         p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
         self.ctrl[role] = _Proc(ROLES[role], p, self)
@@ -375,8 +383,9 @@ class ReconfigSim:
     # -- ground and COM module ----------------------------------------------------------------
 
     def send_hpc(self, hpc):
-        """Send an HPC as a BD frame on the essential MAP to both controllers' COM UARTs."""
+        """Send an HPC as a signed BD frame on the essential MAP to both controllers' COM UARTs."""
         seg = tc.Segment(ESSENTIAL_MAP, hpc.packet(seq_count=self._seq)).pack()
+        seg = self.security.apply(self.scid, 0, seg, True)  # signed with the essential MAP's SA
         frame = tc.TcFrame(self.scid, 0, seg, self._seq & 0xFF, bypass=True).pack()
         self._seq += 1
         data = cltu.encode(frame)

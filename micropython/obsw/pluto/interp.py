@@ -159,9 +159,8 @@ class Procedure(Statements):
         self.state = "finished"
         self.outcome = outcome
         self.error = error
-        self.question = None
-        if error:
-            self.system.log("procedure %s: %s" % (outcome, error))
+        self.question = None  # outcome and error are the status; the log holds only what
+        # log statements wrote
 
     def _procedure(self):
         d = self.program.ast

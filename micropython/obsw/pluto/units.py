@@ -207,6 +207,14 @@ def dims(text):
     return parse(text)[1] if text else NONE
 
 
+def _decimal(ratio):
+    """True when ``ratio`` is a power of ten (a change of decimal prefix only)."""
+    p = 1.0
+    while p < ratio and p < 1e40:
+        p *= 10
+    return p == ratio
+
+
 class Quantity:
     """A number with an engineering unit: ``Quantity(5, "V")``."""
 
@@ -225,7 +233,17 @@ class Quantity:
         s2, d2 = parse(unit)
         if d1 != d2:
             raise UnitError("cannot convert %s to %s" % (self.unit, unit))
-        v = (self.value * s1 + _OFFSET.get(self.unit, 0) - _OFFSET.get(unit, 0)) / s2
+        off = _OFFSET.get(self.unit, 0) - _OFFSET.get(unit, 0)
+        ratio = s1 / s2 if s1 >= s2 else s2 / s1
+        if off:
+            v = (self.value * s1 + off) / s2
+        elif s1 >= s2:
+            v = self.value * ratio
+        else:
+            v = self.value / ratio
+        if not off and type(v) is float and v - v == 0 and _decimal(ratio):
+            # decimal prefixes are not exact in binary: 3300 mV is 3.3 V, not 3.3000000000000003
+            v = float("%.15g" % v)
         if type(self.value) is int and v == int(v):
             v = int(v)
         return Quantity(v, unit)

@@ -21,9 +21,8 @@ class _Onboard:
     exception of its own (that is a decoder raising something it does not declare)."""
 
     def __init__(self):
-        from pus_loop import APID, sdb
-
         from obsw_host.pus.onboard import Onboard
+        from pus_loop import APID, sdb
 
         self.apid = APID
         self.onboard = Onboard(sdb(), port=0)

@@ -253,6 +253,36 @@ class _FarmState:
             f.clcw()
 
 
+class _ProcessorState:
+    """The onboard frame processor: CLTU bytes on either link, frames through FARM-1 and
+    segments to the packet routes; it never raises, whatever arrives."""
+
+    def __init__(self):
+        self.reset()
+
+    def reset(self):
+        from obsw.frames.processor import FrameProcessor
+
+        self.proc = FrameProcessor(5, lambda apid, packet: None, tc_vcids=(0, 1))
+        self.now = 0.0
+
+    def call(self, data):
+        self.now += 0.1
+        link = data[0] & 1 if data else 0
+        self.proc.receive(link, data, self.now)
+        self.proc.on_frame_data(link, data, self.now)
+
+
+def _processor_seeds():
+    seg = b"\x03" + PusTc(10, 17, 1).pack()
+    return [
+        cltu.encode(TcFrame(5, 0, seg, 0).pack()),
+        cltu.encode(TcFrame(5, 1, seg, 0, True).pack())
+        + cltu.encode(TcFrame(5, 0, seg, 1).pack()),
+        cltu.encode(TcFrame(5, 0, set_vr_command(0), 0, True, True).pack()),
+    ]
+
+
 def _farm_seeds():
     out = []
     for frames in (
@@ -482,6 +512,7 @@ def targets():
     can2 = _CanState()
     fr = _FarmState()
     cf = _CfdpState()
+    fp = _ProcessorState()
     pluto = PLUTO_SEEDS + _pluto_files()
     return [
         Target("spp", spp.SpacePacket.unpack, pus, (spp.SppError,)),
@@ -518,6 +549,7 @@ def targets():
         ),
         Target("cltu", _cltu_call, _cltu_seeds(), (FrameError,)),
         Target("farm", fr.call, _farm_seeds(), (), reset=fr.reset),
+        Target("frame-processor", fp.call, _processor_seeds(), (), reset=fp.reset),
         Target(
             "spacecan-payload",
             _can_payload_call,

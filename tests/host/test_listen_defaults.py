@@ -77,7 +77,9 @@ def test_can_hub_binds_loopback():
 
 def test_commands_default_to_loopback():
     parser = build_parser()
-    assert parser.parse_args(["obc", "serve"]).host == DEFAULT_HOST
+    from obsw_host.obc.config import load
+
+    assert load(None).host == DEFAULT_HOST  # what `obsw obc serve` binds without a CONFIG
     args = parser.parse_args(["frames", "processor", "--uart-a", "a", "--uart-b", "b"])
     assert args.host == DEFAULT_HOST
 

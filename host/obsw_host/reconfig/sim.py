@@ -144,10 +144,12 @@ class ReconfigSim:
         heapsize="1M",
         out=None,
         key_file=None,
+        obc_command=None,
     ):
         self.own_dir = directory is None
         self.dir = directory or tempfile.mkdtemp(prefix="obsw-reconfig-")
         self.obc_calls = list(obc_calls)
+        self.obc_command = obc_command  # callable(sim) -> argv of the OBC, or the sample OBC
         self.scid = scid
         self.obc_line = obc_line
         self.initial_lines = initial_lines
@@ -289,11 +291,14 @@ class ReconfigSim:
         core, host = roots()
         old = os.environ.get("PYTHONPATH")
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([core, host] + ([old] if old else [])))
-        cmd = [sys.executable, "-m", "obsw_host.reconfig.obc"]
-        cmd += [str(self.hub.ports[0]), str(self.hub.ports[1])]
-        if self.obc_boots == 0:
-            for c in self.obc_calls:
-                cmd += ["--call", c]
+        if self.obc_command is not None:
+            cmd = list(self.obc_command(self))
+        else:
+            cmd = [sys.executable, "-m", "obsw_host.reconfig.obc"]
+            cmd += [str(self.hub.ports[0]), str(self.hub.ports[1])]
+            if self.obc_boots == 0:
+                for c in self.obc_calls:
+                    cmd += ["--call", c]
         p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
         self.obc_boots += 1
         self.obc = _Proc("obc", p, self)

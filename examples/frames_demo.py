@@ -10,12 +10,12 @@ import tempfile
 import threading
 import time
 
-from obsw.pus import sdb as sdb_module
 from obsw.frames import fop as F
 from obsw.frames.cltu import encode
 from obsw.frames.farm import STATE_NAMES
 from obsw.frames.sdls import OUTCOME_NAMES
 from obsw.frames.tc import TcFrame
+from obsw.pus import sdb as sdb_module
 from obsw.pus.tm import PusTm
 from obsw_host.frames import keys
 from obsw_host.frames.ground import Ground

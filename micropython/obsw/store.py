@@ -8,12 +8,18 @@ length and CRC-32, so a half-written file is recognised and ignored: whenever po
 ``os.fsync``; the file is closed (flushed) before the rename and ``os.sync`` is called
 where the port has it.
 
+A cut between the remove and the rename leaves the complete ``.new`` as the only copy; the
+next ``save`` first renames it into place, and only then writes a new ``.new``, so a second
+cut during that write cannot take the last copy with it. Files are parsed with their JSON
+nesting bounded (``obsw.jsonsafe``).
+
 The file system is passed in (``fs``) so tests can cut the power after any operation.
 """
 
 import json
 import os
 
+from obsw import jsonsafe
 from obsw.crc import crc32
 
 _MAGIC = b"OBSWCTX1"
@@ -90,7 +96,7 @@ def decode(data):
         raise ValueError("context file has %d bytes of %d" % (len(body), size))
     if crc32(body) != crc:
         raise ValueError("context file checksum mismatch")
-    return json.loads(body.decode())
+    return jsonsafe.loads(body)
 
 
 class Store:
@@ -115,6 +121,11 @@ class Store:
         new = path + _NEW
         data = encode(value)
         fs = self.fs
+        if fs.exists(new) and not self._valid(path) and self._valid(new):
+            # the last save was cut between remove and rename: .new is the only copy
+            if fs.exists(path):
+                fs.remove(path)
+            fs.rename(new, path)
         f = fs.open(new, "wb")
         try:
             f.write(data)
@@ -130,6 +141,19 @@ class Store:
             fs.rename(new, path)
         fs.sync(self.root)
         self.saves += 1
+
+    def _valid(self, path):
+        if not self.fs.exists(path):
+            return False
+        try:
+            f = self.fs.open(path, "rb")
+            try:
+                decode(f.read())
+            finally:
+                f.close()
+            return True
+        except (OSError, ValueError):
+            return False
 
     def _read(self, path):
         fs = self.fs

@@ -35,6 +35,31 @@ class TestRejections(unittest.TestCase):
         e = self.reject(step("log 1;\n  x := 2;"), PlutoReferenceError)
         self.assertEqual((e.kind, e.line, e.col), ("unknown_reference", 6, 3))
 
+    def test_type_error_names_variable_and_declared_type(self):
+        for decl, stmt, msg in (
+            ("count of type signed integer", 'count := "x";',
+             "count: cannot assign a string to a signed integer variable"),
+            ("n of type unsigned integer", "n := 1.5;",
+             "n: cannot assign a real to an unsigned integer variable"),
+            ("b of type Boolean", "b := 3;", "b: cannot assign an integer to a Boolean variable"),
+        ):  # fmt: skip
+            e = self.reject(step(stmt, "variable " + decl), PlutoTypeError)
+            self.assertEqual(e.msg, msg)
+
+    def test_deep_nesting_is_a_syntax_error_with_line(self):
+        from obsw.pluto.lexer import PlutoSyntaxError
+
+        for src in (
+            step("log " + "(" * 200 + "1" + ")" * 200 + ";"),
+            step("log 1" + " + 1" * 3000 + ";"),
+            step("if TRUE then " * 100 + "log 1;" + " end if;" * 100),
+            step("log " + "9" * 5000 + ";"),
+            step("log 2025-13-45T25:61:61Z;"),
+            step("log 3:67:0.74.39:806:36.;"),
+        ):
+            e = self.reject(src, PlutoSyntaxError)
+            self.assertTrue(e.line >= 1)
+
     def test_unknown_event(self):
         e = self.reject(step("wait for 1 s timeout 1 s raise event Nope;"), PlutoReferenceError)
         self.assertIn("Nope", e.msg)

@@ -7,11 +7,11 @@ import threading
 import time
 
 import pytest
-from obsw.pus import sdb as sdb_module
 from obsw.frames import fop as F
 from obsw.frames import sdls
 from obsw.frames.cltu import encode
 from obsw.frames.tc import Segment, TcFrame
+from obsw.pus import sdb as sdb_module
 from obsw.pus.tm import PusTm
 from obsw_host.frames import keys
 from obsw_host.frames.ground import Ground

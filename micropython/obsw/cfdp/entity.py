@@ -16,6 +16,7 @@ from obsw.cfdp.defs import (
     DIR_FINISHED,
     DIR_METADATA,
     FILE_DIRECTIVE,
+    FILESTORE_REJECTION,
     STATUS_ACTIVE,
     STATUS_TERMINATED,
     STATUS_UNRECOGNIZED,
@@ -53,6 +54,9 @@ _STAT_KEYS = (
     "finished_resent",
     "decode_errors",
     "misrouted",
+    "oversize",
+    "refused",
+    "internal_errors",
 )
 
 
@@ -265,6 +269,9 @@ class CfdpEntity:
                 if remote is None:
                     self.stats["misrouted"] += 1
                     return None
+                if len(self.tx) >= self.mib.max_transactions:
+                    self.stats["refused"] += 1  # the sender's timers will try again
+                    return None
                 tx = Receiver(self, tid, remote, h, now)
                 self.tx[(tid, "R")] = tx
                 self.indicate("transaction", tid, role="R", source_id=h.source)
@@ -277,7 +284,15 @@ class CfdpEntity:
                 if pdu.CODE == DIR_FINISHED and h.mode == ACKNOWLEDGED:
                     self._ack_late(h, DIR_FINISHED, pdu.condition)
                 return None
-        tx.on_pdu(pdu, now)
+        try:
+            tx.on_pdu(pdu, now)
+        except Exception:  # a defect must not stop the entity: drop that transaction
+            self.stats["internal_errors"] += 1
+            try:
+                tx.abandon(FILESTORE_REJECTION)
+            except Exception:
+                self.forget(tx)
+            return None
         return pdu
 
     def _ack_late(self, h, directive, condition):

@@ -10,12 +10,19 @@ from obsw.cfdp.defs import (
 )
 from obsw.crc import CHECKSUM_CRC32
 
+_MAX_REMOTES = 256  # entries made from ``default`` for the entities met so far
+
 
 class RemoteEntity:
     """How this entity talks to one remote entity. Intervals in seconds; None turns a timer off.
 
     ``keep_alive_limit`` is the largest lag (octets) tolerated between what the sender sent and
     what the receiver reports in a Keep Alive PDU.
+
+    ``max_file_size`` bounds what a receiving transaction accepts from this entity: file data
+    or a declared size beyond it is a filestore rejection fault and is never written.
+    ``max_gaps`` bounds the missing ranges a receiver tracks; beyond it the last two are
+    merged (the octets between them are asked for again), so memory stays bounded.
     """
 
     def __init__(
@@ -41,6 +48,8 @@ class RemoteEntity:
         check_interval=5.0,
         check_limit=2,
         keep_incomplete=False,
+        max_file_size=64 << 20,
+        max_gaps=1024,
     ):
         self.entity_id = entity_id
         self.mode = mode
@@ -62,13 +71,25 @@ class RemoteEntity:
         self.check_interval = check_interval
         self.check_limit = check_limit
         self.keep_incomplete = keep_incomplete
+        self.max_file_size = max_file_size
+        self.max_gaps = max(2, max_gaps)
 
 
 class Mib:
     """The local entity: its id, default fault handlers and the remote entities it knows."""
 
-    def __init__(self, entity_id, remotes=(), *, seq_len=2, fault_handlers=None, default=None):
+    def __init__(
+        self,
+        entity_id,
+        remotes=(),
+        *,
+        seq_len=2,
+        fault_handlers=None,
+        default=None,
+        max_transactions=64,
+    ):
         self.entity_id = entity_id
+        self.max_transactions = max_transactions  # concurrent ones; more are refused, counted
         self.seq_len = seq_len
         self.remotes = {}
         for r in remotes:
@@ -84,7 +105,7 @@ class Mib:
 
     def remote(self, entity_id):
         r = self.remotes.get(entity_id)
-        if r is None and self.default is not None:
+        if r is None and self.default is not None and len(self.remotes) < _MAX_REMOTES:
             d = self.default
             r = RemoteEntity(entity_id)
             for k in d.__dict__:

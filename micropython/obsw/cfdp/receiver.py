@@ -162,9 +162,22 @@ class Receiver(Transaction):
         elif code == DIR_PROMPT:
             self.on_prompt(pdu.response, now)
 
+    def limit(self):
+        """The largest file this transaction may write: the remote's ``max_file_size``, and
+        what the PDU header's file size field can express (a NAK must be able to ask)."""
+        cap = self.remote.max_file_size
+        if not self.header.large and cap > 0xFFFFFFFF:
+            cap = 0xFFFFFFFF
+        return cap
+
     def on_metadata(self, pdu, now):
         if self.meta is not None or self.state_ != RECEIVING:
             return
+        if pdu.file_size > self.limit():
+            self.entity.stats["oversize"] += 1
+            self.fault(FILESTORE_REJECTION, now)
+            if self.done or self.suspended:
+                return
         dest = pdu.dest_name
         if dest and pdu.source_name and self.entity.fs.is_dir(dest):
             base = pdu.source_name.replace("\\", "/").split("/")[-1]
@@ -211,17 +224,30 @@ class Receiver(Transaction):
             return
         n = len(data)
         end = offset + n
-        if self.eof is not None and end > self.eof[1]:
+        if end > self.limit():
+            # never written, whatever the fault handler says: no sender decides our memory
+            self.entity.stats["oversize"] += 1
+            self.fault(FILESTORE_REJECTION, now)
+            return
+        size = self.eof[1] if self.eof is not None else self.meta["size"] if self.meta else 0
+        if size and end > size:
             if not self.fault(FILE_SIZE_ERROR, now):
                 return
-        self._file().write(offset, data)
+        try:
+            self._file().write(offset, data)
+        except OSError:
+            self.fault(FILESTORE_REJECTION, now)
+            return
         self.received += n
         ck = self.ck
         if ck is not None and ck.offset == offset:
             ck.update(data)
         progress = self.progress
         if offset > progress:
-            self.gaps.append([progress, offset, None])
+            gaps = self.gaps
+            gaps.append([progress, offset, None])
+            if len(gaps) > self.remote.max_gaps:
+                gaps[-2][1] = gaps.pop()[1]  # bounded: the octets between are asked again
             if self.mode == ACKNOWLEDGED and self.remote.immediate_nak and not self.suspended:
                 self.gaps[-1][2] = now
                 self._send_naks([(progress, offset)], progress, end)
@@ -249,6 +275,10 @@ class Receiver(Transaction):
             )
             return
         size = pdu.file_size
+        if size > self.limit():
+            self.entity.stats["oversize"] += 1
+            self.fault(FILESTORE_REJECTION, now)
+            return
         self.eof = (pdu.checksum, size)
         self.indicate("eof_recv", condition=NO_ERROR, size=size)
         if self.progress > size:

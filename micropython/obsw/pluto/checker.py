@@ -98,7 +98,7 @@ class Checker(ExprChecker):
             vt = self.var(s[2], scopes)
             et = self.expr(s[3], scopes)
             if vt:
-                self.assignable(vt, et, s[3], s[3][1])
+                self.assignable(vt, et, s[3], s[3][1], " ".join(s[2][2]))
         elif k == "if":
             self.want_bool(s[2], scopes, "the if condition")
             self.block(s[3], scopes)
@@ -127,7 +127,7 @@ class Checker(ExprChecker):
                     if not _num(t):
                         self.fail(PlutoTypeError, "for bounds must be numbers", e[1])
                     elif vt:
-                        self.assignable(vt, t, e, e[1])
+                        self.assignable(vt, t, e, e[1], " ".join(s[2][2]))
             self.timeout(s[6], scopes)
             self.block(s[7], scopes)
         elif k == "wait":
@@ -225,30 +225,34 @@ class Checker(ExprChecker):
             return None
         return self.var_types[r[5]]
 
-    def assignable(self, vinfo, et, e, p):
+    def assignable(self, vinfo, et, e, p, name=None):
         vt, unit, vals, code = vinfo
         if et[0] == "?" or vt[0] == "?":
             return
+        who = (name + ": ") if name else ""
+        declared = _declared(code, vt)
         if vt[0] == "e":
             if et[0] != "s" and et[0] != "e":
-                self.fail(PlutoTypeError, "enumerated variable needs one of %s" % (vals,), p)
+                self.fail(PlutoTypeError, "%senumerated variable needs one of %s"
+                          % (who, vals), p)  # fmt: skip
             elif e[0] == "c" and vals and e[2] not in vals:
-                self.fail(PlutoTypeError, "%r is not one of %s" % (e[2], ", ".join(vals)), p)
+                self.fail(PlutoTypeError, "%s%r is not one of %s"
+                          % (who, e[2], ", ".join(vals)), p)  # fmt: skip
             return
         if vt[0] in "ir":
             if et[0] not in "ir":
-                self.fail(PlutoTypeError, "cannot assign %s to a %s variable"
-                          % (_show(et), _show(vt)), p)  # fmt: skip
+                self.fail(PlutoTypeError, "%scannot assign %s to %s variable"
+                          % (who, _a(_show(et)), _a(declared)), p)  # fmt: skip
             elif vt[0] == "i" and et[0] == "r":
-                self.fail(PlutoTypeError, "cannot assign a real to an integer variable", p)
+                self.fail(PlutoTypeError, "%scannot assign a real to %s variable"
+                          % (who, _a(declared)), p)  # fmt: skip
             elif et[1] != vt[1] and et[1] != NONE:
-                self.fail(PlutoTypeError, "units do not match: variable has %s"
-                          % (unit or "no units"), p)  # fmt: skip
+                self.fail(PlutoTypeError, "%sunits do not match: variable has %s"
+                          % (who, unit or "no units"), p)  # fmt: skip
             return
         if vt[0] != et[0]:
-            self.fail(
-                PlutoTypeError, "cannot assign %s to a %s variable" % (_show(et), _show(vt)), p
-            )
+            self.fail(PlutoTypeError, "%scannot assign %s to %s variable"
+                      % (who, _a(_show(et)), _a(declared)), p)  # fmt: skip
 
     def ref(self, r, scopes):
         """Resolve a reference node in place and return its type."""
@@ -297,3 +301,25 @@ def check(proc, resolver=None, arguments=None):
         err.errors = c.errors
         raise err
     return c.var_types, c.def_vars
+
+
+_DECLARED = {
+    "b": "Boolean",
+    "i": "signed integer",
+    "u": "unsigned integer",
+    "r": "real",
+    "s": "string",
+    "a": "absolute time",
+    "rt": "relative time",
+}
+
+
+def _declared(code, vt):
+    """The PLUTO type a variable was declared with, as written in the procedure."""
+    if isinstance(code, tuple):
+        return "enumerated " + str(code[1])
+    return _DECLARED.get(code) or _show(vt)
+
+
+def _a(text):
+    return ("an " if text[:1] in "aeiouAEIOU" else "a ") + text

@@ -59,13 +59,15 @@ class ObcpEngine:
     ``system`` is an ``IlSystem`` (or any ``System``; one with ``fork`` gives each procedure
     its own outputs); it also answers the load-time checks unless ``check`` is False.
     ``capacity`` bounds the loaded OBCPs, ``budget`` the statements one procedure runs per
-    ``step``, ``poll`` how often a waiting condition is re-evaluated (seconds).
+    ``step``, ``poll`` how often a waiting condition is re-evaluated (seconds), and
+    ``max_source`` the characters of one procedure text.
     ``on_event(name, payload)`` sees every event (a PUS service 5 bridge), besides the
     interaction layer's subscribers once the engine is provided on a node.
     """
 
-    def __init__(self, system, *, capacity=8, budget=100, poll=1.0, check=True):
+    def __init__(self, system, *, capacity=8, budget=100, poll=1.0, check=True, max_source=65536):
         self.system = system
+        self.max_source = max_source
         self.capacity = capacity
         self.budget = budget
         self.poll = poll
@@ -114,7 +116,21 @@ class ObcpEngine:
                 NO_ROOM, "%d OBCPs loaded, the engine holds %d" % (self.capacity, self.capacity)
             )
         if isinstance(source, (bytes, bytearray)):
-            source = bytes(source).decode()
+            try:
+                source = bytes(source).decode()
+            except UnicodeError:
+                raise rejected(name, PlutoError("procedure text is not UTF-8", 1, 1)) from None
+        if not isinstance(source, str):
+            raise rejected(name, PlutoError("procedure text must be text", 1, 1))
+        if len(source) > self.max_source:
+            raise rejected(
+                name,
+                PlutoError(
+                    "procedure text of %d characters, at most %d" % (len(source), self.max_source),
+                    1,
+                    1,
+                ),
+            )
         arguments = wire_arguments(arguments)
         ob = Obcp(name, source, self._compile(name, source, arguments), arguments)
         self._obcps[name] = ob
@@ -364,6 +380,8 @@ class ObcpEngine:
             return load_program(source, self.system if self.check else None, arguments)
         except PlutoError as e:
             raise rejected(name, e) from None
+        except Exception as e:  # a checker defect refuses this text, it never stops the engine
+            raise rejected(name, PlutoError("%s: %s" % (type(e).__name__, e), 0, 0)) from None
 
     def _in_order(self):
         return [self._obcps[n] for n in self._order]

@@ -11,6 +11,17 @@ class PlutoRuntimeError(ValueError):
         super().__init__(msg)
 
 
+_INT_MIN = -(1 << 63)
+_INT_MAX = (1 << 64) - 1
+
+
+def _bounded(v):
+    """An integer result within PLUTO's 64-bit integers (signed or unsigned), else an error."""
+    if type(v) is int and (v < _INT_MIN or v > _INT_MAX):
+        raise PlutoRuntimeError("integer overflow: %d" % v)
+    return v
+
+
 class _Ask(Exception):
     """An ``ask user`` expression has no answer yet; the statement waits and re-evaluates."""
 
@@ -98,18 +109,23 @@ class Evaluator:
             ta, tb = type(a), type(b)
             if (ta is int or ta is float) and (tb is int or tb is float):
                 if op == "+":
-                    return a + b
+                    return _bounded(a + b)
                 if op == "-":
-                    return a - b
+                    return _bounded(a - b)
                 if op == "*":
-                    return a * b
+                    return _bounded(a * b)
                 if op == "/":
                     if b == 0:
                         raise PlutoRuntimeError("division by zero")
                     return a / b
                 if a == 0 and b < 0:
                     raise PlutoRuntimeError("zero to a negative power")
-                return a**b
+                if ta is int and tb is int and b > 64 and (a > 1 or a < -1):
+                    raise PlutoRuntimeError("integer overflow: %d ** %d" % (a, b))
+                try:
+                    return _bounded(a**b)
+                except OverflowError:
+                    raise PlutoRuntimeError("%r ** %r is out of range" % (a, b)) from None
             try:
                 return units.arith(op, a, b)
             except ZeroDivisionError:

@@ -16,6 +16,9 @@ OBJECT_TYPES = ("variable", "parameter", "argument", "activity", "event", "step"
 RELOPS = ("=", "!=", "<", ">", "<=", ">=")
 _TIME_ORDER = ("d", "h", "min", "s")
 SUBJECT = ("subj", 0)  # the value a case statement tests, in its case tags
+# Deepest nesting of blocks, parentheses and operators the parser takes: the parser, the
+# checker and the interpreter walk the tree recursively, and a board's stack is small.
+MAX_NESTING = 12
 
 
 def _show(tok):
@@ -30,6 +33,13 @@ class ExprParser:
     def __init__(self, tokens):
         self.toks = tokens
         self.i = 0
+        self.depth = 0
+
+    def enter(self):
+        """One level deeper (a block, a parenthesis, an operator); refused past the limit."""
+        self.depth += 1
+        if self.depth > MAX_NESTING:
+            self.err("nesting deeper than %d levels" % MAX_NESTING)
 
     # token helpers
     def tok(self, k=0):
@@ -165,10 +175,21 @@ class ExprParser:
         if self.isop("**"):
             p = self.pos()
             self.i += 1
-            return ("b", p, "**", base, self.factor())
+            self.enter()
+            try:
+                return ("b", p, "**", base, self.factor())
+            finally:
+                self.depth -= 1
         return base
 
     def simple(self):
+        self.enter()
+        try:
+            return self._simple()
+        finally:
+            self.depth -= 1
+
+    def _simple(self):
         t = self.toks[self.i]
         k, v, p = t
         if k == NUM or k == RELT or k == ABST or k == STR:

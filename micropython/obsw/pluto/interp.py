@@ -140,7 +140,7 @@ class Procedure(Statements):
         except _Abort as e:
             gen.close()
             self._finish(ABORTED, str(e))
-        except (PlutoRuntimeError, UnitError, TypeError, ValueError, ZeroDivisionError, _Ask) as e:
+        except (PlutoRuntimeError, UnitError, TypeError, ValueError, ArithmeticError, _Ask) as e:
             gen.close()
             self._finish(ABORTED, "runtime error at line %d: %s" % (self._line(), e))
         finally:
@@ -159,9 +159,8 @@ class Procedure(Statements):
         self.state = "finished"
         self.outcome = outcome
         self.error = error
-        self.question = None
-        if error:
-            self.system.log("procedure %s: %s" % (outcome, error))
+        self.question = None  # outcome and error are the status; the log holds only what
+        # log statements wrote
 
     def _procedure(self):
         d = self.program.ast

@@ -123,6 +123,9 @@ def _digits(src, i, n):
     return j
 
 
+_MAX_DIGITS = 40  # a 64-bit integer has 20 digits; a real 17 significant ones and an exponent
+
+
 def _number(src, i, n, out, p):
     if src[i] == "0" and src[i + 1 : i + 2] in ("x", "X"):
         j = i + 2
@@ -130,6 +133,8 @@ def _number(src, i, n, out, p):
             j += 1
         if j == i + 2:
             raise PlutoSyntaxError("hexadecimal constant needs digits", *line_col(p))
+        if j - i - 2 > 16:
+            raise PlutoSyntaxError("hexadecimal constant longer than 64 bits", *line_col(p))
         out.append((NUM, int(src[i + 2 : j], 16), p))
         return j
     j = _digits(src, i, n)
@@ -147,7 +152,7 @@ def _number(src, i, n, out, p):
         while k < n and (isdigits(src[k]) or src[k] in ":."):
             k += 1
         parts = src[i:k].split(":")
-        if len(parts) not in (4, 5):
+        if len(parts) not in (4, 5) or not _relative_parts(parts):
             raise PlutoSyntaxError("malformed relative time %r" % src[i:k], *line_col(p))
         v = int(parts[0]) * 86400 + int(parts[1]) * 3600 + int(parts[2]) * 60 + int(parts[3])
         if len(parts) == 5 and parts[4]:
@@ -165,5 +170,22 @@ def _number(src, i, n, out, p):
         if isdigits(src[k : k + 1]):
             j = _digits(src, k, n)
             real = True
-    out.append((NUM, float(src[i:j]) if real else int(src[i:j]), p))
+    if j - i > _MAX_DIGITS:
+        raise PlutoSyntaxError(
+            "numeric constant of %d characters, at most %d" % (j - i, _MAX_DIGITS), *line_col(p)
+        )
+    v = float(src[i:j]) if real else int(src[i:j])
+    if real and (v - v != 0):  # inf: beyond the largest real
+        raise PlutoSyntaxError("real constant out of range: %s" % src[i:j], *line_col(p))
+    out.append((NUM, v, p))
     return j
+
+
+def _relative_parts(parts):
+    """d:hh:mm:ss[:fff]: digits only, hours, minutes and seconds in range."""
+    for k, part in enumerate(parts):
+        if not part or not isdigits(part) or len(part) > 9:
+            return False
+        if k in (1, 2, 3) and (len(part) != 2 or int(part) > (23, 59, 59)[k - 1]):
+            return False
+    return True

@@ -4,8 +4,12 @@ A procedure or step definition is ``("def", pos, decls, preconditions, main, wat
 confirmation)``; statements are tuples tagged by their first item (see README, PLUTO section).
 """
 
-from obsw.pluto.exprs import SUBJECT, ExprParser, _show
-from obsw.pluto.lexer import EOF, STR, WORD, tokenize
+from obsw.pluto.exprs import MAX_NESTING, SUBJECT, ExprParser, _show
+from obsw.pluto.lexer import EOF, STR, WORD, PlutoSyntaxError, line_col, tokenize
+
+# Deepest tree (tuples and lists) a procedure may give: long operator chains such as
+# 1 + 1 + ... + 1 nest without any parenthesis.
+MAX_TREE_DEPTH = 6 * MAX_NESTING
 
 _STATUS = (("confirmed",), ("not", "confirmed"), ("aborted",))
 _MAIN_STOPS = ("end", "watchdog", "confirmation")
@@ -17,7 +21,24 @@ _PROC_ONLY = (
 
 def parse(src):
     """Parse procedure text into its definition node; raises PlutoSyntaxError."""
-    return Parser(tokenize(src)).procedure()
+    tree = Parser(tokenize(src)).procedure()
+    check_depth(tree)
+    return tree
+
+
+def check_depth(tree):
+    """PlutoSyntaxError at the first node nested deeper than MAX_TREE_DEPTH (no recursion)."""
+    stack = [(tree, 1, 0)]
+    while stack:
+        node, depth, p = stack.pop()
+        if len(node) > 1 and type(node[0]) is str and type(node[1]) is int:
+            p = node[1]
+        if depth > MAX_TREE_DEPTH:
+            raise PlutoSyntaxError("nesting deeper than %d levels" % MAX_NESTING, *line_col(p))
+        for child in node:
+            t = type(child)
+            if (t is tuple or t is list) and child:
+                stack.append((child, depth + 1, p))
 
 
 class Parser(ExprParser):
@@ -119,10 +140,12 @@ class Parser(ExprParser):
         return out
 
     def stmts(self, step, stops):
+        self.enter()
         out = []
         while True:
             t = self.tok()
             if t[0] == EOF or (t[0] == WORD and t[1] in stops):
+                self.depth -= 1
                 return out
             out.append(self.statement(step))
             self.expect(";", after="after the statement")

@@ -207,6 +207,14 @@ def dims(text):
     return parse(text)[1] if text else NONE
 
 
+def _decimal(ratio):
+    """True when ``ratio`` is a power of ten (a change of decimal prefix only)."""
+    p = 1.0
+    while p < ratio and p < 1e40:
+        p *= 10
+    return p == ratio
+
+
 class Quantity:
     """A number with an engineering unit: ``Quantity(5, "V")``."""
 
@@ -225,7 +233,17 @@ class Quantity:
         s2, d2 = parse(unit)
         if d1 != d2:
             raise UnitError("cannot convert %s to %s" % (self.unit, unit))
-        v = (self.value * s1 + _OFFSET.get(self.unit, 0) - _OFFSET.get(unit, 0)) / s2
+        off = _OFFSET.get(self.unit, 0) - _OFFSET.get(unit, 0)
+        ratio = s1 / s2 if s1 >= s2 else s2 / s1
+        if off:
+            v = (self.value * s1 + off) / s2
+        elif s1 >= s2:
+            v = self.value * ratio
+        else:
+            v = self.value / ratio
+        if not off and type(v) is float and v - v == 0 and _decimal(ratio):
+            # decimal prefixes are not exact in binary: 3300 mV is 3.3 V, not 3.3000000000000003
+            v = float("%.15g" % v)
         if type(self.value) is int and v == int(v):
             v = int(v)
         return Quantity(v, unit)
@@ -296,25 +314,48 @@ def iso(seconds):
         y, mo, d, rem // 3600, rem // 60 % 60, rem % 60, ms)  # fmt: skip
 
 
+def _field(text, lo, hi):
+    """An unsigned decimal field within lo..hi (ValueError otherwise, also for '' or '+1')."""
+    if not text or not isdigits(text) or len(text) > 9:
+        raise ValueError
+    v = int(text)
+    if not lo <= v <= hi:
+        raise ValueError
+    return v
+
+
+_MONTH_DAYS = (31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31)
+
+
 def parse_iso(text):
-    """Seconds since the Unix epoch of ``YYYY-MM-DDThh:mm:ss[.f][Z]`` or ``YYYY-DDDThh:mm:ss``."""
+    """Seconds since the Unix epoch of ``YYYY-MM-DDThh:mm:ss[.f][Z]`` or ``YYYY-DDDThh:mm:ss``;
+    every field checked against its range (a leap second, ss = 60, is taken)."""
     t = text[:-1] if text.endswith("Z") else text
     try:
         date, clock = t.split("T")
         parts = date.split("-")
+        if len(parts[0]) != 4:
+            raise ValueError
+        year = _field(parts[0], 1, 9999)
         if len(parts) == 3:
-            days = _days_from_civil(int(parts[0]), int(parts[1]), int(parts[2]))
+            month = _field(parts[1], 1, 12)
+            days = _days_from_civil(year, month, _field(parts[2], 1, _MONTH_DAYS[month - 1]))
         elif len(parts) == 2:
-            days = _days_from_civil(int(parts[0]), 1, 1) + int(parts[1]) - 1
+            days = _days_from_civil(year, 1, 1) + _field(parts[1], 1, 366) - 1
         else:
             raise ValueError
         hms = clock.split(":")
+        if len(hms) != 3:
+            raise ValueError
         sec = hms[2]
         frac = 0
         if "." in sec:
             sec, f = sec.split(".")
-            frac = int(f) / 10 ** len(f) if f else 0
-        whole = days * 86400 + int(hms[0]) * 3600 + int(hms[1]) * 60 + int(sec)
+            if not f or not isdigits(f) or len(f) > 9:
+                raise ValueError
+            frac = int(f) / 10 ** len(f)
+        whole = days * 86400 + _field(hms[0], 0, 23) * 3600 + _field(hms[1], 0, 59) * 60
+        whole += _field(sec, 0, 60)
     except (ValueError, IndexError):
         raise UnitError("not an absolute time: %r" % text) from None
     return whole + frac if frac else whole

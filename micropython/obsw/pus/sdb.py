@@ -31,8 +31,7 @@ A type is a name (``uint8`` .. ``uint64``, ``int8`` .. ``int64``, ``float32``, `
 ``octets``) or a ``[ptc, pfc]`` pair. ``load``/``loads`` check that every id is unique.
 """
 
-import json
-
+from obsw import jsonsafe
 from obsw.pus.fields import field
 from obsw.pus.structure import Structure
 
@@ -474,7 +473,7 @@ _KNOWN = (
 def parse_json(text):
     """The one place the database's JSON text is parsed."""
     try:
-        return json.loads(text)
+        return jsonsafe.loads(text)
     except ValueError as e:
         raise SdbError("spacecraft database is not valid JSON: %s" % e) from None
 

@@ -22,7 +22,7 @@ from obsw.pus.packets import ACK_ALL
 from obsw.pus.services.s01_verification import FAILURE_NAMES
 from obsw.pus.services.s12_layouts import STATUS_NAMES
 
-from obsw_host.yamcs.xtce_types import argument_type, bits_of, parameter_type
+from obsw_host.yamcs.xtce_types import argument_type, parameter_type
 
 XTCE_NS = "http://www.omg.org/spec/XTCE/20180204"
 U8, U16, U32, E8, E16 = (3, 4), (3, 12), (3, 14), (2, 8), (2, 16)

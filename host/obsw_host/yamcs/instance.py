@@ -1,8 +1,9 @@
 """A complete Yamcs instance for the spacecraft: server and instance configuration, MDB, SQL.
 
 ``write_instance(folder, spacecraft, ...)`` writes ``etc/`` (yamcs.yaml, yamcs.INSTANCE.yaml,
-processor.yaml, extra_streams.sql, events.json), ``mdb/MISSION.xml`` and the CFDP buckets
-``files/up`` (Yamcs sends from there) and ``files/down`` (what Yamcs receives). Yamcs is
+processor.yaml, extra_streams.sql, events.json), ``mdb/MISSION.xml`` and the CFDP buckets of
+each instance, ``files/INSTANCE/up`` (Yamcs sends from there) and ``files/INSTANCE/down``
+(what Yamcs receives). Yamcs is
 started with that folder as its working directory (see ``server``).
 
 Two link modes, every socket on loopback:
@@ -150,7 +151,6 @@ def links(mode, ports, scid=SCID):
             "name": "tm_frames",
             "class": "org.yamcs.tctm.ccsds.UdpTmFrameLink",
             "port": ports["tm_frames"],
-            "initialBytesToStrip": 4,
             "frameType": "TM",
             "spacecraftId": scid,
             "frameLength": 256,
@@ -286,26 +286,37 @@ def cfdp_sql(apid):
 
 
 def write_instance(
-    folder, spacecraft, mode="packets", ports=None, http_port=HTTP_PORT, mdb_name=None
+    folder, spacecraft, mode="packets", ports=None, http_port=HTTP_PORT, instances=None
 ):
-    """Write the Yamcs instance for ``spacecraft`` into ``folder``; returns the MDB path."""
-    ports = dict(PORTS, **(ports or {}))
+    """Write a Yamcs server for ``spacecraft`` into ``folder``: one instance named ``obsw`` with
+    ``mode`` links on ``ports``, or the ``instances`` given as {name: (mode, ports)} (one
+    server, several instances). Returns the MDB path."""
+    instances = instances or {INSTANCE: (mode, ports)}
     etc = os.path.join(folder, "etc")
     mdb = os.path.join(folder, "mdb")
-    for d in (
-        etc,
-        mdb,
-        os.path.join(folder, "files", "up"),
-        os.path.join(folder, "files", "down"),
-    ):
-        os.makedirs(d, exist_ok=True)
-    mdb_name = mdb_name or "%s.xml" % spacecraft.mission
+    os.makedirs(etc, exist_ok=True)
+    os.makedirs(mdb, exist_ok=True)
+    mdb_name = "%s.xml" % spacecraft.mission
     with open(os.path.join(mdb, mdb_name), "w") as f:
         f.write(generate(spacecraft))
     with open(os.path.join(etc, "events.json"), "w") as f:
         json.dump(event_templates(spacecraft), f, indent=1)
     ground = spacecraft.filestores.get("GROUND", 1)
     sat = spacecraft.filestores.get("SAT", 2)
+    buckets = []
+    files = {}
+    for name, (mode_, ports_) in instances.items():
+        for way in ("up", "down"):
+            path = os.path.join("files", name, way)
+            os.makedirs(os.path.join(folder, path), exist_ok=True)
+            buckets.append({"name": "%s_%s" % (name, way), "path": path})
+        config = instance_config(
+            spacecraft, mode_, dict(PORTS, **(ports_ or {})), "mdb/" + mdb_name, ground, sat
+        )
+        cfdp = config["services"][-1]["args"]
+        cfdp["incomingBucket"] = name + "_down"
+        cfdp["localEntities"][0]["bucket"] = name + "_up"
+        files["yamcs.%s.yaml" % name] = _yaml(config)
     server = {
         "services": [
             {
@@ -314,21 +325,13 @@ def write_instance(
             }
         ],
         "dataDir": "data",
-        "instances": [INSTANCE],
+        "instances": list(instances),
         "secretKey": "obsw-local-only",
-        "buckets": [
-            {"name": "cfdpUp", "path": "files/up"},
-            {"name": "cfdpDown", "path": "files/down"},
-        ],
+        "buckets": buckets,
     }
-    files = {
-        "yamcs.yaml": _yaml(server),
-        "yamcs.%s.yaml" % INSTANCE: _yaml(
-            instance_config(spacecraft, mode, ports, "mdb/" + mdb_name, ground, sat)
-        ),
-        "processor.yaml": _yaml(PROCESSOR),
-        "extra_streams.sql": cfdp_sql(spacecraft.apid("cfdp", 100)),
-    }
+    files["yamcs.yaml"] = _yaml(server)
+    files["processor.yaml"] = _yaml(PROCESSOR)
+    files["extra_streams.sql"] = cfdp_sql(spacecraft.apid("cfdp", 100))
     for name, text in files.items():
         with open(os.path.join(etc, name), "w") as f:
             f.write(text + "\n")

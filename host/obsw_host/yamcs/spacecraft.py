@@ -31,13 +31,15 @@ from obsw_host.yamcs.gateway import PacketGateway
 from obsw_host.yamcs.instance import CFDP_VC, SCID
 
 LOOPBACK = "127.0.0.1"
+ASM = b"\x1a\xcf\xfc\x1d"
 
 
 class UdpFrameLink:
     """A frame processor link on UDP: reads what Yamcs sends, writes to ``peer``.
 
     ``drop(data)`` (optional) returns True for a datagram to lose on the way in, to show
-    COP-1 recovering a lost frame.
+    COP-1 recovering a lost frame. What goes out is a CADU less its attached sync marker: the
+    ground station's frame synchroniser hands Yamcs one transfer frame per datagram.
     """
 
     def __init__(self, peer, port=0, drop=None):
@@ -67,7 +69,7 @@ class UdpFrameLink:
     def write(self, data):
         if self.enabled and self.peer is not None:
             try:
-                self.sock.sendto(data, self.peer)
+                self.sock.sendto(data[len(ASM) :], self.peer)
             except OSError:
                 pass  # nobody listening yet: the frame is lost, as on a radio link
 
@@ -161,7 +163,8 @@ class SampleSpacecraft:
                 entity, (LOOPBACK, 0), {ground: tm_input}, apid=cfdp_apid, packet_type=TYPE_TM
             )
             self.indications = []
-            self.cfdp.on_indication = self.indications.append
+            self._indicated = threading.Condition()
+            self.cfdp.on_indication = self._indication
         except Exception:
             self.close()
             raise
@@ -237,6 +240,18 @@ class SampleSpacecraft:
                 self.ground_entity, name, dest_name or name, mode=mode, now=time.monotonic()
             )
         )
+
+    def _indication(self, ind):
+        with self._indicated:
+            self.indications.append(ind)
+            self._indicated.notify_all()
+
+    def wait_finished(self, tid=None, role=None, timeout=30.0):
+        """The first 'finished' indication of ``tid`` / ``role``; None after ``timeout`` s."""
+        with self._indicated:
+            self._indicated.wait_for(lambda: self.finished(tid, role), timeout)
+            found = self.finished(tid, role)
+        return found[0] if found else None
 
     def finished(self, tid=None, role=None):
         """The 'finished' indications so far (of ``tid``, of ``role`` 'S' or 'R')."""

@@ -84,8 +84,23 @@ class Ground:
         self.startup = time.monotonic() - started
         self.client = YamcsClient("127.0.0.1:%d" % self.http_port)
         self.connections = {}
-        link = self.client.get_link("frames", "tc_frames.vc0")
-        link.initialize_cop1("WITH_CLCW_CHECK", clcw_wait_timeout=10)
+        self.cop1 = self.client.get_link("frames", "tc_frames.vc0")
+        self.initialize_cop1()
+
+    def initialize_cop1(self):
+        """Initialise AD with a CLCW check, as an operator would, and wait for 'active'."""
+        active = threading.Event()
+
+        def on_status(status):
+            if status.state == "ACTIVE":
+                active.set()
+
+        sub = self.cop1.create_cop1_subscription(on_status)
+        try:
+            self.cop1.initialize_cop1("WITH_CLCW_CHECK", clcw_wait_timeout=10)
+            assert active.wait(TIMEOUT), "COP-1 did not become active"
+        finally:
+            sub.cancel()
 
     def processor(self, name):
         return self.client.get_processor(name, "realtime")

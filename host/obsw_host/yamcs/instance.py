@@ -10,7 +10,8 @@ Two link modes, every socket on loopback:
 - ``packets``: Yamcs connects by TCP to the packet gateway (``gateway.PacketGateway``): one
   connection carries PUS TM and TC, one carries CFDP TM; TCs go out on the first.
 - ``frames``: Yamcs sends TC transfer frames in CLTUs by UDP to the frame processor (its FOP-1
-  runs COP-1 against our FARM-1 on VC 0) and receives TM transfer frames by UDP (virtual
+  runs COP-1 against our FARM-1 on VC 0; no segment header, since Yamcs 5.12.8 fails on MAP
+  IDs for the commands of its own services, CFDP's among them) and receives TM transfer frames by UDP (virtual
   channels 0 real time, 1 playback, 2 CFDP, 6 essential; idle frames and the CLCW in the
   OCF).
 """
@@ -137,7 +138,6 @@ def links(mode, ports, scid=SCID):
                 {
                     "vcId": 0,
                     "service": "PACKET",
-                    "mapId": 0,
                     "stream": "tc_realtime",
                     "commandPostprocessorClassName": "org.yamcs.pus.PusCommandPostprocessor",
                     "commandPostprocessorArgs": PUS_TC_ARGS,
@@ -315,7 +315,7 @@ def write_instance(
         )
         cfdp = config["services"][-1]["args"]
         cfdp["incomingBucket"] = name + "_down"
-        cfdp["localEntities"][0]["bucket"] = name + "_up"
+        cfdp["localEntities"][0]["bucket"] = name + "_down"  # where files to it land
         files["yamcs.%s.yaml" % name] = _yaml(config)
     server = {
         "services": [

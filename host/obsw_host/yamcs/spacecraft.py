@@ -5,7 +5,8 @@ with the sample solar panel (``obsw_host.pus.onboard.Onboard``), the on-board CF
 (``obsw_host.cfdp.link.UdpEntity``, files under ``root``) and, for ``mode``:
 - ``packets``: the packet gateway (Yamcs' TCP packet links <-> the processes' UDP);
 - ``frames``: the frame processor (``obsw_host.frames.processor.FrameProcessorHost``) with
-  link A on UDP: CLTUs from Yamcs in, TM CADUs out to Yamcs' frame link (link B idle).
+  link A on UDP: CLTUs from Yamcs in, TM frames out to Yamcs' frame link (link B idle); TC
+  frames without segment header (the MAP service), TM frames not randomized.
 ``ports()`` gives the ground ports to write into the Yamcs instance. Everything listens on
 127.0.0.1 only; ports are chosen by the system unless given.
 """
@@ -135,6 +136,7 @@ class SampleSpacecraft:
                     tm_plan={},
                     tm_vc_of_apid={cfdp_apid: CFDP_VC},
                     tm_randomize=False,
+                    segment_header=False,
                     clcw_period=0.2,
                 )
                 tm_input = (LOOPBACK, self.processor.tm_port)

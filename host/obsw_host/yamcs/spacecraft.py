@@ -248,12 +248,13 @@ class SampleSpacecraft:
             self.indications.append(ind)
             self._indicated.notify_all()
 
-    def wait_finished(self, tid=None, role=None, timeout=30.0):
-        """The first 'finished' indication of ``tid`` / ``role``; None after ``timeout`` s."""
+    def wait_finished(self, tid=None, role=None, timeout=30.0, count=1):
+        """The ``count``-th 'finished' indication of ``tid`` / ``role``; None after ``timeout``
+        seconds."""
         with self._indicated:
-            self._indicated.wait_for(lambda: self.finished(tid, role), timeout)
+            self._indicated.wait_for(lambda: len(self.finished(tid, role)) >= count, timeout)
             found = self.finished(tid, role)
-        return found[0] if found else None
+        return found[count - 1] if len(found) >= count else None
 
     def finished(self, tid=None, role=None):
         """The 'finished' indications so far (of ``tid``, of ``role`` 'S' or 'R')."""

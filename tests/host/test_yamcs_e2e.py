@@ -332,3 +332,32 @@ def test_lost_frame_is_retransmitted_by_cop1(ground):
     assert cmd.is_success(), cmd.error
     assert ground.drop.lost == before + 1
     assert counters["accepted"] == accepted + 1  # the retransmitted frame, once
+
+
+def _socket_inodes(pid):
+    inodes = set()
+    fd_dir = "/proc/%d/fd" % pid
+    for fd in os.listdir(fd_dir):
+        try:
+            target = os.readlink(os.path.join(fd_dir, fd))
+        except OSError:
+            continue
+        if target.startswith("socket:["):
+            inodes.add(target[8:-1])
+    return inodes
+
+
+def test_yamcs_listens_on_loopback_only(ground):
+    if not os.path.exists("/proc/net/udp"):
+        pytest.skip("no /proc/net to inspect sockets on this system")
+    inodes = _socket_inodes(ground.yamcs.process.pid)
+    loopback = ("0100007F", "00000000000000000000000001000000")
+    listening = []
+    for table, listen_state in (("tcp", "0A"), ("tcp6", "0A"), ("udp", None), ("udp6", None)):
+        with open("/proc/net/" + table) as f:
+            for row in f.read().splitlines()[1:]:
+                cols = row.split()
+                if cols[9] in inodes and (listen_state is None or cols[3] == listen_state):
+                    listening.append((table, cols[1]))
+    assert listening, "found none of Yamcs' sockets"
+    assert [x for x in listening if x[1].split(":")[0] not in loopback] == []

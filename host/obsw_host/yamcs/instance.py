@@ -11,9 +11,9 @@ Two link modes, every socket on loopback:
   connection carries PUS TM and TC, one carries CFDP TM; TCs go out on the first.
 - ``frames``: Yamcs sends TC transfer frames in CLTUs by UDP to the frame processor (its FOP-1
   runs COP-1 against our FARM-1 on VC 0; no segment header, since Yamcs 5.12.8 fails on MAP
-  IDs for the commands of its own services, CFDP's among them) and receives TM transfer frames by UDP (virtual
-  channels 0 real time, 1 playback, 2 CFDP, 6 essential; idle frames and the CLCW in the
-  OCF).
+  IDs for the commands of its own services, CFDP's among them) and receives TM transfer
+  frames by UDP (virtual channels 0 real time, 1 playback, 2 CFDP, 6 essential; idle frames
+  and the CLCW in the OCF).
 """
 
 import json

@@ -67,6 +67,39 @@ def command(folder, *extra):
     ] + list(extra)
 
 
+GUARD_SOURCE = os.path.join(os.path.dirname(__file__), "loopback_bind.c")
+
+
+def loopback_guard(folder):
+    """Environment that keeps every socket Yamcs binds on loopback (``loopback_bind.c``
+    preloaded; built with the C compiler into ``folder``), or None without a compiler."""
+    cc = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
+    if cc is None:
+        return None
+    lib = os.path.join(folder, "loopback_bind.so")
+    if not os.path.exists(lib):
+        p = subprocess.run(
+            [cc, "-shared", "-fPIC", "-O2", "-o", lib, GUARD_SOURCE, "-ldl"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+        )
+        if p.returncode != 0:
+            return None
+    return {"LD_PRELOAD": lib}
+
+
+def binds_any_address(folder):
+    """True if the configuration has a link that binds all interfaces (Yamcs' UDP TM links)."""
+    etc = os.path.join(folder, "etc")
+    for name in os.listdir(etc):
+        if name.startswith("yamcs.") and name.endswith(".yaml"):
+            with open(os.path.join(etc, name)) as f:
+                text = f.read()
+            if "UdpTmFrameLink" in text or "UdpTmDataLink" in text:
+                return True
+    return False
+
+
 def check(folder, timeout=120):
     """Run Yamcs' own validation (``--check``) on the folder; returns (ok, output)."""
     p = subprocess.run(
@@ -99,6 +132,13 @@ class Yamcs:
         """Start Yamcs and return once the instance runs (TimeoutError, with the log's tail,
         if it does not within ``timeout`` s or the process ends)."""
         env = dict(os.environ)
+        guard = loopback_guard(self.folder)
+        if guard is None and binds_any_address(self.folder):
+            raise YamcsUnavailable(
+                "this configuration's UDP TM link would listen on every interface; keeping it "
+                "on loopback needs a C compiler (apt-get install gcc)"
+            )
+        env.update(guard or {})
         env.update(self.env or {})
         log = open(self.log_path, "w")
         self.process = subprocess.Popen(

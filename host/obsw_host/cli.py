@@ -18,6 +18,7 @@ COMMANDS = (
     "cfdp",
     "pluto",
     "board",
+    "yamcs",
 )
 
 

@@ -13,6 +13,7 @@ import time
 import urllib.error
 import urllib.request
 
+VERSION = "5.12.8"
 JAVA_HINT = "apt-get install openjdk-17-jre-headless"
 BUNDLE_HINT = "pip install fprime-yamcs-bundle==5.12.8.0 (tools/bootstrap installs it)"
 

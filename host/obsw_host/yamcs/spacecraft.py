@@ -8,7 +8,8 @@ with the sample solar panel (``obsw_host.pus.onboard.Onboard``), the on-board CF
   link A on UDP: CLTUs from Yamcs in, TM frames out to Yamcs' frame link (link B idle); TC
   frames without segment header (the MAP service), TM frames not randomized.
 ``ports()`` gives the ground ports to write into the Yamcs instance. Everything listens on
-127.0.0.1 only; ports are chosen by the system unless given.
+127.0.0.1 only; ports are chosen by the system unless ``ports`` gives them (``pus``,
+``cfdp``: the gateway's TCP ports; ``cltu``: the frame processor's UDP port for CLTUs).
 """
 
 import collections
@@ -91,7 +92,9 @@ class SampleSpacecraft:
         drop=None,
         sat_entity=None,
         ground_entity=None,
+        ports=None,
     ):
+        ports = ports or {}
         self.mode = mode
         self.sdb = sdb_module.load(sdb_path)
         self.panel = SolarPanel()
@@ -111,7 +114,9 @@ class SampleSpacecraft:
         try:
             if mode == "packets":
                 self.gateway = PacketGateway(
-                    tcp_ports={"pus": 0, "cfdp": 0}, apids={"cfdp": [cfdp_apid]}, tm_port=0
+                    tcp_ports={"pus": ports.get("pus", 0), "cfdp": ports.get("cfdp", 0)},
+                    apids={"cfdp": [cfdp_apid]},
+                    tm_port=0,
                 )
                 tm_input = self.gateway.tm_address
             elif mode == "frames":
@@ -123,7 +128,7 @@ class SampleSpacecraft:
                 plan = tm_plan()
                 channels = plan_channels(plan) + [TmVirtualChannel(CFDP_VC, 0, 1 << 20, "cfdp")]
                 peer = (LOOPBACK, tm_frames_port) if tm_frames_port else None
-                self.link_a = UdpFrameLink(peer, drop=drop)
+                self.link_a = UdpFrameLink(peer, ports.get("cltu", 0), drop=drop)
                 self.link_b = UdpFrameLink(None)
                 self.link_b.enabled = False
                 self.processor = FrameProcessorHost(

@@ -29,6 +29,10 @@ U8, U16, U32, E8, E16 = (3, 4), (3, 12), (3, 14), (2, 8), (2, 16)
 SEVERITY_LEVELS = {1: "watch", 2: "warning", 3: "distress", 4: "critical"}
 
 
+class XtceNameError(ValueError):
+    """Two things of the database would get one name in the mission database."""
+
+
 def _sub(parent, tag, **attrs):
     return ET.SubElement(parent, tag, {k: str(v) for k, v in attrs.items()})
 
@@ -385,6 +389,8 @@ class Generator:
     def command(self, system, name, msg_type, fields=(), description=None):
         """A MetaCommand on ``pus_tc``: ``fields`` are ('fixed', name, value, bits) or
         ('arg', name, argument type element)."""
+        if any(c.get("name") == name for c in system.commands):
+            raise XtceNameError("two commands named %s/%s" % (system.path, name))
         cmd = ET.Element("MetaCommand", name=name)
         if description:
             cmd.set("shortDescription", description)

@@ -10,8 +10,8 @@
   types, units, calibrations and alarm limits where the database gives them;
 - the telecommands: an abstract ``pus_tc`` whose verifiers follow the service 1 reports
   (acceptance, start, completion, by APID and sequence count), services 3, 5, 8 (one command
-  per function with its typed arguments), 11, 12, 17, 18, 20 (one set command per writable
-  parameter, its range checked) and 23.
+  per function with its typed arguments), 11, 12 (a limit check for each parameter with
+  limits), 17, 18, 20 (one set command per writable parameter, its range checked) and 23.
 """
 
 import xml.etree.ElementTree as ET
@@ -554,6 +554,52 @@ class Generator:
                 "TC[20,3] set %s" % p.qualified,
             )
 
+    def monitor_commands(self):
+        """TC[12,5] for each parameter with limits: a limit check with the database's critical
+        range as default limits (then TC[12,1] enables it)."""
+        labels = {e.id: _label(e.qualified) for e in self.sc.events.values()}
+        labels[0] = "none"
+        for pid in sorted(self.sc.params):
+            p = self.sc.params[pid]
+            if not p.limits or p.pair[0] not in (2, 3, 4, 5):
+                continue
+            low, high = p.limits.get("critical") or p.limits.get("warning")
+            s = self.system_of(p.path[:-1])
+            fields = [("fixed", "n", 1, 16), ("arg", "pmon", argument_type("", U16))]
+            fields += [
+                ("fixed", "parameter", pid, 16),
+                ("fixed", "validity", 0, 16),
+                ("fixed", "validity_mask", 0, 32),
+                ("fixed", "validity_value", 0, 32),
+                ("arg", "interval", argument_type("", U16, valid=(1, 65535))),
+                ("arg", "repetitions", argument_type("", U16, valid=(1, 65535))),
+                ("fixed", "check", 1, 8),
+                ("arg", "low", argument_type("", p.pair, p.unit)),
+                ("arg", "low_event", argument_type("", E16, labels=labels)),
+                ("arg", "high", argument_type("", p.pair, p.unit)),
+                ("arg", "high_event", argument_type("", E16, labels=labels)),
+            ]
+            name = "monitor_" + _label(p.path[-1])
+            self.command(
+                s,
+                name,
+                M.TC_MON_ADD_PARAMETER_MONITORING,
+                fields,
+                "TC[12,5] limit check of %s" % p.qualified,
+            )
+            cmd = s.commands[-1]
+            defaults = {
+                "interval": 1,
+                "repetitions": 1,
+                "low": low,
+                "high": high,
+                "low_event": "none",
+                "high_event": "none",
+            }
+            for a in cmd.find("ArgumentList"):
+                if a.get("name") in defaults and defaults[a.get("name")] is not None:
+                    a.set("initialValue", str(defaults[a.get("name")]))
+
     def function_commands(self):
         for fid in sorted(self.sc.functions):
             f = self.sc.functions[fid]
@@ -578,6 +624,7 @@ class Generator:
         self.tc_base()
         self.service_commands()
         self.parameter_commands()
+        self.monitor_commands()
         self.function_commands()
         return self.root.element()
 

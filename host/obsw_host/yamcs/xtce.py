@@ -596,8 +596,13 @@ class Generator:
                 "low_event": "none",
                 "high_event": "none",
             }
+            if p.calibration or p.pair[0] != 5:  # on-board limits are raw integer values
+                for key in ("low", "high"):
+                    v = defaults[key]
+                    ok = v is not None and not p.calibration and float(v).is_integer()
+                    defaults[key] = int(v) if ok else None
             for a in cmd.find("ArgumentList"):
-                if a.get("name") in defaults and defaults[a.get("name")] is not None:
+                if defaults.get(a.get("name")) is not None:
                     a.set("initialValue", str(defaults[a.get("name")]))
 
     def function_commands(self):

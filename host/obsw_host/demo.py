@@ -16,6 +16,7 @@ SECTIONS = (
     ("OBCPs: ground uploads a PLUTO procedure with service 18", "obsw_host.pus.obcp_demo", "run"),
     ("Reconfiguration module: two MicroPython controllers", "obsw_host.reconfig_sim", "demo"),
     ("The whole OBC: the 12-step chain and its faults", "obsw_host.obc.chain", "demo"),
+    ("Mission control: Yamcs operates the sample spacecraft", "obsw_host.yamcs.demo", "run"),
 )
 
 

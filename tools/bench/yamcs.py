@@ -49,7 +49,7 @@ def bench_sdb(structures, folder):
     return path
 
 
-def source_obsw(target, rate, seconds, folder):
+def source_obsw(target, rate, seconds, folder, apid=10):
     """Child: the on-board PUS process reporting ``rate`` HK packets per second."""
     from obsw import sdb as sdb_module
     from obsw_host.pus.onboard import Onboard
@@ -58,7 +58,12 @@ def source_obsw(target, rate, seconds, folder):
     structures = max(1, round(rate * PERIOD))
     sdb = sdb_module.load(bench_sdb(structures, folder))
     onboard = Onboard(
-        sdb, port=0, period=PERIOD, tm_to=target, components=[(SOLAR_PANEL, SolarPanel())]
+        sdb,
+        apid=apid,
+        port=0,
+        period=PERIOD,
+        tm_to=target,
+        components=[(SOLAR_PANEL, SolarPanel())],
     )
     onboard.start()
     time.sleep(seconds)  # the load runs for a fixed time
@@ -66,7 +71,7 @@ def source_obsw(target, rate, seconds, folder):
     return onboard.app.counters.get("tm_sent", 0)
 
 
-def source_reference(target, rate, seconds, folder):
+def source_reference(target, rate, seconds, folder, apid=10):
     """Child: the same HK packet bytes (sequence counts running) at ``rate`` per second."""
     from obsw.pus.tm import PusTm
     from obsw_host.pus.onboard import tai_now
@@ -76,7 +81,7 @@ def source_reference(target, rate, seconds, folder):
     # distinct time stamps: Yamcs keys its archive on generation time and sequence count
     t0 = int(tai_now()) << 16
     packets = [
-        PusTm(10, 3, 25, data, seq_count=i & 0x3FFF, time=divmod(t0 + 16 * i, 1 << 16)).pack()
+        PusTm(apid, 3, 25, data, seq_count=i & 0x3FFF, time=divmod(t0 + 16 * i, 1 << 16)).pack()
         for i in range(int(rate * seconds) + 1)
     ]
     sent = 0
@@ -96,7 +101,7 @@ def source_reference(target, rate, seconds, folder):
 
 def child(args):
     fn = source_obsw if args.child == "obsw" else source_reference
-    sent = fn(("127.0.0.1", args.target), args.rate, args.seconds, args.folder)
+    sent = fn(("127.0.0.1", args.target), args.rate, args.seconds, args.folder, args.apid)
     print(json.dumps({"sent": sent}), flush=True)
 
 
@@ -140,12 +145,14 @@ def run_level(impl, rate, seconds, target, folder, client):
                 str(seconds),
                 "--folder",
                 folder,
+                "--apid",
+                str(10 + i),  # one APID per process: Yamcs keys packets by time and APID+count
             ],
             stdout=subprocess.PIPE,
             env=env,
             text=True,
         )
-        for _ in range(n)
+        for i in range(n)
     ]
     sent = 0
     for p in procs:
@@ -164,6 +171,7 @@ def main():
     ap.add_argument("--rate", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--seconds", type=float, help=argparse.SUPPRESS)
     ap.add_argument("--folder", help=argparse.SUPPRESS)
+    ap.add_argument("--apid", type=int, default=10, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
         return child(args)

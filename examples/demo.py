@@ -16,6 +16,7 @@ SECTIONS = (
     ("OBCPs: ground uploads a PLUTO procedure with service 18", "obcp_demo", "run"),
     ("Reconfiguration module: two MicroPython controllers", "obsw_host.reconfig_sim", "demo"),
     ("The whole OBC: the 12-step chain and its faults", "obsw_host.obc.chain", "demo"),
+    ("Mission control: Yamcs operates the sample spacecraft", "yamcs_demo", "run"),
 )
 
 

@@ -27,6 +27,7 @@ COMMANDS = {
     "cfdp": "CFDP file transfer (put, get, status, serve)",
     "pluto": "check or dry-run PLUTO procedures",
     "board": "Pyboard firmware for the reconfiguration module",
+    "yamcs": "mission control with Yamcs: XTCE, instance, server",
 }
 ANYWHERE = ("--json", "--debug")  # flags accepted at any position before "--"
 USAGE_ERROR = 2

@@ -1,0 +1,1 @@
+"""Mission control with Yamcs: XTCE from the spacecraft database, instances, links."""

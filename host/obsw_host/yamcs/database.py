@@ -1,0 +1,151 @@
+"""The spacecraft database as the XTCE generator sees it: one adapter over ``obsw.sdb``.
+
+Everything the Yamcs side reads from the database goes through ``load(path)``, which returns
+plain records (``Spacecraft``, ``Param``, ``Event``, ``Function``, ``Structure``). The
+database file is parsed and checked by the project's own loader; the optional entries the
+loader keeps no object for (units, limits, calibrations, ranges of writable parameters) are
+read from the same JSON document, on each attribute or parameter:
+
+    {"name": "speed", "parameter": 2, "type": "float32", "unit": "deg/s", "writable": true,
+     "range": [0, 10],
+     "limits": {"warning": [0.5, 8], "critical": [0, 9.5]},
+     "calibration": {"polynomial": [0, 1]}}
+
+``calibration`` is a polynomial (coefficients from the constant term up) or a spline
+(``{"spline": [[raw, eng], ...]}``) from the raw value to the engineering value.
+"""
+
+import json
+
+from obsw import sdb as sdb_module
+
+
+class Param:
+    """One PUS parameter: id, space system path parts, type pair and optional extras."""
+
+    def __init__(self, pid, qualified, pair, unit, writable, extra):
+        self.id = pid
+        self.qualified = qualified
+        self.path = qualified.split(".")  # 'SolarPanel.angle' -> ['SolarPanel', 'angle']
+        self.pair = pair
+        self.unit = unit
+        self.writable = writable
+        self.range = extra.get("range")
+        self.limits = extra.get("limits")
+        self.calibration = extra.get("calibration")
+        self.description = extra.get("description")
+
+
+class Event:
+    """One PUS event: id, qualified name, severity 1..4 and its auxiliary data fields."""
+
+    def __init__(self, eid, qualified, severity, fields):
+        self.id = eid
+        self.qualified = qualified
+        self.path = qualified.split(".")
+        self.severity = severity
+        self.fields = fields  # [(name, (ptc, pfc))]
+
+
+class Function:
+    """One service 8 function: id, qualified name and its arguments [(id, name, pair)]."""
+
+    def __init__(self, fid, qualified, arguments):
+        self.id = fid
+        self.qualified = qualified
+        self.path = qualified.split(".")
+        self.arguments = arguments
+
+
+class Structure:
+    """One housekeeping report structure: SID, interval and its parameter ids in order."""
+
+    def __init__(self, sid, interval, parameters, enabled):
+        self.sid = sid
+        self.interval = interval
+        self.parameters = parameters
+        self.enabled = enabled
+
+
+class Spacecraft:
+    """What the Yamcs instance needs to know of the spacecraft database."""
+
+    def __init__(self, mission, apids, params, events, functions, structures, filestores):
+        self.mission = mission or "spacecraft"
+        self.apids = apids
+        self.params = params  # id -> Param
+        self.events = events  # id -> Event
+        self.functions = functions  # id -> Function
+        self.structures = structures  # [Structure]
+        self.filestores = filestores  # prefix -> CFDP entity id
+
+    def apid(self, name, default=None):
+        return self.apids.get(name, default)
+
+
+def _pair(type_spec):
+    if isinstance(type_spec, str):
+        return sdb_module.TYPES[type_spec]
+    return tuple(type_spec)
+
+
+def _extras(doc):
+    """qualified parameter name -> its raw JSON entry (for the keys the loader ignores)."""
+    out = {}
+    for comp in doc.get("components", []):
+        for a in comp.get("attributes", []):
+            out["%s.%s" % (comp["name"], a["name"])] = a
+    for p in doc.get("parameters", []):
+        out[p["name"]] = p
+    return out
+
+
+def loads(text):
+    """The Spacecraft of a database given as JSON text (SdbError when it is malformed)."""
+    db = sdb_module.loads(text)
+    doc = json.loads(text)
+    extras = _extras(doc)
+    params = {}
+    for pid, p in db.parameters.items():
+        params[pid] = Param(
+            pid, p.qualified, _pair(p.type_spec), p.unit, p.writable, extras.get(p.qualified, {})
+        )
+    events = {}
+    for eid, e in db.events.items():
+        raw = _event_entry(doc, e)
+        fields = [(f["name"], _pair(f["type"])) for f in raw.get("data", ())]
+        events[eid] = Event(eid, e.qualified, e.severity, fields)
+    functions = {}
+    for f in db.extra.get("functions", ()):
+        args = [(a["id"], a["name"], _pair(a["type"])) for a in f.get("arguments", ())]
+        functions[f["id"]] = Function(f["id"], f["name"], args)
+    structures = [
+        Structure(h["sid"], h["interval"], list(h["parameters"]), h["enabled"])
+        for h in db.housekeeping
+    ]
+    return Spacecraft(
+        db.mission, dict(db.apids), params, events, functions, structures, dict(db.filestores)
+    )
+
+
+def _event_entry(doc, event):
+    if event.component:
+        for comp in doc.get("components", []):
+            if comp["name"] == event.component:
+                for e in comp.get("events", []):
+                    if e["name"] == event.name:
+                        return e
+    for e in doc.get("events", []):
+        if e["name"] == event.name:
+            return e
+    return {}
+
+
+def load(path=None):
+    """The Spacecraft of the database file ``path`` (default: the sample database)."""
+    if path is None:
+        from obsw_host.pus.demo import SDB_PATH
+
+        path = SDB_PATH
+    with open(path) as f:
+        return loads(f.read())

@@ -1,0 +1,674 @@
+"""XTCE (Yamcs mission database) generated from the spacecraft database, nothing hand-written.
+
+``generate(spacecraft)`` returns the XML text of one SpaceSystem named after the mission:
+- the packet headers (``ccsds`` root, ``pus_tm`` with the PUS-C secondary header of
+  ``obsw.pus.config.PusConfig``), every report the OBC sends: service 1 verification reports,
+  3 housekeeping structures (one container per SID, the database's parameters in order),
+  5 event reports (one container per event with its auxiliary data), 12 check transitions
+  (with an alarm on the monitored parameter's checking state), 17 and 20 reports;
+- the parameters in one sub-system per component (``/MISSION/SolarPanel/angle``) with their
+  types, units, calibrations and alarm limits where the database gives them;
+- the telecommands: an abstract ``pus_tc`` whose verifiers follow the service 1 reports
+  (acceptance, start, completion, by APID and sequence count), services 3, 5, 8 (one command
+  per function with its typed arguments), 11, 12 (a limit check for each parameter with
+  limits), 17, 18, 20 (one set command per writable parameter, its range checked) and 23.
+"""
+
+import xml.etree.ElementTree as ET
+
+from obsw.pus import messages as M
+from obsw.pus.config import PusConfig
+from obsw.pus.packets import ACK_ALL
+from obsw.pus.services.s01_verification import FAILURE_NAMES
+from obsw.pus.services.s12_layouts import STATUS_NAMES
+
+from obsw_host.yamcs.xtce_types import argument_type, parameter_type
+
+XTCE_NS = "http://www.omg.org/spec/XTCE/20180204"
+U8, U16, U32, E8, E16 = (3, 4), (3, 12), (3, 14), (2, 8), (2, 16)
+SEVERITY_LEVELS = {1: "watch", 2: "warning", 3: "distress", 4: "critical"}
+
+
+class XtceNameError(ValueError):
+    """Two things of the database would get one name in the mission database."""
+
+
+def _sub(parent, tag, **attrs):
+    return ET.SubElement(parent, tag, {k: str(v) for k, v in attrs.items()})
+
+
+def _label(text):
+    return "".join(c if c.isalnum() or c in "_-" else "_" for c in text)
+
+
+class SpaceSystem:
+    """One XTCE SpaceSystem being built: its types, parameters, containers and commands."""
+
+    def __init__(self, name, path):
+        self.name = name
+        self.path = path  # absolute, '/MISSION/SolarPanel'
+        self.children = {}
+        self.ptypes = []
+        self.params = []
+        self.containers = []
+        self.atypes = []
+        self.commands = []
+
+    def child(self, name):
+        s = self.children.get(name)
+        if s is None:
+            s = self.children[name] = SpaceSystem(name, self.path + "/" + name)
+        return s
+
+    def parameter(self, name, ptype, description=None):
+        """Add a parameter of type element ``ptype``; returns its absolute reference."""
+        ptype.set("name", name + "_t")
+        self.ptypes.append(ptype)
+        p = ET.Element("Parameter", name=name, parameterTypeRef=name + "_t")
+        if description:
+            p.set("shortDescription", description)
+        self.params.append(p)
+        return self.path + "/" + name
+
+    def element(self):
+        ss = ET.Element("SpaceSystem", name=self.name)
+        if self.params or self.containers:
+            tm = _sub(ss, "TelemetryMetaData")
+            _sub(tm, "ParameterTypeSet").extend(self.ptypes)
+            _sub(tm, "ParameterSet").extend(self.params)
+            if self.containers:
+                _sub(tm, "ContainerSet").extend(self.containers)
+        if self.commands:
+            cm = _sub(ss, "CommandMetaData")
+            if self.atypes:
+                _sub(cm, "ArgumentTypeSet").extend(self.atypes)
+            _sub(cm, "MetaCommandSet").extend(self.commands)
+        for c in self.children.values():
+            ss.append(c.element())
+        return ss
+
+
+def _container(name, base, conditions, entries=(), archive=False):
+    """A SequenceContainer: ``conditions`` [(parameter ref, value)], ``entries`` parameter refs
+    or (ref, absolute bit offset) pairs."""
+    c = ET.Element("SequenceContainer", name=name)
+    if archive:
+        anc = _sub(c, "AncillaryDataSet")
+        _sub(
+            anc, "AncillaryData", name="Yamcs", mimeType="text/plain"
+        ).text = "UseAsArchivingPartition"
+    lst = _sub(c, "EntryList")
+    for e in entries:
+        ref, offset = e if isinstance(e, tuple) else (e, None)
+        entry = _sub(lst, "ParameterRefEntry", parameterRef=ref)
+        if offset is not None:
+            loc = _sub(entry, "LocationInContainerInBits", referenceLocation="containerStart")
+            _sub(loc, "FixedValue").text = str(offset)
+    if base is not None:
+        b = _sub(c, "BaseContainer", containerRef=base)
+        if conditions:
+            rc = _sub(b, "RestrictionCriteria")
+            cl = _sub(rc, "ComparisonList")
+            for ref, value in conditions:
+                _sub(cl, "Comparison", parameterRef=ref, value=value, comparisonOperator="==")
+    return c
+
+
+class Generator:
+    """Builds the mission's SpaceSystem from a ``database.Spacecraft``."""
+
+    def __init__(self, sc, config=None):
+        self.sc = sc
+        self.cfg = config or PusConfig()
+        self.root = SpaceSystem(_label(sc.mission), "/" + _label(sc.mission))
+        self.refs = {}  # parameter id -> absolute reference
+        self.apid = sc.apid("pus", 10)
+
+    # ------------------------------------------------------------------ helpers
+    def system_of(self, parts):
+        s = self.root
+        for p in parts:
+            s = s.child(_label(p))
+        return s
+
+    def header_param(self, name, bits, labels=None, description=None):
+        return self.root.parameter(
+            name, parameter_type(name, (0, bits), labels=labels), description
+        )
+
+    # ------------------------------------------------------------------ telemetry
+    def headers(self):
+        r = self.root
+        cfg = self.cfg
+        h = {}
+        for name, bits in (
+            ("ccsds_version", 3),
+            ("ccsds_type", 1),
+            ("ccsds_secondary_header", 1),
+            ("apid", 11),
+            ("sequence_flags", 2),
+            ("sequence_count", 14),
+            ("packet_length", 16),
+        ):
+            h[name] = self.header_param(name, bits)
+        r.containers.append(_container("ccsds", None, (), list(h.values())))
+        pus = [
+            ("pus_version", 4),
+            ("time_reference", 4),
+            ("service", 8),
+            ("subtype", 8),
+        ]
+        if cfg.message_counter_size:
+            pus.append(("message_counter", 8 * cfg.message_counter_size))
+        if cfg.destination_id_size:
+            pus.append(("destination", 8 * cfg.destination_id_size))
+        entries = [self.header_param(n, b) for n, b in pus]
+        t = cfg.time
+        if t is not None:
+            obt = ET.Element("AbsoluteTimeParameterType", name="obt_t")
+            enc = _sub(obt, "Encoding", units="seconds", scale=repr(1.0 / (1 << (8 * t.fine))))
+            _sub(enc, "IntegerDataEncoding", sizeInBits=8 * (t.coarse + t.fine))
+            _sub(_sub(obt, "ReferenceTime"), "Epoch").text = "TAI"
+            r.ptypes.append(obt)
+            r.params.append(
+                ET.Element(
+                    "Parameter",
+                    name="obt",
+                    parameterTypeRef="obt_t",
+                    shortDescription="on-board time of the report (CUC, TAI)",
+                )
+            )
+            entries.append(r.path + "/obt")
+        self.h = h
+        self.service = r.path + "/service"
+        self.subtype = r.path + "/subtype"
+        r.containers.append(
+            _container("pus_tm", "ccsds", [(h["ccsds_secondary_header"], 1)], entries)
+        )
+        self.data_bits = 8 * (6 + cfg.tm_header_size)
+
+    def report(self, name, msg_type, entries=(), archive=False, base="pus_tm", extra=()):
+        conditions = [(self.service, msg_type[0]), (self.subtype, msg_type[1])] + list(extra)
+        self.root.containers.append(_container(name, base, conditions, entries, archive))
+        return name
+
+    def verification(self):
+        r = self.root
+        self.v_subtype = self.header_param("verification_subtype", 8)
+        self.v_flags = self.header_param("verified_tc_flags", 5)
+        self.v_apid = self.header_param("verified_tc_apid", 11)
+        self.header_param("verified_tc_sequence_flags", 2)
+        self.v_seq = self.header_param("verified_tc_sequence_count", 14)
+        self.v_code = r.parameter(
+            "failure_code", parameter_type("failure_code", E8, labels=_failure_labels())
+        )
+        self.v_step = self.header_param("step_id", 8)
+        r.containers.append(
+            _container(
+                "verification",
+                "pus_tm",
+                [(self.service, 1)],
+                [
+                    (self.v_subtype, 64),
+                    (self.v_flags, self.data_bits),
+                    self.v_apid,
+                    r.path + "/verified_tc_sequence_flags",
+                    self.v_seq,
+                ],
+            )
+        )
+        for sub, name, entries in (
+            (M.TM_VERIFY_ACCEPTANCE_FAILURE, "acceptance_failure", [self.v_code]),
+            (M.TM_VERIFY_START_FAILURE, "start_failure", [self.v_code]),
+            (M.TM_VERIFY_PROGRESS_SUCCESS, "progress_success", [self.v_step]),
+            (M.TM_VERIFY_PROGRESS_FAILURE, "progress_failure", [self.v_step, self.v_code]),
+            (M.TM_VERIFY_COMPLETION_FAILURE, "completion_failure", [self.v_code]),
+            (M.TM_VERIFY_ROUTING_FAILURE, "routing_failure", [self.v_code]),
+        ):
+            r.containers.append(
+                _container(name, "verification", [(self.subtype, sub[1])], entries)
+            )
+
+    def parameters(self):
+        for pid in sorted(self.sc.params):
+            p = self.sc.params[pid]
+            s = self.system_of(p.path[:-1])
+            ptype = parameter_type("", p.pair, p.unit, limits=p.limits, calibration=p.calibration)
+            self.refs[pid] = s.parameter(_label(p.path[-1]), ptype, p.description)
+
+    def housekeeping(self):
+        r = self.root
+        sid = self.header_param("hk_structure_id", 16)
+        self.report("hk_report", M.TM_HK_HK_REPORT, [sid])
+        for st in self.sc.structures:
+            entries = [self.refs[pid] for pid in st.parameters]
+            r.containers.append(
+                _container("hk_%d" % st.sid, "hk_report", [(sid, st.sid)], entries, True)
+            )
+
+    def events(self):
+        r = self.root
+        labels = {e.id: _label(e.qualified) for e in self.sc.events.values()}
+        self.event_id = r.parameter("event_id", parameter_type("", E16, labels=labels))
+        base = self.report("event_report", (5, 0), [self.event_id])
+        # the subtype is the severity: match any of 1..4 by leaving it out of the condition
+        _drop_condition(r.containers[-1], self.subtype)
+        self.templates = []
+        for e in sorted(self.sc.events.values(), key=lambda e: e.id):
+            s = self.system_of(e.path[:-1])
+            refs = []
+            for fname, pair in e.fields:
+                pname = "%s_%s" % (_label(e.path[-1]), _label(fname))
+                refs.append((fname, s.parameter(pname, parameter_type("", pair))))
+            r.containers.append(
+                _container(
+                    "event_" + _label(e.qualified),
+                    base,
+                    [(self.event_id, labels[e.id])],
+                    [ref for _, ref in refs],
+                )
+            )
+            text = e.qualified
+            if refs:
+                text += ": " + ", ".join("%s={%s}" % (n, ref) for n, ref in refs)
+            self.templates.append({"eventId": labels[e.id], "template": text})
+
+    def monitoring(self):
+        """TM[12,12]: the first transition of each report, per monitored parameter."""
+        r = self.root
+        base_entries = [
+            self.header_param("transition_count", 16),
+            self.header_param("pmon_id", 16),
+            self.header_param("monitored_parameter_id", 16),
+            self.header_param("check_type", 8),
+        ]
+        self.report("check_transition", M.TM_MON_CHECK_TRANSITION_REPORT, base_entries)
+        states = {k: _label(v) for k, v in STATUS_NAMES.items()}
+        for pid in sorted(self.sc.params):
+            p = self.sc.params[pid]
+            if not p.limits or p.pair[0] not in (2, 3, 4, 5):
+                continue
+            s = self.system_of(p.path[:-1])
+            name = _label(p.path[-1])
+            limit = s.parameter(name + "_limit_crossed", parameter_type("", p.pair, p.unit))
+            prev = s.parameter(name + "_previous_check", parameter_type("", E8, labels=states))
+            alarms = {"below_low": "critical", "above_high": "critical", "invalid": "warning"}
+            cur = s.parameter(
+                name + "_check_state", parameter_type("", E8, labels=states, alarms=alarms)
+            )
+            r.containers.append(
+                _container(
+                    "check_transition_" + _label(p.qualified),
+                    "check_transition",
+                    [(base_entries[2], pid), (base_entries[3], 1)],
+                    [self.refs[pid], limit, prev, cur],
+                )
+            )
+
+    def parameter_reports(self):
+        n = self.header_param("parameter_count", 8)
+        pid_ref = self.header_param("reported_parameter_id", 16)
+        self.report("parameter_values", M.TM_PARAM_VALUE_REPORT, [n, pid_ref])
+        for pid in sorted(self.sc.params):
+            if self.sc.params[pid].pair[0] in (7, 8):
+                continue
+            self.root.containers.append(
+                _container(
+                    "parameter_value_%d" % pid,
+                    "parameter_values",
+                    [(n, 1), (pid_ref, pid)],
+                    [self.refs[pid]],
+                )
+            )
+
+    def test_reports(self):
+        self.report("are_you_alive_report", M.TM_TEST_ARE_YOU_ALIVE_REPORT)
+        apid = self.header_param("connection_test_apid", 16)
+        self.report("connection_test_report", M.TM_TEST_ON_BOARD_CONNECTION_REPORT, [apid])
+
+    # ------------------------------------------------------------------ telecommands
+    def tc_base(self):
+        r = self.root
+        cfg = self.cfg
+        for name, bits in (("apid_t", 11), ("ack_t", 4), ("u8_t", 8), ("source_t", 16)):
+            r.atypes.append(argument_type(name, (0, bits)))
+        cmd = _sub(ET.Element("root"), "MetaCommand", name="pus_tc", abstract="true")
+        cmd.set("shortDescription", "PUS-C telecommand: header, then the service's data")
+        args = _sub(cmd, "ArgumentList")
+        _sub(args, "Argument", name="apid", argumentTypeRef="apid_t", initialValue=self.apid)
+        _sub(args, "Argument", name="ack", argumentTypeRef="ack_t", initialValue=ACK_ALL)
+        _sub(args, "Argument", name="service", argumentTypeRef="u8_t")
+        _sub(args, "Argument", name="subtype", argumentTypeRef="u8_t")
+        if cfg.source_id_size:
+            _sub(args, "Argument", name="source", argumentTypeRef="source_t", initialValue=0)
+        cc = _sub(cmd, "CommandContainer", name="pus_tc")
+        entries = _sub(cc, "EntryList")
+        _fixed(entries, "ccsds_version_type_flag", 0b00011, 5)
+        _sub(entries, "ArgumentRefEntry", argumentRef="apid")
+        _fixed(entries, "sequence_flags", 3, 2)
+        _fixed(entries, "sequence_count", 0, 14)
+        _fixed(entries, "packet_length", 0, 16)
+        _fixed(entries, "pus_version", 2, 4)
+        _sub(entries, "ArgumentRefEntry", argumentRef="ack")
+        _sub(entries, "ArgumentRefEntry", argumentRef="service")
+        _sub(entries, "ArgumentRefEntry", argumentRef="subtype")
+        if cfg.source_id_size:
+            _sub(entries, "ArgumentRefEntry", argumentRef="source")
+        if cfg.tc_spare:
+            _fixed(entries, "spare", 0, 8 * cfg.tc_spare)
+        vs = _sub(cmd, "VerifierSet")
+        for tag, name, stage, window in (
+            ("AcceptedVerifier", "Accepted", 1, "PT10S"),
+            ("ExecutionVerifier", "Started", 3, "PT10S"),
+            ("CompleteVerifier", "Complete", 7, "PT30S"),
+        ):
+            v = _sub(vs, tag, name=name)
+            alg = _sub(v, "CustomAlgorithm", name="verify_" + name.lower())
+            _sub(alg, "AlgorithmText", language="Java").text = (
+                'org.yamcs.pus.Pus1Verifier({stage: %d, template: "failure code {code}"})' % stage
+            )
+            inputs = _sub(alg, "InputSet")
+            for ref, n in (
+                ("/yamcs/cmd/arg/apid", "sentApid"),
+                ("/yamcs/cmdHist/ccsds-seqcount", "sentSeq"),
+                (self.v_apid, "rcvdApid"),
+                (self.v_seq, "rcvdSeq"),
+                (self.v_subtype, "reportSubType"),
+                (self.v_code, "code"),
+            ):
+                _sub(inputs, "InputParameterInstanceRef", parameterRef=ref, inputName=n)
+            _sub(
+                v,
+                "CheckWindow",
+                timeToStopChecking=window,
+                timeWindowIsRelativeTo="commandRelease",
+            )
+        r.commands.append(cmd)
+        self.tc = r.path + "/pus_tc"
+
+    def command(self, system, name, msg_type, fields=(), description=None):
+        """A MetaCommand on ``pus_tc``: ``fields`` are ('fixed', name, value, bits) or
+        ('arg', name, argument type element)."""
+        if any(c.get("name") == name for c in system.commands):
+            raise XtceNameError("two commands named %s/%s" % (system.path, name))
+        cmd = ET.Element("MetaCommand", name=name)
+        if description:
+            cmd.set("shortDescription", description)
+        base = _sub(cmd, "BaseMetaCommand", metaCommandRef=self.tc)
+        assigns = _sub(base, "ArgumentAssignmentList")
+        _sub(assigns, "ArgumentAssignment", argumentName="service", argumentValue=msg_type[0])
+        _sub(assigns, "ArgumentAssignment", argumentName="subtype", argumentValue=msg_type[1])
+        args = [f for f in fields if f[0] == "arg"]
+        if args:
+            alist = _sub(cmd, "ArgumentList")
+            for _, aname, atype in args:
+                tname = "%s_%s_t" % (name, aname)
+                atype.set("name", tname)
+                system.atypes.append(atype)
+                _sub(alist, "Argument", name=aname, argumentTypeRef=tname)
+        cc = _sub(cmd, "CommandContainer", name=name)
+        entries = _sub(cc, "EntryList")
+        for f in fields:
+            if f[0] == "fixed":
+                _fixed(entries, f[1], f[2], f[3])
+            else:
+                _sub(entries, "ArgumentRefEntry", argumentRef=f[1])
+        _sub(cc, "BaseContainer", containerRef=self.tc)
+        system.commands.append(cmd)
+
+    def service_commands(self):
+        sc = self.sc
+        pus = self.root.child("PUS")
+        sid_labels = {s.sid: "sid_%d" % s.sid for s in sc.structures}
+        ev_labels = {e.id: _label(e.qualified) for e in sc.events.values()}
+
+        def sid_arg():
+            return ("arg", "sid", argument_type("", U16, labels=sid_labels or None))
+
+        one16 = ("fixed", "n", 1, 16)
+        one8 = ("fixed", "n", 1, 8)
+        self.command(pus, "ping", M.TC_TEST_ARE_YOU_ALIVE, description="TC[17,1] are you alive")
+        self.command(
+            pus,
+            "connection_test",
+            M.TC_TEST_ON_BOARD_CONNECTION,
+            [("arg", "target_apid", argument_type("", U16, valid=(0, 2047)))],
+            "TC[17,3] on-board connection test",
+        )
+        self.command(pus, "hk_enable", M.TC_HK_ENABLE_HK_REPORTS, [one16, sid_arg()])
+        self.command(pus, "hk_disable", M.TC_HK_DISABLE_HK_REPORTS, [one16, sid_arg()])
+        self.command(pus, "hk_one_shot", M.TC_HK_ONE_SHOT_HK, [one16, sid_arg()])
+        self.command(
+            pus,
+            "hk_interval",
+            M.TC_HK_MODIFY_HK_INTERVAL,
+            [one16, sid_arg(), ("arg", "interval", argument_type("", U16, valid=(1, 65535)))],
+        )
+
+        def ev():
+            return ("arg", "event", argument_type("", E16, labels=ev_labels))
+
+        self.command(pus, "event_enable", M.TC_EVENT_ENABLE, [one8, ev()])
+        self.command(pus, "event_disable", M.TC_EVENT_DISABLE, [one8, ev()])
+        self.command(pus, "event_report_disabled", M.TC_EVENT_REPORT_DISABLED)
+        for name, mt in (
+            ("schedule_enable", M.TC_SCHED_ENABLE),
+            ("schedule_disable", M.TC_SCHED_DISABLE),
+            ("schedule_reset", M.TC_SCHED_RESET),
+            ("schedule_detail_all", M.TC_SCHED_DETAIL_REPORT_ALL),
+            ("schedule_summary_all", M.TC_SCHED_SUMMARY_REPORT_ALL),
+            ("monitoring_enable", M.TC_MON_ENABLE_PARAMETER_MONITORING_FUNCTION),
+            ("monitoring_disable", M.TC_MON_DISABLE_PARAMETER_MONITORING_FUNCTION),
+            ("monitors_report", M.TC_MON_REPORT_PARAMETER_MONITORING),
+            ("obcp_abort_all", M.TC_OBCP_ABORT_ALL),
+        ):
+            self.command(pus, name, mt)
+
+        def pmon():
+            return ("arg", "pmon", argument_type("", U16))
+
+        self.command(pus, "monitor_enable", M.TC_MON_ENABLE_PARAMETER_MONITORING, [one16, pmon()])
+        self.command(
+            pus, "monitor_disable", M.TC_MON_DISABLE_PARAMETER_MONITORING, [one16, pmon()]
+        )
+        param_labels = {pid: _label(p.qualified) for pid, p in sc.params.items()}
+        self.command(
+            pus,
+            "parameters_report",
+            M.TC_PARAM_REPORT_VALUES,
+            [one8, ("arg", "parameter", argument_type("", U16, labels=param_labels))],
+            "TC[20,1] report one parameter's value",
+        )
+        self.obcp_commands(pus)
+        self.file_commands(pus)
+
+    def obcp_commands(self, pus):
+        def obcp():
+            return ("arg", "obcp", argument_type("", (8, 8)))
+
+        levels = {0: "none", 1: "procedure", 2: "step", 3: "statement"}
+        no_args = ("fixed", "argument_count", 0, 8)
+        self.command(
+            pus,
+            "obcp_load",
+            M.TC_OBCP_LOAD_DIRECT,
+            [obcp(), ("arg", "code", argument_type("", (8, 0))), no_args],
+            "TC[18,1] load a PLUTO procedure given as text",
+        )
+        self.command(
+            pus,
+            "obcp_activate",
+            M.TC_OBCP_ACTIVATE,
+            [obcp(), ("arg", "level", argument_type("", E8, labels=levels)), no_args],
+        )
+        for name, mt in (
+            ("obcp_unload", M.TC_OBCP_UNLOAD),
+            ("obcp_stop", M.TC_OBCP_STOP),
+            ("obcp_suspend", M.TC_OBCP_SUSPEND),
+            ("obcp_resume", M.TC_OBCP_RESUME),
+            ("obcp_abort", M.TC_OBCP_ABORT),
+        ):
+            self.command(pus, name, mt, [obcp()])
+
+    def file_commands(self, pus):
+        def path(name):
+            return ("arg", name, argument_type("", (8, 0)))
+
+        self.command(
+            pus,
+            "file_create",
+            M.TC_FILE_CREATE,
+            [path("repository"), path("file"), ("arg", "max_size", argument_type("", U32))],
+        )
+        self.command(pus, "file_delete", M.TC_FILE_DELETE, [path("repository"), path("file")])
+        self.command(
+            pus,
+            "file_copy",
+            M.TC_FILE_COPY,
+            [
+                ("arg", "operation", argument_type("", U16)),
+                path("source_repository"),
+                path("source_file"),
+                path("target_repository"),
+                path("target_file"),
+            ],
+            "TC[23,14] copy a file (by CFDP between SAT: and GROUND:)",
+        )
+
+    def parameter_commands(self):
+        for pid in sorted(self.sc.params):
+            p = self.sc.params[pid]
+            if not p.writable:
+                continue
+            s = self.system_of(p.path[:-1])
+            valid = tuple(p.range) if p.range else None
+            self.command(
+                s,
+                "set_" + _label(p.path[-1]),
+                M.TC_PARAM_SET_VALUES,
+                [
+                    ("fixed", "n", 1, 8),
+                    ("fixed", "parameter", pid, 16),
+                    ("arg", "value", argument_type("", p.pair, p.unit, valid=valid)),
+                ],
+                "TC[20,3] set %s" % p.qualified,
+            )
+
+    def monitor_commands(self):
+        """TC[12,5] for each parameter with limits: a limit check with the database's critical
+        range as default limits (then TC[12,1] enables it)."""
+        labels = {e.id: _label(e.qualified) for e in self.sc.events.values()}
+        labels[0] = "none"
+        for pid in sorted(self.sc.params):
+            p = self.sc.params[pid]
+            if not p.limits or p.pair[0] not in (2, 3, 4, 5):
+                continue
+            low, high = p.limits.get("critical") or p.limits.get("warning")
+            s = self.system_of(p.path[:-1])
+            fields = [("fixed", "n", 1, 16), ("arg", "pmon", argument_type("", U16))]
+            fields += [
+                ("fixed", "parameter", pid, 16),
+                ("fixed", "validity", 0, 16),
+                ("fixed", "validity_mask", 0, 32),
+                ("fixed", "validity_value", 0, 32),
+                ("arg", "interval", argument_type("", U16, valid=(1, 65535))),
+                ("arg", "repetitions", argument_type("", U16, valid=(1, 65535))),
+                ("fixed", "check", 1, 8),
+                ("arg", "low", argument_type("", p.pair, p.unit)),
+                ("arg", "low_event", argument_type("", E16, labels=labels)),
+                ("arg", "high", argument_type("", p.pair, p.unit)),
+                ("arg", "high_event", argument_type("", E16, labels=labels)),
+            ]
+            name = "monitor_" + _label(p.path[-1])
+            self.command(
+                s,
+                name,
+                M.TC_MON_ADD_PARAMETER_MONITORING,
+                fields,
+                "TC[12,5] limit check of %s" % p.qualified,
+            )
+            cmd = s.commands[-1]
+            defaults = {
+                "interval": 1,
+                "repetitions": 1,
+                "low": low,
+                "high": high,
+                "low_event": "none",
+                "high_event": "none",
+            }
+            if p.calibration or p.pair[0] != 5:  # on-board limits are raw integer values
+                for key in ("low", "high"):
+                    v = defaults[key]
+                    ok = v is not None and not p.calibration and float(v).is_integer()
+                    defaults[key] = int(v) if ok else None
+            for a in cmd.find("ArgumentList"):
+                if defaults.get(a.get("name")) is not None:
+                    a.set("initialValue", str(defaults[a.get("name")]))
+
+    def function_commands(self):
+        for fid in sorted(self.sc.functions):
+            f = self.sc.functions[fid]
+            s = self.system_of(f.path[:-1])
+            fields = [("fixed", "function", fid, 16), ("fixed", "n", len(f.arguments), 8)]
+            for aid, aname, pair in f.arguments:
+                fields.append(("fixed", "id_" + _label(aname), aid, 8))
+                fields.append(("arg", _label(aname), argument_type("", pair)))
+            self.command(
+                s, _label(f.path[-1]), M.TC_FUNCTION_PERFORM, fields, "TC[8,1] %s" % f.qualified
+            )
+
+    def build(self):
+        self.headers()
+        self.verification()
+        self.parameters()
+        self.housekeeping()
+        self.events()
+        self.monitoring()
+        self.parameter_reports()
+        self.test_reports()
+        self.tc_base()
+        self.service_commands()
+        self.parameter_commands()
+        self.monitor_commands()
+        self.function_commands()
+        return self.root.element()
+
+
+def _drop_condition(container, ref):
+    for cl in container.iter("ComparisonList"):
+        for c in list(cl):
+            if c.get("parameterRef") == ref:
+                cl.remove(c)
+
+
+def _fixed(entries, name, value, bits):
+    digits = max(1, (bits + 3) // 4)
+    if digits % 2:
+        digits += 1
+    _sub(
+        entries,
+        "FixedValueEntry",
+        name=name,
+        binaryValue="%0*x" % (digits, value),
+        sizeInBits=bits,
+    )
+
+
+def _failure_labels():
+    return {code: _label(text) for code, text in FAILURE_NAMES.items()}
+
+
+def generate(spacecraft, config=None):
+    """The XTCE document (text) of ``spacecraft`` (a ``database.Spacecraft``)."""
+    g = Generator(spacecraft, config)
+    root = g.build()
+    root.set("xmlns", XTCE_NS)
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, "unicode") + "\n"
+
+
+def event_templates(spacecraft, config=None):
+    """The PusEventDecoder templates of every event: [{"eventId": label, "template": text}]."""
+    g = Generator(spacecraft, config)
+    g.build()
+    return g.templates

@@ -7,7 +7,7 @@ import os
 import socket
 import tempfile
 
-from obsw_host.pus.demo import SDB_PATH
+from obsw_host.sample import SDB_PATH
 
 MISSION = "/obsw-demo"
 

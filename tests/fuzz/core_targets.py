@@ -20,11 +20,11 @@ from obsw.pluto.lexer import PlutoError, tokenize
 from obsw.pluto.parser import parse
 from obsw.pus.fields import FieldValueError, field
 from obsw.pus.packets import PusError, unpack_packet
+from obsw.pus.sdb import SdbError
+from obsw.pus.sdb import loads as sdb_loads
 from obsw.pus.structure import Repeated, Structure
 from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm
-from obsw.sdb import SdbError
-from obsw.sdb import loads as sdb_loads
 from obsw.spacecan import packets as can_packets
 from obsw.spacecan.fragment import Reassembler, split
 from obsw.spacecan.nodedef import NodeDefinition

@@ -5,7 +5,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 from obsw_host.cli import main
-from obsw_host.pus.demo import SDB_PATH
+from obsw_host.sample import SDB_PATH
 from obsw_host.yamcs import database, server
 from obsw_host.yamcs.instance import write_instance
 from obsw_host.yamcs.xtce import event_templates, generate

@@ -14,7 +14,7 @@ import threading
 import time
 
 import pytest
-from obsw_host.pus.demo import SDB_PATH
+from obsw_host.sample import SDB_PATH
 from obsw_host.yamcs import database, instance, server
 from obsw_host.yamcs.spacecraft import SampleSpacecraft
 

@@ -119,7 +119,7 @@ def _initialize_cop1(url, link="tc_frames.vc0"):
 
 
 def run(args):
-    from obsw_host.pus.demo import SDB_PATH
+    from obsw_host.sample import SDB_PATH
     from obsw_host.yamcs import database, server
     from obsw_host.yamcs.instance import write_instance
     from obsw_host.yamcs.spacecraft import SampleSpacecraft

@@ -1,4 +1,4 @@
-"""The spacecraft database as the XTCE generator sees it: one adapter over ``obsw.sdb``.
+"""The spacecraft database as the XTCE generator sees it: one adapter over ``obsw.pus.sdb``.
 
 Everything the Yamcs side reads from the database goes through ``load(path)``, which returns
 plain records (``Spacecraft``, ``Param``, ``Event``, ``Function``, ``Structure``). The
@@ -17,7 +17,7 @@ read from the same JSON document, on each attribute or parameter:
 
 import json
 
-from obsw import sdb as sdb_module
+from obsw.pus import sdb as sdb_module
 
 
 class Param:
@@ -144,7 +144,7 @@ def _event_entry(doc, event):
 def load(path=None):
     """The Spacecraft of the database file ``path`` (default: the sample database)."""
     if path is None:
-        from obsw_host.pus.demo import SDB_PATH
+        from obsw_host.sample import SDB_PATH
 
         path = SDB_PATH
     with open(path) as f:

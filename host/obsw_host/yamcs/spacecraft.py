@@ -19,10 +19,10 @@ import socket
 import threading
 import time
 
-from obsw import sdb as sdb_module
 from obsw.cfdp.entity import CfdpEntity
 from obsw.cfdp.mib import Mib, RemoteEntity
 from obsw.crc import CHECKSUM_MODULAR
+from obsw.pus import sdb as sdb_module
 from obsw.spp import TYPE_TM
 
 from obsw_host.cfdp.filestore import RootedFilestore

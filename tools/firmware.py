@@ -185,11 +185,11 @@ def build_pyboard(src=None):
 
 
 def build_unix(src=None):
-    """The unix port with manifests/core.py frozen: returns the executable."""
+    """The unix port with manifests/unix.py (asyncio and the core) frozen: the executable."""
     tree = source(src)
     build_mpy_cross(src)
     out = BUILD / "unix"
-    manifest = ROOT / "manifests" / "core.py"
+    manifest = ROOT / "manifests" / "unix.py"
     args = ["-C", str(tree / "ports" / "unix"), "BUILD=" + str(out)]
     args += list(UNIX_OPTIONS) + ["FROZEN_MANIFEST=" + str(manifest)]
     return _make(tree, out, "micropython", manifest_inputs(manifest), args)[0]
@@ -207,6 +207,32 @@ def pyboard_heap(src=None):
     return sym["_heap_end"] - sym["_heap_start"]
 
 
+# a float constant the freezer cannot write for a single-precision image (beyond +-3.4e38, inf)
+_UNFREEZABLE = re.compile(r"[0-9.]e\+?([4-9][0-9]|[1-9][0-9]{2})\b|\binf\b")
+BOARD_TESTS = BUILD / "board-tests"
+
+
+def stage_board_tests():
+    """Copy the core tests and their support modules that freeze into build/fw/board-tests
+    (frozen into the QEMU image); returns the names of those that do not (run from source)."""
+    BOARD_TESTS.mkdir(parents=True, exist_ok=True)
+    left = []
+    wanted = set()
+    for p in sorted((ROOT / "tests" / "core").glob("*.py")):
+        text = p.read_text()
+        if _UNFREEZABLE.search(text):
+            left.append(p.name)
+            continue
+        wanted.add(p.name)
+        dst = BOARD_TESTS / p.name
+        if not dst.is_file() or dst.read_text() != text:
+            dst.write_text(text)
+    for old in BOARD_TESTS.glob("*.py"):
+        if old.name not in wanted:
+            old.unlink()
+    return left
+
+
 def build_qemu(src=None, heap=None):
     """boards/OBSW_QEMU (mps2-an385, Cortex-M3) with manifests/qemu.py frozen and a GC heap of
     ``heap`` bytes (default: the Pyboard's). Returns firmware.elf."""
@@ -214,6 +240,7 @@ def build_qemu(src=None, heap=None):
     tree = source(src)
     build_mpy_cross(src)
     heap = heap or pyboard_heap(src)
+    stage_board_tests()
     out = BUILD / ("qemu-%d" % heap)
     manifest = ROOT / "manifests" / "qemu.py"
     args = ["-C", str(tree / "ports" / "qemu"), "BOARD=OBSW_QEMU", "BOARD_DIR=" + str(QEMU_BOARD)]

@@ -24,7 +24,7 @@ CORE_TESTS = sorted((ROOT / "tests" / "core").glob("test_*.py"))
 # Core tests that cannot run on a board with the Pyboard's heap, and why (counted as skipped).
 CORTEX_M_SKIPS = {}
 MIN_FREE = 0.30  # the least share of the Pyboard heap free at the low-water mark
-HEAP_PASSES = 6000
+HEAP_PASSES = 10000
 COUNTS = re.compile(r"(\d+) passed, (\d+) failed(?:, (\d+) skipped)?")
 
 
@@ -80,9 +80,7 @@ def stage_cortex_m():
     except firmware.FirmwareError as e:
         print(e)
         return _close("cortex-m", t0, 0, 1)
-    stage = _stage_dir("cortex-m-tests")
-    for p in (ROOT / "tests" / "core").glob("*.py"):
-        shutil.copy(p, stage / p.name)
+    from_source = firmware.stage_board_tests()  # tests that cannot be frozen: copied, compiled
     passed = failed = skipped = 0
     q = firmware.Qemu(elf)
     try:
@@ -90,7 +88,8 @@ def stage_cortex_m():
             name = path.name
             code = "import obsw_run_tests as r; r.main([%r], %r)" % (name, CORTEX_M_SKIPS)
             t1 = time.monotonic()
-            rc, out = firmware.mpremote(q.pty, "mount", str(stage), "exec", code, timeout=180)
+            pre = ["cp", str(path), ":" + name, "+"] if name in from_source else []
+            rc, out = firmware.mpremote(q.pty, *pre, "exec", code, timeout=90)
             c = _counts(out)
             if c is None:
                 failed += 1
@@ -137,7 +136,7 @@ def stage_heap():
             % (HEAP_PASSES, MIN_FREE)
         )
         t1 = time.monotonic()
-        rc, out = firmware.mpremote(q.pty, "exec", code, timeout=600)
+        rc, out = firmware.mpremote(q.pty, "exec", code, timeout=300)
         print("\n".join(_figures(out, ("heap", "passes", "reconfig", "Traceback", "MemoryError"))))
         print("reconfiguration session %.1f s" % (time.monotonic() - t1))
         if rc == 0 and "reconfig ok" in out:
@@ -156,7 +155,7 @@ def stage_heap():
             "cp", str(data / "commissioning.pluto"), ":p.pluto", "+",
             "cp", str(data / "commissioning.system.json"), ":p.json", "+",
             "exec", code,
-            timeout=600,
+            timeout=180,
         )  # fmt: skip
         lines = sum(1 for _ in open(data / "commissioning.pluto"))
         print("PLUTO procedure tests/data/pluto/commissioning.pluto (%d lines)" % lines)

@@ -64,6 +64,7 @@ class Manifest:
             "require": self.required.append,
             "package": self._package,
             "module": self._module,
+            "freeze": self._freeze,
             "options": type("Options", (), {})(),
         }
         exec(code, env)
@@ -74,15 +75,24 @@ class Manifest:
             self.metadata = {"description": description, "version": version}
 
     def _include(self, manifest_path, **kwargs):
+        if manifest_path.startswith("$("):
+            return  # MicroPython's own manifests (asyncio, ...): not the project's modules
         p = self._dirs[-1] / manifest_path
         self.execute(p / "manifest.py" if p.is_dir() else p)
 
     def _package(self, package_path, files=None, base_path=".", opt=None):
+        if base_path.startswith("$("):
+            return
         base = self._base(base_path)
         for f in sorted((base / package_path).rglob("*.py")):
             rel = f.relative_to(base)
             if files is None or str(rel.relative_to(package_path)) in files:
                 self.modules.append((f, str(rel)))
+
+    def _freeze(self, path, script=None, opt=None):
+        base = self._base(path)
+        for f in sorted(base.rglob("*.py")) if script is None else [base / script]:
+            self.modules.append((f, str(f.relative_to(base))))
 
     def _module(self, module_path, base_path=".", opt=None):
         base = self._base(base_path)

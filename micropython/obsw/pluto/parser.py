@@ -17,7 +17,7 @@ _PROC_ONLY = (
 
 def parse(src):
     """Parse procedure text into its definition node; raises PlutoSyntaxError."""
-    return Parser(tokenize(src)).procedure()
+    return Parser(tokenize(src, True)).procedure()
 
 
 class Parser(ExprParser):

@@ -29,3 +29,8 @@ MP_REGISTER_MODULE(MP_QSTR_obsw_qemu, obsw_qemu_module);
 void obsw_qemu_boot(void) {
     pyexec_frozen_module("_boot.py", false);
 }
+
+// littlefs stamps files with the time; the emulated board has no calendar clock.
+uint64_t mp_hal_time_ns(void) {
+    return 0;
+}

@@ -1,7 +1,9 @@
-# The QEMU Cortex-M board image: the whole core (core.py gives the metadata), the board's boot
+# The QEMU Cortex-M board image: the whole core, the board's boot
 # script, the board-side test runner and heap session, and the core tests with their support
 # modules (all frozen: their code takes no heap, as on a board whose image carries its tests).
-include("core.py")
+metadata(version="0.1.0", description="obsw core and tests on the QEMU Cortex-M board")
+
+package("obsw", base_path="../micropython")  # the core, as core.py freezes it
 # asyncio as a Pyboard has it (the qemu port builds without it): the package with its pure-Python
 # task queue in place of the C one
 package(

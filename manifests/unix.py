@@ -1,4 +1,6 @@
 # The unix port with the core frozen: what the port's standard variant freezes (asyncio), then
-# the core (core.py gives the metadata).
+# the core, as core.py freezes it.
+metadata(version="0.1.0", description="obsw core frozen into the MicroPython unix port")
+
 include("$(MPY_DIR)/extmod/asyncio")
-include("core.py")
+package("obsw", base_path="../micropython")

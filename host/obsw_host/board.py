@@ -251,3 +251,27 @@ def test(files, port=None, runner=_capture):
     print("board: %d passed, %d failed%s" % (totals[0], totals[1],
           ", %d skipped" % totals[2] if totals[2] else ""))  # fmt: skip
     return totals[1]
+
+
+def demo(out=print):
+    """The demo's section: the QEMU Cortex-M board with the Pyboard's heap runs the frozen
+    reconfiguration application for a while and reports its heap (the image is built first if
+    it is not in build/fw yet)."""
+    fw = firmware_tools()
+    try:
+        elf = fw.build_qemu()
+    except fw.FirmwareError as e:
+        out("no QEMU board image: %s" % e)
+        return
+    with fw.Qemu(elf) as q:
+        out("QEMU board (mps2-an385, Cortex-M3) on %s, image %s" % (q.pty, elf))
+        code = (
+            "import sys, gc; print(sys.implementation._machine, 'heap', gc.mem_free() + "
+            "gc.mem_alloc()); import obsw_heap; obsw_heap.reconfig(2000)"
+        )
+        rc, text = fw.mpremote(q.pty, "exec", code, timeout=120)
+        for line in text.splitlines():
+            if line.startswith(("mps2", "heap", "passes", "Traceback")) or "Error" in line:
+                out("  " + line)
+        if rc:
+            raise BoardError("the board session failed (mpremote status %d)" % rc)

@@ -25,7 +25,7 @@ import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
-from mpy import BUDGETS, Manifest, compile_one  # noqa: E402
+from mpy import BUDGETS, Manifest, compile_one, missing_from_manifest  # noqa: E402
 
 BUILD = ROOT / "build" / "fw"
 VERSION = "1.28.0"
@@ -329,18 +329,23 @@ def _sections(elf):
     return sizes
 
 
+_SIZES = {}  # source path -> (bytes of bytecode, error): images share most modules
+
+
 def _frozen_size(manifest):
     """Bytes of Pyboard (armv7emsp) bytecode that ``manifest`` freezes, and failures."""
     m = Manifest()
     m.execute(manifest)
     total, bad = 0, []
-    tmp = BUILD / "frozen-sizes" / pathlib.Path(manifest).stem
+    tmp = BUILD / "frozen-sizes"
     for src, name in m.modules:
-        dst = tmp / (name[:-3] + ".mpy")
-        ok, err = compile_one(src, dst, "armv7emsp", name)
-        if ok:
-            total += dst.stat().st_size
-        else:
+        if src not in _SIZES:
+            dst = tmp / (name[:-3] + ".mpy")
+            ok, err = compile_one(src, dst, "armv7emsp", name)
+            _SIZES[src] = (dst.stat().st_size, None) if ok else (0, err)
+        size, err = _SIZES[src]
+        total += size
+        if err:
             bad.append("%s: %s" % (name, err))
     return total, bad
 
@@ -385,6 +390,12 @@ def stage_sizes():
             failed += 1
         else:
             passed += 1
+    entry = PYBOARD / "reconfig_main.py"
+    roots = [ROOT / "micropython", ROOT / "boards" / "common", PYBOARD]
+    missing = missing_from_manifest(ROOT / "manifests" / "reconfig.py", [entry], roots)
+    print("\nreconfig.py freezes every module reconfig_main.py imports: %s"
+          % ("yes" if not missing else "no, it misses " + ", ".join(missing)))  # fmt: skip
+    passed, failed = passed + (not missing), failed + bool(missing)
     print("firmware stage time %.1f s" % (time.monotonic() - t0))
     print("firmware: %d passed, %d failed" % (passed, failed))
     return 1 if failed else 0

@@ -15,6 +15,7 @@ SECTIONS = (
     ("Storage and files: store, pass, CFDP copies", "storage_demo", "run"),
     ("OBCPs: ground uploads a PLUTO procedure with service 18", "obcp_demo", "run"),
     ("Reconfiguration module: two MicroPython controllers", "obsw_host.reconfig_sim", "demo"),
+    ("Firmware: the reconfiguration image on a QEMU Cortex-M board", "obsw_host.board", "demo"),
     ("The whole OBC: the 12-step chain and its faults", "obsw_host.obc.chain", "demo"),
     ("Mission control: Yamcs operates the sample spacecraft", "yamcs_demo", "run"),
 )

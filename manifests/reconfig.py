@@ -1,4 +1,7 @@
 # The reconfiguration module's image: its application and only the core modules it imports.
+# Every module that the entry point (boards/OBSW_RECONFIG/reconfig_main.py) imports, directly or
+# not, must be listed: tests/host/test_manifests.py and the firmware stage check it
+# (`tools/mpy.py closure manifests/reconfig.py boards/OBSW_RECONFIG/reconfig_main.py`).
 metadata(
     version="0.1.0",
     description="obsw reconfiguration module (CPDU, safeguard memory, time, essential TC/TM)",
@@ -51,6 +54,7 @@ package(
         "tc.py",
         "tm.py",
         "tm_mux.py",
+        "tm_plan.py",
     ],
     base_path=_CORE,
 )

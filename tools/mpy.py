@@ -3,8 +3,11 @@
 mpy.py build OUT [--march x64]    compile micropython/**.py into OUT (same tree, .mpy files)
 mpy.py sizes [MANIFEST...]        compile what each manifest freezes for the Pyboard
                                   (armv7emsp) and print a size table per module and in total
+mpy.py closure MANIFEST ENTRY...  the modules the entry points import, directly or not, and
+                                  those of them the manifest does not freeze (exit 1 if any)
 """
 
+import ast
 import os
 import pathlib
 import subprocess
@@ -44,6 +47,7 @@ class Manifest:
         self.modules = []  # (path on disk, module path in the image)
         self.required = []
         self.metadata = None
+        self.included = []  # the manifest files themselves
         self._dirs = []
 
     def _base(self, base_path):
@@ -51,6 +55,7 @@ class Manifest:
 
     def execute(self, path):
         path = pathlib.Path(path).resolve()
+        self.included.append(str(path))
         self._dirs.append(path.parent)
         code = compile(path.read_text(), str(path), "exec")
         env = {
@@ -59,6 +64,7 @@ class Manifest:
             "require": self.required.append,
             "package": self._package,
             "module": self._module,
+            "freeze": self._freeze,
             "options": type("Options", (), {})(),
         }
         exec(code, env)
@@ -69,15 +75,24 @@ class Manifest:
             self.metadata = {"description": description, "version": version}
 
     def _include(self, manifest_path, **kwargs):
+        if manifest_path.startswith("$("):
+            return  # MicroPython's own manifests (asyncio, ...): not the project's modules
         p = self._dirs[-1] / manifest_path
         self.execute(p / "manifest.py" if p.is_dir() else p)
 
     def _package(self, package_path, files=None, base_path=".", opt=None):
+        if base_path.startswith("$("):
+            return
         base = self._base(base_path)
         for f in sorted((base / package_path).rglob("*.py")):
             rel = f.relative_to(base)
             if files is None or str(rel.relative_to(package_path)) in files:
                 self.modules.append((f, str(rel)))
+
+    def _freeze(self, path, script=None, opt=None):
+        base = self._base(path)
+        for f in sorted(base.rglob("*.py")) if script is None else [base / script]:
+            self.modules.append((f, str(f.relative_to(base))))
 
     def _module(self, module_path, base_path=".", opt=None):
         base = self._base(base_path)
@@ -127,7 +142,73 @@ def sizes(manifests):
     return failed
 
 
+def _imported(path, package):
+    """Absolute module names a source file imports, anywhere in it (lazy imports too)."""
+    tree = ast.parse(pathlib.Path(path).read_text(), str(path))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                yield a.name
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join([p for p in parts if p] + ([base] if base else []))
+            yield base
+            for a in node.names:
+                yield base + "." + a.name  # a submodule, if there is one by that name
+
+
+def _find(name, roots):
+    rel = name.replace(".", "/")
+    for r in roots:
+        for cand in (r / (rel + ".py"), r / rel / "__init__.py"):
+            if cand.is_file():
+                return cand
+    return None
+
+
+def import_closure(entries, roots):
+    """{module name: source path} of everything the entry files import from ``roots``
+    (modules found nowhere in them, e.g. ``pyb`` or ``struct``, are the firmware's own)."""
+    roots = [pathlib.Path(r) for r in roots]
+    found = {}
+    todo = [(pathlib.Path(e), "") for e in entries]
+    while todo:
+        path, package = todo.pop()
+        for name in _imported(path, package):
+            parts = name.split(".")
+            for i in range(1, len(parts) + 1):  # a package's __init__ runs first
+                mod = ".".join(parts[:i])
+                if mod in found:
+                    continue
+                src = _find(mod, roots)
+                if src is None:
+                    continue
+                found[mod] = src
+                pkg = mod if src.name == "__init__.py" else mod.rpartition(".")[0]
+                todo.append((src, pkg))
+    return found
+
+
+def missing_from_manifest(manifest, entries, roots):
+    """Modules the entries import that ``manifest`` does not freeze."""
+    m = Manifest()
+    m.execute(manifest)
+    frozen = {p.resolve() for p, _ in m.modules}
+    need = import_closure(entries, roots)
+    return sorted(n for n, p in need.items() if p.resolve() not in frozen)
+
+
 def main(argv):
+    if len(argv) >= 4 and argv[1] == "closure":
+        roots = [ROOT / "micropython", ROOT / "boards" / "common"]
+        for mod, path in sorted(import_closure(argv[3:], roots).items()):
+            print("%-40s %s" % (mod, path.relative_to(ROOT)))
+        missing = missing_from_manifest(argv[2], argv[3:], roots)
+        for mod in missing:
+            print("not in %s: %s" % (argv[2], mod))
+        return 1 if missing else 0
     if len(argv) >= 3 and argv[1] == "build":
         march = argv[argv.index("--march") + 1] if "--march" in argv else "x64"
         return 1 if build(argv[2], march) else 0

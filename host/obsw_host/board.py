@@ -1,14 +1,16 @@
 """Pyboard firmware and deployment for the reconfiguration module (`obsw board ...`).
 
-build   the official MicroPython stm32 port, BOARD_DIR=boards/OBSW_RECONFIG, whose
-        FROZEN_MANIFEST is manifests/reconfig.py (needs a MicroPython checkout and
-        arm-none-eabi-gcc)
+build   from the pinned MicroPython source (tools/firmware.py): the Pyboard firmware
+        (stm32 port, BOARD_DIR=boards/OBSW_RECONFIG, FROZEN_MANIFEST manifests/reconfig.py),
+        the unix port and the QEMU Cortex-M board with the core frozen
 deploy  the same modules compiled with mpy-cross for the Pyboard (armv7emsp) and copied to
         the board's filesystem with mpremote, with boot.py and main.py
 flash   mpremote puts the board in its bootloader, then the firmware goes over DFU
 repl    mpremote's REPL
-test    runs board test files on the connected board with mpremote
-Every external program is named by the environment (MAKE, MPREMOTE, MPY_CROSS, DFU_UTIL).
+test    runs board test files on the connected board with mpremote and reads their results
+qemu    starts the QEMU board and prints its pty: deploy, test and repl take it as --port
+A Pyboard over USB and the QEMU board over its pty are driven the same way.
+Every external program is named by the environment (MPREMOTE, MPY_CROSS, DFU_UTIL).
 """
 
 import os
@@ -84,33 +86,49 @@ def frozen_modules():
     return out
 
 
-def build(micropython_dir, jobs=2, extra=(), runner=subprocess.call):
-    """Build firmware.dfu with the official stm32 port; returns the build directory."""
-    if not micropython_dir or not os.path.isfile(
-        os.path.join(micropython_dir, "ports", "stm32", "Makefile")
-    ):
-        raise BoardError(
-            "no MicroPython checkout at %r: clone https://github.com/micropython/micropython "
-            "and pass its path with --micropython (or set MICROPYTHON_DIR)" % (micropython_dir,)
-        )
-    if _tool("ARM_GCC", "arm-none-eabi-gcc") is None:
-        raise BoardError(
-            "arm-none-eabi-gcc not found: install the GNU Arm Embedded toolchain "
-            "(e.g. apt install gcc-arm-none-eabi) and put it on PATH"
-        )
-    make = _tool("MAKE", "make")
-    if make is None:
-        raise BoardError("make not found")
-    port = os.path.join(micropython_dir, "ports", "stm32")
-    build_dir = os.path.join(port, "build-" + BOARD)
-    _run([make, "-C", os.path.join(micropython_dir, "mpy-cross")], runner)
-    _run([make, "-C", port, "BOARD=" + BOARD, "BOARD_DIR=" + board_dir(), "submodules"], runner)
-    _run(
-        [make, "-C", port, "-j%d" % jobs, "BOARD=" + BOARD, "BOARD_DIR=" + board_dir()]
-        + list(extra),
-        runner,
-    )
-    return build_dir
+def firmware_tools():
+    """tools/firmware.py of this repository (the pinned-source builds and the QEMU board)."""
+    tools = os.path.join(repo_root(), "tools")
+    if tools not in sys.path:
+        sys.path.insert(0, tools)
+    import firmware
+
+    return firmware
+
+
+IMAGES = ("pyboard", "unix", "qemu")
+
+
+def build(source=None, images=("pyboard",)):
+    """Build ``images`` from the pinned MicroPython source (cached); returns {image: path}."""
+    fw = firmware_tools()
+    out = {}
+    try:
+        fw.say("MicroPython %s source: %s" % (fw.VERSION, fw.source(source)))
+        for image in images:
+            if image == "pyboard":
+                d = fw.build_pyboard(source)
+                out[image] = os.path.join(str(d), "firmware.dfu")
+                fw.say("Pyboard firmware %s (.hex next to it), heap %d bytes"
+                       % (out[image], fw.pyboard_heap(source)))  # fmt: skip
+            elif image == "unix":
+                out[image] = str(fw.build_unix(source))
+            elif image == "qemu":
+                out[image] = str(fw.build_qemu(source))
+            else:
+                raise BoardError("unknown image %r (one of %s)" % (image, ", ".join(IMAGES)))
+    except fw.FirmwareError as e:
+        raise BoardError(str(e)) from None
+    return out
+
+
+def qemu(extra_args=(), source=None):
+    """Start the QEMU board (built if needed); returns the running firmware.Qemu (``.pty``)."""
+    fw = firmware_tools()
+    try:
+        return fw.Qemu(fw.build_qemu(source), extra_args)
+    except fw.FirmwareError as e:
+        raise BoardError(str(e)) from None
 
 
 def _mpremote(port):
@@ -147,7 +165,8 @@ def deploy(port=None, runner=subprocess.call, out_dir=None):
         cmd += ["exec", _mkdir_code(d), "+"]
     cmd += ["cp", "-r"] + [os.path.join(out_dir, e) for e in sorted(os.listdir(out_dir))]
     cmd += [":", "+", "cp", os.path.join(board_dir(), "boot.py"), ":boot.py"]
-    cmd += ["+", "cp", os.path.join(board_dir(), "main.py"), ":main.py", "+", "reset"]
+    # a soft reset runs boot.py and main.py again (a hard reset would end a QEMU board)
+    cmd += ["+", "cp", os.path.join(board_dir(), "main.py"), ":main.py", "+", "soft-reset"]
     _run(cmd, runner)
     return files
 
@@ -170,19 +189,47 @@ def repl(port=None, runner=subprocess.call):
     _run(_mpremote(port) + ["repl"], runner)
 
 
-BOARD_TESTS = ("test_reconfig_cpdu.py", "test_reconfig_time.py", "test_reconfig_safeguard.py")
+# core tests of the reconfiguration image's own modules that fit a Pyboard's heap (the
+# reconfiguration tests' host models hold two 64 KiB EEPROMs: they run on the host)
+BOARD_TESTS = (
+    "test_crc.py",
+    "test_frames_tc.py",
+    "test_frames_cltu.py",
+    "test_spacecan_frames.py",
+)
 
 
-def test(files, port=None, runner=subprocess.call):
-    """Run core test files on the board with the project's unittest runner. The board must
-    hold the modules in its filesystem (`deploy`): the test support models are copied next to
-    them. Default: the reconfiguration tests."""
+def _results(text):
+    """(passed, failed, skipped) from the runner's closing line, or None."""
+    found = None
+    for line in text.splitlines():
+        words = line.replace(",", "").split()
+        if len(words) >= 4 and words[1] == "passed" and words[3] == "failed":
+            try:
+                found = (int(words[0]), int(words[2]), int(words[4]) if len(words) > 5 else 0)
+            except ValueError:
+                pass
+    return found
+
+
+def _capture(cmd):
+    print("$ " + " ".join(cmd), flush=True)
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    out = res.stdout + res.stderr
+    print(out, end="" if out.endswith("\n") or not out else "\n")
+    return res.returncode, out
+
+
+def test(files, port=None, runner=_capture):
+    """Run core test files on the board with the project's unittest runner and read their
+    results. The board must hold the modules (`deploy`, or frozen): the test support models
+    are copied next to them. Default: the reconfiguration tests. Returns the failures."""
     root = repo_root()
     if not files:
         files = [os.path.join(root, "tests", "core", f) for f in BOARD_TESTS]
     upy = os.path.join(root, "tools", "upy")
     support = os.path.join(root, "micropython", "obsw", "reconfig")
-    failed = 0
+    totals = [0, 0, 0]
     for f in files:
         name = os.path.basename(f)
         cmd = _mpremote(port) + ["cp", os.path.join(upy, "unittest.py"), ":unittest.py", "+"]
@@ -190,13 +237,41 @@ def test(files, port=None, runner=subprocess.call):
             cmd += ["exec", _mkdir_code(d), "+"]
         for m in ("models.py", "dekker_sim.py"):  # test support, not in the image
             cmd += ["cp", os.path.join(support, m), ":obsw/reconfig/" + m, "+"]
-        cmd += ["cp", os.path.join(upy, "run.py"), ":obsw_run_tests.py", "+"]
+        cmd += ["cp", os.path.join(upy, "obsw_run_tests.py"), ":obsw_run_tests.py", "+"]
         cmd += ["cp", f, ":" + name, "+", "exec"]
-        cmd.append("import sys; sys.argv = ['run', %r]; import obsw_run_tests" % name)
-        try:
-            _run(cmd, runner)
-        except BoardError as e:
-            print(str(e))
-            failed += 1
-    print("%d passed, %d failed" % (len(files) - failed, failed))
-    return failed
+        cmd.append("import obsw_run_tests; obsw_run_tests.main([%r])" % name)
+        rc, out = runner(cmd)
+        got = _results(out or "")
+        if rc or got is None:
+            totals[1] += max(1, got[1] if got else 1)
+            print("%s: no result from the board (status %s)" % (name, rc))
+            continue
+        for i in range(3):
+            totals[i] += got[i]
+    print("board: %d passed, %d failed%s" % (totals[0], totals[1],
+          ", %d skipped" % totals[2] if totals[2] else ""))  # fmt: skip
+    return totals[1]
+
+
+def demo(out=print):
+    """The demo's section: the QEMU Cortex-M board with the Pyboard's heap runs the frozen
+    reconfiguration application for a while and reports its heap (the image is built first if
+    it is not in build/fw yet)."""
+    fw = firmware_tools()
+    try:
+        elf = fw.build_qemu()
+    except fw.FirmwareError as e:
+        out("no QEMU board image: %s" % e)
+        return
+    with fw.Qemu(elf) as q:
+        out("QEMU board (mps2-an385, Cortex-M3) on %s, image %s" % (q.pty, elf))
+        code = (
+            "import sys, gc; print(sys.implementation._machine, 'heap', gc.mem_free() + "
+            "gc.mem_alloc()); import obsw_heap; obsw_heap.reconfig(2000)"
+        )
+        rc, text = fw.mpremote(q.pty, "exec", code, timeout=120)
+        for line in text.splitlines():
+            if line.startswith(("mps2", "heap", "passes", "Traceback")) or "Error" in line:
+                out("  " + line)
+        if rc:
+            raise BoardError("the board session failed (mpremote status %d)" % rc)

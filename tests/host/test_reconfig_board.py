@@ -10,6 +10,7 @@ from obsw_host.commands import board as cmd
 
 FAKE = """#!/bin/sh
 echo "$(basename "$0") $*" >> "{log}"
+echo "2 passed, 0 failed"
 exit 0
 """
 
@@ -43,32 +44,24 @@ def run(argv):
     return args.func(args)
 
 
-def test_build_runs_the_stm32_port_with_this_board(fakes):
+def test_build_says_where_to_get_the_pinned_source(fakes, capsys, monkeypatch):
     tmp, calls = fakes
-    mp = tmp / "micropython"
-    (mp / "ports" / "stm32").mkdir(parents=True)
-    (mp / "ports" / "stm32" / "Makefile").write_text("")
-    assert run(["board", "build", "--micropython", str(mp), "-j", "3"]) == 0
-    c = calls()
-    assert c[0] == "make -C %s" % (mp / "mpy-cross")
-    assert "submodules" in c[1]
-    assert "-j3" in c[2] and "BOARD=OBSW_RECONFIG" in c[2]
-    assert "BOARD_DIR=%s" % board.board_dir() in c[2]
+    monkeypatch.setenv("OBSW_MICROPYTHON_SRC", str(tmp / "nothing"))
+    assert run(["board", "build", "--image", "unix"]) == 2
+    assert "no MicroPython 1.28.0 source" in capsys.readouterr().out
+    assert run(["board", "build", "--micropython", str(tmp / "nothing")]) == 2
+    assert calls() == []
+    fw = board.firmware_tools()
+    monkeypatch.delenv("OBSW_MICROPYTHON_SRC")
+    monkeypatch.setattr(fw, "_candidates", lambda explicit: iter([tmp / "none"]))
+    with pytest.raises(fw.FirmwareError) as e:
+        fw.source()
+    assert "git clone --branch v1.28.0" in str(e.value)
+
+
+def test_the_pyboard_image_freezes_the_reconfiguration_manifest():
     with open(os.path.join(board.board_dir(), "mpconfigboard.mk")) as f:
         assert "manifests/reconfig.py" in f.read()
-
-
-def test_build_says_what_is_missing(fakes, capsys, monkeypatch):
-    tmp, calls = fakes
-    assert run(["board", "build", "--micropython", str(tmp / "nothing")]) == 2
-    assert "no MicroPython checkout" in capsys.readouterr().out
-    mp = tmp / "mp"
-    (mp / "ports" / "stm32").mkdir(parents=True)
-    (mp / "ports" / "stm32" / "Makefile").write_text("")
-    monkeypatch.setenv("ARM_GCC", str(tmp / "no-such-gcc"))
-    assert run(["board", "build", "--micropython", str(mp)]) == 2
-    assert "arm-none-eabi-gcc not found" in capsys.readouterr().out
-    assert calls() == []
 
 
 def test_deploy_compiles_for_the_pyboard_and_copies(fakes):
@@ -76,7 +69,7 @@ def test_deploy_compiles_for_the_pyboard_and_copies(fakes):
     assert run(["board", "deploy", "--port", "/dev/ttyACM0"]) == 0
     c = calls()
     assert len(c) == 1 and c[0].startswith("mpremote connect /dev/ttyACM0")
-    assert " cp -r " in c[0] and c[0].endswith("reset")
+    assert " cp -r " in c[0] and c[0].endswith("soft-reset")
     assert ":main.py" in c[0] and ":boot.py" in c[0]
     names = [n for _, n in board.frozen_modules()]
     assert "obsw/reconfig/app.py" in names and "hal_pyb.py" in names

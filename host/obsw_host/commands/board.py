@@ -5,10 +5,27 @@ def add_parser(sub):
     p = sub.add_parser("board", help="Pyboard firmware for the reconfiguration module")
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
-    b = s.add_parser("build", help="build firmware with the official stm32 port")
-    b.add_argument("--micropython", help="MicroPython checkout (default $MICROPYTHON_DIR)")
+    b = s.add_parser(
+        "build", help="build the Pyboard firmware, unix port and QEMU board (pinned source)"
+    )
+    b.add_argument(
+        "--micropython",
+        help="the MicroPython 1.28.0 source: release archive, folder holding it, or tree "
+        "(default $OBSW_MICROPYTHON_SRC, then ../shared/micropython)",
+    )
+    b.add_argument(
+        "--image",
+        action="append",
+        choices=("pyboard", "unix", "qemu"),
+        help="what to build (repeatable; default: all three)",
+    )
     b.add_argument("-j", "--jobs", type=int, default=2)
     b.set_defaults(func=_build)
+    q = s.add_parser("qemu", help="start the QEMU Cortex-M board and print its pty")
+    q.add_argument(
+        "qemu_args", nargs="*", help="extra qemu arguments (after --), e.g. -- -icount shift=0"
+    )
+    q.set_defaults(func=_qemu)
     for name, fn, text in (
         ("deploy", _deploy, "mpy-cross the modules and copy them with mpremote"),
         ("flash", _flash, "bootloader via mpremote, then DFU"),
@@ -16,7 +33,9 @@ def add_parser(sub):
         ("test", _test, "run board test files on the board"),
     ):
         q = s.add_parser(name, help=text)
-        q.add_argument("--port", help="serial port (default: mpremote's auto)")
+        q.add_argument(
+            "--port", "--device", help="serial port or QEMU pty (default: mpremote's auto)"
+        )
         if name == "flash":
             q.add_argument("firmware", help="firmware.dfu from `obsw board build`")
         if name == "test":
@@ -41,10 +60,28 @@ def _build(args):
 
     from obsw_host import board
 
-    src = args.micropython or os.environ.get("MICROPYTHON_DIR")
+    os.environ["OBSW_JOBS"] = str(args.jobs)
 
     def go():
-        print("firmware in %s" % board.build(src, args.jobs))
+        for image, path in board.build(args.micropython, args.image or board.IMAGES).items():
+            print("%-8s %s" % (image, path))
+
+    return _guard(go)
+
+
+def _qemu(args):
+    from obsw_host import board
+
+    def go():
+        q = board.qemu(args.qemu_args)
+        print("QEMU board on %s (obsw board deploy|test|repl --port %s); Ctrl-C ends it"
+              % (q.pty, q.pty), flush=True)  # fmt: skip
+        try:
+            q.proc.wait()
+        except KeyboardInterrupt:
+            pass
+        finally:
+            q.close()
 
     return _guard(go)
 

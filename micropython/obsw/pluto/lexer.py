@@ -47,9 +47,49 @@ def _isword(c):
     return c.isalpha() or c == "_"
 
 
-def tokenize(src):
-    """List of (kind, value, pos) tuples ending with an EOF token; raises PlutoSyntaxError."""
-    out = []
+_KINDS = WORD + NUM + STR + OP + ABST + RELT + EOF
+
+
+class Tokens:
+    """A token list in two preallocated columns, kind and position packed into one small int
+    (a board's heap holds a long procedure's tokens in 8 bytes each instead of a tuple each, in
+    two blocks that do not fragment it); indexing gives (kind, value, pos)."""
+
+    def __init__(self, capacity):
+        self.codes = [0] * capacity
+        self.values = [None] * capacity
+        self.n = 0
+
+    def append(self, token):
+        code = (token[2] << 3) | _KINDS.index(token[0])
+        if self.n < len(self.codes):
+            self.codes[self.n] = code
+            self.values[self.n] = token[1]
+        else:
+            self.codes.append(code)
+            self.values.append(token[1])
+        self.n += 1
+
+    def __len__(self):
+        return self.n
+
+    def __getitem__(self, j):
+        if j < 0:
+            j += self.n
+        if not 0 <= j < self.n:
+            raise IndexError(j)
+        code = self.codes[j]
+        return _KINDS[code & 7], self.values[j], code >> 3
+
+    def __iter__(self):
+        for j in range(self.n):
+            yield self[j]
+
+
+def tokenize(src, compact=False):
+    """List of (kind, value, pos) tuples ending with an EOF token (``compact``: a Tokens of
+    them); raises PlutoSyntaxError."""
+    out = Tokens(len(src) // 4 + 8) if compact else []
     i, n = 0, len(src)
     line, start = 1, 0
     after_num = False

@@ -21,7 +21,7 @@ _PROC_ONLY = (
 
 def parse(src):
     """Parse procedure text into its definition node; raises PlutoSyntaxError."""
-    tree = Parser(tokenize(src)).procedure()
+    tree = Parser(tokenize(src, True)).procedure()
     check_depth(tree)
     return tree
 

@@ -38,6 +38,9 @@ REAL_MIL_EXTENDED = const(4)
 
 _INT_FMT = {8: "B", 16: "H", 32: "I", 64: "Q"}
 _FLT_MAX = 3.4028234663852886e38
+# not math.inf in the code: the compiler folds it into a constant that the freezer writes as
+# C 'inf', which does not compile (frozen images)
+_INF = float("inf")
 
 
 class FieldTypeError(ValueError):
@@ -209,7 +212,7 @@ class Real(FieldType):
             v = float(value)
         except (TypeError, ValueError):
             self.fail(value, "a real number")
-        if self.pfc == REAL_IEEE_SINGLE and _FLT_MAX < abs(v) < math.inf:
+        if self.pfc == REAL_IEEE_SINGLE and _FLT_MAX < abs(v) < _INF:
             self.fail(value, "a real number within IEEE single range")
         return v
 
@@ -243,7 +246,7 @@ class MilStd1750(FieldType):
             v = float(value)
         except (TypeError, ValueError):
             self.fail(value, "a real number")
-        if v != v or v in (math.inf, -math.inf):
+        if v != v or v in (_INF, -_INF):
             self.fail(value, "a finite real number")
         if v == 0:
             return 0, 0

@@ -97,14 +97,16 @@ class SimI2C:
 class M24512Model:
     """64 KiB in 128-byte pages; a page write wraps within its page; busy for a few polls.
 
-    With ``path`` the contents persist in that file (the host simulation's EEPROM).
+    With ``path`` the contents persist in that file (the host simulation's EEPROM). ``size``
+    (a power of two) models only the low part of the device, for a board's small heap.
     """
 
-    def __init__(self, path=None, busy_polls=2):
+    def __init__(self, path=None, busy_polls=2, size=65536):
         self.path = path
         self.busy_polls = busy_polls
         self.busy = 0
-        self.mem = bytearray(b"\xff" * 65536)
+        self.mask = size - 1
+        self.mem = bytearray(b"\xff" * size)
         self._file = None
         if path is not None:
             try:
@@ -118,7 +120,7 @@ class M24512Model:
     def read(self, mem, n):
         out = bytearray(n)
         for i in range(n):
-            out[i] = self.mem[(mem + i) & 0xFFFF]
+            out[i] = self.mem[(mem + i) & self.mask]
         return out
 
     def _put(self, mem, data, keep=None):
@@ -317,12 +319,14 @@ class ModelHal(Hal):
     """An in-memory hardware layer on a manual clock (``now`` in microseconds; each reading
     of it moves it on by ``tick_us``, as time passes while code runs)."""
 
-    def __init__(self, role=NOMINAL, seed=1, bit_error_gap=0, rtc_seconds=0, tick_us=5):
+    def __init__(
+        self, role=NOMINAL, seed=1, bit_error_gap=0, rtc_seconds=0, tick_us=5, eeprom_size=65536
+    ):
         self.role = role
         self.now = 0
         self.tick_us = tick_us
         self.i2c = SimI2C(seed, bit_error_gap)
-        self.eeproms = [M24512Model(), M24512Model()]
+        self.eeproms = [M24512Model(size=eeprom_size), M24512Model(size=eeprom_size)]
         self.i2c.devices[0x50] = self.eeproms[0]
         self.i2c.devices[0x51] = self.eeproms[1]
         self.rtc = DS3231Model(lambda: self.now / 1000000, seconds=rtc_seconds)

@@ -1,0 +1,2 @@
+OBSW_QEMU_DIR := $(USERMOD_DIR)
+SRC_USERMOD_C += $(OBSW_QEMU_DIR)/obsw_qemu.c

@@ -1,0 +1,438 @@
+"""MicroPython images from the pinned source: mpy-cross, the Pyboard firmware, a unix port and a
+QEMU Cortex-M board with the core frozen; and the QEMU board itself (start, pty, stop).
+
+firmware.py build [all|mpy-cross|pyboard|unix|qemu]   build (cached in build/fw/)
+firmware.py qemu [QEMU_ARG...]                         start the QEMU board, print its pty, wait
+firmware.py sizes                                      flash and frozen-bytecode table (a stage)
+
+The source: --micropython PATH or $OBSW_MICROPYTHON_SRC (the release archive, a folder holding
+it, or an unpacked tree), else the archive in ../shared/micropython next to the repository.
+Every build is skipped when its inputs (manifests, frozen modules, board files, options) are
+unchanged. Python API: ``source()``, ``build_pyboard()``, ``build_unix()``, ``build_qemu()``,
+``Qemu(elf, extra_args)`` (``.pty``, ``.close()``), ``pyboard_heap()``.
+"""
+
+import hashlib
+import os
+import pathlib
+import re
+import select
+import shutil
+import subprocess
+import sys
+import tarfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+from mpy import BUDGETS, Manifest, compile_one, missing_from_manifest  # noqa: E402
+
+BUILD = ROOT / "build" / "fw"
+VERSION = "1.28.0"
+ARCHIVE = "micropython-%s-src.tar.gz" % VERSION
+ARCHIVE_SHA256 = "2baa9f8f3aa5fc6dd0bc6dd55c0eea6587ffe3d6bf03a0ccc920c5a3ac4d517d"
+GET_SOURCE = (
+    "git clone --branch v%s https://github.com/micropython/micropython && "
+    "make -C micropython/ports/stm32 submodules" % VERSION
+)
+PYBOARD = ROOT / "boards" / "OBSW_RECONFIG"
+QEMU_BOARD = ROOT / "boards" / "OBSW_QEMU"
+UNIX_OPTIONS = ("VARIANT=standard", "MICROPY_PY_BTREE=0", "MICROPY_PY_FFI=0", "MICROPY_PY_SSL=0")
+# STM32F405RG: 1 MiB flash; sectors 1-4 (112 KiB at 0x08004000) hold the filesystem, the
+# firmware has sector 0 (16 KiB, vectors) and sectors 5-11 (896 KiB from 0x08020000).
+F405_FLASH = 1024 * 1024
+F405_FIRMWARE_SPACE = (16 + 896) * 1024
+JOBS = os.environ.get("OBSW_JOBS", "2")
+
+
+class FirmwareError(RuntimeError):
+    """No source, no toolchain, or a build that failed."""
+
+
+def say(text):
+    print("firmware: " + text, flush=True)
+
+
+# -- the source -------------------------------------------------------------------------------
+
+
+def _candidates(explicit):
+    if explicit:
+        yield pathlib.Path(explicit)
+        return
+    env = os.environ.get("OBSW_MICROPYTHON_SRC")
+    if env:
+        yield pathlib.Path(env)
+        return
+    for base in (ROOT.parent / "shared" / "micropython", ROOT / "shared" / "micropython"):
+        yield base
+
+
+def _tree(path):
+    return path.is_dir() and (path / "py" / "mpconfig.h").is_file()
+
+
+def source(explicit=None):
+    """The MicroPython tree to build from (unpacked into build/fw once)."""
+    for c in _candidates(explicit):
+        if _tree(c):
+            return c
+        archive = c / ARCHIVE if c.is_dir() else c
+        if archive.is_file():
+            return _unpack(archive)
+        if explicit or os.environ.get("OBSW_MICROPYTHON_SRC"):
+            raise FirmwareError("no MicroPython %s source at %s" % (VERSION, c))
+    raise FirmwareError(
+        "no MicroPython %s source: set OBSW_MICROPYTHON_SRC to %s (or to a tree), or get it "
+        "with: %s" % (VERSION, ARCHIVE, GET_SOURCE)
+    )
+
+
+def _unpack(archive):
+    dest = BUILD / ("micropython-" + VERSION)
+    stamp = dest / ".obsw-unpacked"
+    st = archive.stat()
+    key = "%s %d %d" % (archive.resolve(), st.st_size, int(st.st_mtime))
+    if stamp.is_file() and stamp.read_text() == key:
+        return dest / "micropython"
+    digest = hashlib.sha256(archive.read_bytes()).hexdigest()
+    if digest != ARCHIVE_SHA256:
+        say("warning: %s has sha256 %s, not the pinned release's" % (archive, digest))
+    say("unpacking %s into %s" % (archive, dest))
+    if dest.exists():
+        shutil.rmtree(dest)
+    dest.mkdir(parents=True)
+    with tarfile.open(archive) as t:
+        t.extractall(dest, filter="tar") if hasattr(tarfile, "data_filter") else t.extractall(dest)
+    stamp.write_text(key)
+    return dest / "micropython"
+
+
+# -- toolchains ---------------------------------------------------------------------------------
+
+
+def need(tool, package):
+    if shutil.which(tool) is None:
+        raise FirmwareError(
+            "%s not found: sudo apt-get install -y gcc-arm-none-eabi libnewlib-arm-none-eabi "
+            "qemu-system-arm (%s)" % (tool, package)
+        )
+
+
+# -- cached builds ------------------------------------------------------------------------------
+
+
+def _hash_inputs(paths, options):
+    h = hashlib.sha256()
+    for p in sorted(set(str(p) for p in paths)):
+        h.update(p.encode())
+        h.update(pathlib.Path(p).read_bytes())
+    for o in options:
+        h.update(o.encode())
+    return h.hexdigest()
+
+
+def manifest_inputs(manifest):
+    """The manifest files and every module they freeze."""
+    m = Manifest()
+    m.execute(manifest)
+    return [str(src) for src, _ in m.modules] + m.included
+
+
+def _files_under(folder):
+    return [str(p) for p in pathlib.Path(folder).rglob("*") if p.is_file()]
+
+
+def _make(tree, out, artifact, inputs, args):
+    """Run make unless ``out``'s stamp says these inputs built ``artifact`` already."""
+    key = _hash_inputs(inputs, [str(tree)] + list(args))
+    stamp = out / ".obsw-inputs"
+    if (out / artifact).is_file() and stamp.is_file() and stamp.read_text() == key:
+        say("cached %s" % (out / artifact))
+        return out / artifact, 0.0
+    t0 = time.monotonic()
+    cmd = ["make", "-j" + JOBS] + list(args)
+    say("$ " + " ".join(cmd))
+    log = out.parent / (out.name + ".log")
+    out.mkdir(parents=True, exist_ok=True)
+    with open(log, "w") as f:
+        rc = subprocess.call(cmd, stdout=f, stderr=subprocess.STDOUT)
+    if rc or not (out / artifact).is_file():
+        tail = log.read_text().splitlines()[-25:]
+        raise FirmwareError("build failed (log %s):\n%s" % (log, "\n".join(tail)))
+    stamp.write_text(key)
+    dt = time.monotonic() - t0
+    say("built %s in %.1f s" % (out / artifact, dt))
+    return out / artifact, dt
+
+
+def build_mpy_cross(src=None):
+    tree = source(src)
+    out = tree / "mpy-cross" / "build"
+    return _make(tree, out, "mpy-cross", [], ["-C", str(tree / "mpy-cross")])[0]
+
+
+def build_pyboard(src=None):
+    """boards/OBSW_RECONFIG with the stm32 port: returns the build folder (firmware.dfu/.hex)."""
+    need("arm-none-eabi-gcc", "gcc-arm-none-eabi")
+    tree = source(src)
+    build_mpy_cross(src)
+    out = BUILD / "pyboard"
+    inputs = _files_under(PYBOARD) + manifest_inputs(ROOT / "manifests" / "reconfig.py")
+    args = ["-C", str(tree / "ports" / "stm32"), "BOARD_DIR=" + str(PYBOARD), "BUILD=" + str(out)]
+    _make(tree, out, "firmware.dfu", inputs, args)
+    return out
+
+
+def build_unix(src=None):
+    """The unix port with manifests/unix.py (asyncio and the core) frozen: the executable."""
+    tree = source(src)
+    build_mpy_cross(src)
+    out = BUILD / "unix"
+    manifest = ROOT / "manifests" / "unix.py"
+    args = ["-C", str(tree / "ports" / "unix"), "BUILD=" + str(out)]
+    args += list(UNIX_OPTIONS) + ["FROZEN_MANIFEST=" + str(manifest)]
+    return _make(tree, out, "micropython", manifest_inputs(manifest), args)[0]
+
+
+def pyboard_heap(src=None):
+    """Bytes between _heap_start and _heap_end of the Pyboard firmware (its GC heap)."""
+    elf = build_pyboard(src) / "firmware.elf"
+    out = subprocess.run(["arm-none-eabi-nm", str(elf)], capture_output=True, text=True).stdout
+    sym = {}
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 3:
+            sym[parts[2]] = int(parts[0], 16)
+    return sym["_heap_end"] - sym["_heap_start"]
+
+
+# a float constant the freezer cannot write for a single-precision image (beyond +-3.4e38, inf)
+_UNFREEZABLE = re.compile(r"[0-9.]e\+?([4-9][0-9]|[1-9][0-9]{2})\b|\binf\b")
+BOARD_TESTS = BUILD / "board-tests"
+
+
+def stage_board_tests():
+    """Copy the core tests and their support modules that freeze into build/fw/board-tests
+    (frozen into the QEMU image); returns the names of those that do not (run from source)."""
+    BOARD_TESTS.mkdir(parents=True, exist_ok=True)
+    left = []
+    wanted = set()
+    for p in sorted((ROOT / "tests" / "core").glob("*.py")):
+        text = p.read_text()
+        if _UNFREEZABLE.search(text):
+            left.append(p.name)
+            continue
+        wanted.add(p.name)
+        dst = BOARD_TESTS / p.name
+        if not dst.is_file() or dst.read_text() != text:
+            dst.write_text(text)
+    for old in BOARD_TESTS.glob("*.py"):
+        if old.name not in wanted:
+            old.unlink()
+    return left
+
+
+def build_qemu(src=None, heap=None):
+    """boards/OBSW_QEMU (mps2-an385, Cortex-M3) with manifests/qemu.py frozen and a GC heap of
+    ``heap`` bytes (default: the Pyboard's). Returns firmware.elf."""
+    need("arm-none-eabi-gcc", "gcc-arm-none-eabi")
+    tree = source(src)
+    build_mpy_cross(src)
+    heap = heap or pyboard_heap(src)
+    stage_board_tests()
+    out = BUILD / ("qemu-%d" % heap)
+    manifest = ROOT / "manifests" / "qemu.py"
+    args = ["-C", str(tree / "ports" / "qemu"), "BOARD=OBSW_QEMU", "BOARD_DIR=" + str(QEMU_BOARD)]
+    args += [
+        "BUILD=" + str(out),
+        "MICROPY_HEAP_SIZE=%d" % heap,
+        "FROZEN_MANIFEST=" + str(manifest),
+    ]
+    inputs = _files_under(QEMU_BOARD) + manifest_inputs(manifest)
+    return _make(tree, out, "firmware.elf", inputs, args)[0]
+
+
+# -- the QEMU board -----------------------------------------------------------------------------
+
+
+class Qemu:
+    """qemu-system-arm running firmware.elf with its UART on a pty (``.pty``) for mpremote.
+
+    ``extra_args`` go to qemu as they are (e.g. ``["-icount", "shift=0"]``)."""
+
+    def __init__(self, elf, extra_args=(), timeout=20):
+        need("qemu-system-arm", "qemu-system-arm")
+        cmd = ["qemu-system-arm", "-machine", "mps2-an385", "-nographic", "-monitor", "null"]
+        cmd += ["-semihosting", "-bios", "none", "-serial", "pty", "-kernel", str(elf)]
+        cmd += list(extra_args)
+        self.cmd = cmd
+        self.proc = subprocess.Popen(
+            cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT
+        )
+        self.pty = None
+        seen = b""
+        end = time.monotonic() + timeout
+        while self.pty is None and time.monotonic() < end:
+            r, _, _ = select.select([self.proc.stdout], [], [], 0.5)
+            if r:
+                chunk = os.read(self.proc.stdout.fileno(), 4096)
+                if not chunk:
+                    break
+                seen += chunk
+                m = re.search(rb"(/dev/pts/\d+)", seen)
+                if m:
+                    self.pty = m.group(1).decode()
+        if self.pty is None:
+            self.close()
+            raise FirmwareError("qemu gave no pty: %s" % seen.decode(errors="replace"))
+
+    def close(self):
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(5)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        self.proc.stdout.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def mpremote(pty, *args, timeout=300):
+    """Run mpremote against ``pty``; returns (exit status, output)."""
+    tool = shutil.which("mpremote") or str(ROOT / ".venv" / "bin" / "mpremote")
+    cmd = [tool, "connect", pty] + list(args)
+    try:
+        res = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired as e:
+        out = e.stdout.decode(errors="replace") if isinstance(e.stdout, bytes) else e.stdout
+        return -1, (out or "") + "\n[timed out after %d s]" % timeout
+    return res.returncode, res.stdout + res.stderr
+
+
+# -- the firmware stage -------------------------------------------------------------------------
+
+
+def _sections(elf):
+    out = subprocess.run(["arm-none-eabi-size", "-A", str(elf)], capture_output=True, text=True)
+    sizes = {}
+    for line in out.stdout.splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[1].isdigit():
+            sizes[parts[0]] = int(parts[1])
+    return sizes
+
+
+_SIZES = {}  # source path -> (bytes of bytecode, error): images share most modules
+
+
+def _frozen_size(manifest):
+    """Bytes of Pyboard (armv7emsp) bytecode that ``manifest`` freezes, and failures."""
+    m = Manifest()
+    m.execute(manifest)
+    total, bad = 0, []
+    tmp = BUILD / "frozen-sizes"
+    for src, name in m.modules:
+        if src not in _SIZES:
+            dst = tmp / (name[:-3] + ".mpy")
+            ok, err = compile_one(src, dst, "armv7emsp", name)
+            _SIZES[src] = (dst.stat().st_size, None) if ok else (0, err)
+        size, err = _SIZES[src]
+        total += size
+        if err:
+            bad.append("%s: %s" % (name, err))
+    return total, bad
+
+
+def stage_sizes():
+    t0 = time.monotonic()
+    passed = failed = 0
+    try:
+        out = build_pyboard()
+        passed += 1
+    except FirmwareError as e:
+        print(e)
+        print("firmware: 0 passed, 1 failed")
+        return 1
+    s = _sections(out / "firmware.elf")
+    flash = sum(s.get(k, 0) for k in (".isr_vector", ".isr_extratext", ".text", ".ARM", ".data"))
+    ram = s.get(".data", 0) + s.get(".bss", 0)
+    heap = pyboard_heap()
+    print("Pyboard firmware %s" % (out / "firmware.dfu"))
+    print("  %-40s %9s %9s %6s" % ("", "used", "space", "use"))
+    for label, used, space in (
+        ("flash (firmware)", flash, F405_FIRMWARE_SPACE),
+        ("flash (whole STM32F405, 1 MiB)", flash, F405_FLASH),
+        ("RAM .data+.bss (of 128 KiB)", ram, 128 * 1024),
+        ("GC heap for the application", heap, 128 * 1024),
+    ):
+        print("  %-40s %9d %9d %5.1f%%" % (label, used, space, 100.0 * used / space))
+    if flash > F405_FIRMWARE_SPACE:
+        failed += 1
+        print("  firmware over the flash space")
+    else:
+        passed += 1
+    print("\nfrozen bytecode per image (armv7emsp)")
+    print("  %-24s %9s %9s %6s" % ("image", "bytes", "budget", "use"))
+    for mpath in sorted((ROOT / "manifests").glob("*.py")):
+        total, bad = _frozen_size(mpath)
+        budget = BUDGETS.get(mpath.name, F405_FIRMWARE_SPACE - flash + total)
+        print("  %-24s %9d %9d %5.1f%%" % (mpath.name, total, budget, 100.0 * total / budget))
+        for b in bad:
+            print("    FAILED " + b)
+        if bad or total > budget:
+            failed += 1
+        else:
+            passed += 1
+    entry = PYBOARD / "reconfig_main.py"
+    roots = [ROOT / "micropython", ROOT / "boards" / "common", PYBOARD]
+    missing = missing_from_manifest(ROOT / "manifests" / "reconfig.py", [entry], roots)
+    print("\nreconfig.py freezes every module reconfig_main.py imports: %s"
+          % ("yes" if not missing else "no, it misses " + ", ".join(missing)))  # fmt: skip
+    passed, failed = passed + (not missing), failed + bool(missing)
+    print("firmware stage time %.1f s" % (time.monotonic() - t0))
+    print("firmware: %d passed, %d failed" % (passed, failed))
+    return 1 if failed else 0
+
+
+def main(argv):
+    if not argv or argv[0] in ("-h", "--help"):
+        print(__doc__)
+        return 0 if argv else 2
+    try:
+        if argv[0] == "build":
+            what = argv[1] if len(argv) > 1 else "all"
+            if what in ("all", "mpy-cross"):
+                say("mpy-cross %s" % build_mpy_cross())
+            if what in ("all", "pyboard"):
+                say("Pyboard firmware in %s (heap %d bytes)" % (build_pyboard(), pyboard_heap()))
+            if what in ("all", "unix"):
+                say("unix port %s" % build_unix())
+            if what in ("all", "qemu"):
+                say("QEMU board %s" % build_qemu())
+            return 0
+        if argv[0] == "qemu":
+            with Qemu(build_qemu(), argv[1:]) as q:
+                print(q.pty, flush=True)
+                try:
+                    q.proc.wait()
+                except KeyboardInterrupt:
+                    pass
+            return 0
+        if argv[0] == "sizes":
+            return stage_sizes()
+    except FirmwareError as e:
+        print("firmware: %s" % e)
+        return 1
+    print(__doc__)
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,288 @@
+"""The tools/test stages on real MicroPython images (each closes with 'N passed, N failed').
+
+firmware_stages.py firmware     the Pyboard image builds; flash and frozen-bytecode table
+firmware_stages.py upy-frozen   core tests on the unix port with the core frozen
+firmware_stages.py cortex-m     core tests on the QEMU Cortex-M board through mpremote
+firmware_stages.py heap         reconfiguration session and a PLUTO procedure on the QEMU board
+                                with the Pyboard's heap: heap figures
+firmware_stages.py board        obsw board deploy / test against the QEMU board's pty
+"""
+
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+import firmware  # noqa: E402
+
+CORE_TESTS = sorted((ROOT / "tests" / "core").glob("test_*.py"))
+# Core tests that cannot run on a board with the Pyboard's heap and float, and why (counted as
+# skipped, with the reason, by the board-side runner). A file name skips the whole file.
+EEPROM = "host model of two 64 KiB M24512 EEPROMs: more than the Pyboard's whole heap"
+BIG = "a 64 KiB packet: more than the Pyboard's heap can hold in one block"
+HEAP = "a host-scale scenario (many transfers, stores or procedures at once) beyond a 103 KiB heap"
+FLOAT = (
+    "times as float epoch seconds or exact decimals: the board's floats are single precision "
+    "(32-bit, 128 s apart in 2025)"
+)
+FILES = "reads the host's files (tests/data, temporary folders)"
+STACK = "deep recursion beyond the board's 10 KiB C stack"
+CORTEX_M_SKIPS = {
+    "test_cbor.py::TestDeterministic::test_shortest_float": FLOAT,
+    "test_cbor.py::TestMalformed::test_nesting_too_deep": STACK,
+    "test_cbor.py::TestVectors::test_decode_vectors": FLOAT,
+    "test_cbor.py::TestVectors::test_encode_vectors": FLOAT,
+    "test_cfdp_class2.py::TestClass2::test_checksum_types": HEAP,
+    "test_cfdp_class2.py::TestClass2::test_corruption_with_crc": HEAP,
+    "test_cfdp_class2.py::TestClass2::test_loss_both_directions_many_seeds": HEAP,
+    "test_cfdp_class2.py::TestClass2::test_loss_duplication_reordering": HEAP,
+    "test_cfdp_class2.py::TestClass2::test_lost_eof_and_acks": HEAP,
+    "test_cfdp_class2.py::TestClass2::test_retransmissions_close_to_losses": HEAP,
+    "test_cfdp_class2.py::TestClass2::test_two_transfers_at_once_both_ways": HEAP,
+    "test_cfdp_filestore.py": FILES,
+    "test_cfdp_proxy.py::TestProxy::test_remote_suspend_resume_and_status": HEAP,
+    "test_cfdp_restart.py::TestRestart::test_both_restart_class1": HEAP,
+    "test_cfdp_restart.py::TestRestart::test_receiver_restarts_after_eof": HEAP,
+    "test_cfdp_restart.py::TestRestart::test_receiver_restarts_mid_transfer": HEAP,
+    "test_cfdp_restart.py::TestRestart::test_sender_restarts_mid_transfer": HEAP,
+    "test_pluto_engine.py::TestControl::test_abort": FLOAT,
+    "test_pluto_engine.py::TestControl::test_resume_cancels_pending_suspend": FLOAT,
+    "test_pluto_engine.py::TestControl::test_stop_at_end_of_step": FLOAT,
+    "test_pluto_engine.py::TestControl::test_stop_outside_steps_is_immediate": FLOAT,
+    "test_pluto_engine.py::TestControl::test_suspend_and_resume": FLOAT,
+    "test_pluto_engine.py::TestLoading::test_load_file_and_bytes": FILES,
+    "test_pluto_engine.py::TestRunning::test_events_raised_and_questions": FLOAT,
+    "test_pluto_engine.py::TestRunning::test_failure_emits_failed": FLOAT,
+    "test_pluto_engine.py::TestRunning::test_procedure_reads_calls_and_waits": FLOAT,
+    "test_pluto_engine.py::TestRunning::test_two_procedures_at_once": FLOAT,
+    "test_pluto_engine.py::TestRunning::test_waits_for_component_event": FLOAT,
+    "test_pluto_il.py::TestActivities::test_abandoned_activity_is_aborted": FLOAT,
+    "test_pluto_il.py::TestActivities::test_arguments_by_name_or_position": FLOAT,
+    "test_pluto_il.py::TestActivities::test_component_error_is_not_confirmed": FLOAT,
+    "test_pluto_il.py::TestActivities::test_confirmed_with_converted_arguments": FLOAT,
+    "test_pluto_il.py::TestActivities::test_late_outcome_of_asynchronous_operation": FLOAT,
+    "test_pluto_il.py::TestActivities::test_no_outcome_within_timeout_is_aborted": FLOAT,
+    "test_pluto_il.py::TestActivities::test_provider_failure_is_aborted": FLOAT,
+    "test_pluto_il.py::TestEvents::test_outputs": FLOAT,
+    "test_pluto_il.py::TestEvents::test_wait_for_event_counts_publications": FLOAT,
+    "test_pluto_il.py::TestNames::test_describe_from_sdb_document": FLOAT,
+    "test_pluto_il.py::TestParameters::test_wait_until_parameter": FLOAT,
+    "test_pluto_interp.py": FLOAT,
+    "test_pluto_lexer.py::TestUnits::test_conversion_and_offset": FLOAT,
+    "test_pluto_lexer.py::TestUnits::test_iso_round_trip": FLOAT,
+    "test_pus_fields_numeric.py::TestReal::test_ieee": FLOAT,
+    "test_pus_fields_numeric.py::TestReal::test_ieee_errors": FLOAT,
+    "test_pus_s06_memory.py::TestMemory::test_check_in_slices_matches_whole": HEAP,
+    "test_pus_s11_scheduling.py::TestPersistence::test_activities_due_while_down_go_out_on_the_first_cycle": FLOAT,  # noqa: E501
+    "test_pus_s11_scheduling.py::TestReports::test_groups": HEAP,
+    "test_pus_s12_monitoring.py::TestManagement::test_reports_modify_disable_and_delete": HEAP,
+    "test_pus_s15_storage.py::TestPersistence::test_log_is_compacted_atomically": HEAP,
+    "test_pus_s15_storage.py::TestRetrieval::test_by_sequence_and_abort": HEAP,
+    "test_pus_s15_storage.py::TestRetrieval::test_by_time_range_on_the_playback_channel": HEAP,
+    "test_pus_s15_storage.py::TestRetrieval::test_open_retrieval_follows_the_store": HEAP,
+    "test_pus_s15_storage.py::TestStores::test_circular_and_bounded": HEAP,
+    "test_pus_s15_storage.py::TestStores::test_create_configure_report_delete": HEAP,
+    "test_pus_s15_storage.py::TestStores::test_housekeeping_and_event_control": HEAP,
+    "test_pus_s15_storage.py::TestStores::test_storage_control_selects_packets": HEAP,
+    "test_pus_s18_obcp.py": HEAP,
+    "test_pus_s22_position_scheduling.py::TestPositionScheduling::test_restart_keeps_the_schedule": FLOAT,  # noqa: E501
+    "test_reconfig_app.py": EEPROM,
+    "test_reconfig_cpdu.py": EEPROM,
+    "test_reconfig_safeguard.py": EEPROM,
+    "test_reconfig_time.py::TestWatchdog::test_early_kick_is_a_reset_in_the_model": EEPROM,
+    "test_reconfig_time.py::TestWatchdog::test_unhealthy_is_reset_by_timeout": EEPROM,
+    "test_reconfig_time.py::TestWatchdog::test_window_respected_with_jittery_loop": EEPROM,
+    "test_spacecan_redundancy.py::TestHeartbeatMonitor::test_unbounded_switching": FLOAT,
+    "test_spp.py::TestSpacePacket::test_largest_packet": BIG,
+    "test_timecode.py::TestCds::test_seconds": FLOAT,
+    "test_timecode.py::TestUtc::test_format_parse": FLOAT,
+    "test_timecode.py::TestUtc::test_leap_second": FLOAT,
+}
+MIN_FREE = 0.30  # the least share of the Pyboard heap free at the low-water mark
+HEAP_PASSES = 10000
+COUNTS = re.compile(r"(\d+) passed, (\d+) failed(?:, (\d+) skipped)?")
+
+
+def _close(label, t0, passed, failed, skipped=0):
+    print("%s stage time %.1f s" % (label, time.monotonic() - t0))
+    line = "%s: %d passed, %d failed" % (label, passed, failed)
+    print(line + (", %d skipped" % skipped if skipped else ""))
+    return 1 if failed else 0
+
+
+def _counts(text):
+    found = COUNTS.findall(text)
+    if not found:
+        return None
+    p, f, k = found[-1]
+    return int(p), int(f), int(k or 0)
+
+
+def stage_upy_frozen():
+    t0 = time.monotonic()
+    try:
+        exe = firmware.build_unix()
+    except firmware.FirmwareError as e:
+        print(e)
+        return _close("upy-frozen", t0, 0, 1)
+    env = dict(os.environ, MICROPYPATH="%s:.frozen" % (ROOT / "tools" / "upy"))
+    # the entry point of the reconfiguration image, from the frozen modules alone
+    probe = "import obsw.reconfig.app as a; print('entry point', a.__name__, 'imported frozen')"
+    r = subprocess.run([str(exe), "-c", probe], env=env, capture_output=True, text=True)
+    print(r.stdout.strip() or r.stderr.strip())
+    entry_ok = r.returncode == 0
+    cmd = [str(exe), "-X", "heapsize=64M", str(ROOT / "tools" / "upy" / "run.py")]
+    cmd += [str(p.relative_to(ROOT)) for p in CORE_TESTS]
+    r = subprocess.run(cmd, env=env, cwd=ROOT, capture_output=True, text=True)
+    out = r.stdout + r.stderr
+    print("\n".join(out.splitlines()[-30:]))
+    c = _counts(out) or (0, 1, 0)
+    return _close("upy-frozen", t0, c[0] + entry_ok, c[1] + (not entry_ok), c[2])
+
+
+def _stage_dir(name):
+    d = firmware.BUILD / name
+    if d.exists():
+        shutil.rmtree(d)
+    d.mkdir(parents=True)
+    return d
+
+
+def stage_cortex_m():
+    t0 = time.monotonic()
+    try:
+        elf = firmware.build_qemu()
+    except firmware.FirmwareError as e:
+        print(e)
+        return _close("cortex-m", t0, 0, 1)
+    from_source = firmware.stage_board_tests()  # tests that cannot be frozen: copied, compiled
+    passed = failed = skipped = 0
+    q = firmware.Qemu(elf)
+    try:
+        for path in CORE_TESTS:
+            name = path.name
+            skips = {k: v for k, v in CORTEX_M_SKIPS.items() if k.split("::")[0] == name}
+            code = "import obsw_run_tests as r; r.main([%r], %r)" % (name, skips)
+            t1 = time.monotonic()
+            pre = ["cp", str(path), ":" + name, "+"] if name in from_source else []
+            rc, out = firmware.mpremote(q.pty, *pre, "exec", code, timeout=90)
+            c = _counts(out)
+            if c is None:
+                failed += 1
+                print("FAIL %s (no result, status %d):\n%s" % (name, rc, out[-1500:]))
+                q.close()
+                q = firmware.Qemu(elf)
+                continue
+            passed, failed, skipped = passed + c[0], failed + c[1], skipped + c[2]
+            for line in out.splitlines():
+                if (
+                    line.startswith(("FAIL", "skip", "Traceback", "MemoryError"))
+                    or "Error" in line
+                ):
+                    print("  " + line)
+            print(
+                "%-40s %3d passed %3d failed %3d skipped %5.1f s"
+                % (name, *c, time.monotonic() - t1)
+            )
+        p, f = board_tools(q.pty)
+        passed, failed = passed + p, failed + f
+    finally:
+        q.close()
+    return _close("cortex-m", t0, passed, failed, skipped)
+
+
+def board_tools(pty):
+    """`obsw board deploy` and `obsw board test` against the QEMU board's pty, as against a
+    Pyboard: the deployed modules shadow the frozen ones; the results are read back."""
+    obsw = shutil.which("obsw") or str(ROOT / ".venv" / "bin" / "obsw")
+    t1 = time.monotonic()
+    r = subprocess.run([obsw, "board", "deploy", "--port", pty], capture_output=True, text=True)
+    deployed = r.returncode == 0 and "modules deployed" in r.stdout
+    print("obsw board deploy --port %s: %s" % (pty, r.stdout.strip().splitlines()[-1:]))
+    if not deployed:
+        print(r.stdout[-1500:] + r.stderr[-1500:])
+    r = subprocess.run([obsw, "board", "test", "--port", pty], capture_output=True, text=True)
+    c = _counts(r.stdout) or (0, 1, 0)
+    print("obsw board test --port %s: %d passed, %d failed (%.1f s)"
+          % (pty, c[0], c[1], time.monotonic() - t1))  # fmt: skip
+    if r.returncode or c[1]:
+        print(r.stdout[-2000:] + r.stderr[-1000:])
+    return c[0] + deployed, c[1] + (not deployed)
+
+
+def _figures(out, prefix):
+    return [line for line in out.splitlines() if line.startswith(prefix)]
+
+
+def stage_heap():
+    t0 = time.monotonic()
+    try:
+        elf = firmware.build_qemu()
+        heap = firmware.pyboard_heap()
+    except firmware.FirmwareError as e:
+        print(e)
+        return _close("heap", t0, 0, 1)
+    passed = failed = 0
+    print(
+        "QEMU Cortex-M3 board, MICROPY_HEAP_SIZE %d (the Pyboard's _heap_end - _heap_start)" % heap
+    )
+    with firmware.Qemu(elf) as q:
+        code = (
+            "import obsw_heap; ok, low, total = obsw_heap.reconfig(%d); "
+            "print('reconfig', 'ok' if ok and low >= %r * total else 'FAILED')"
+            % (HEAP_PASSES, MIN_FREE)
+        )
+        t1 = time.monotonic()
+        rc, out = firmware.mpremote(q.pty, "exec", code, timeout=300)
+        print("\n".join(_figures(out, ("heap", "passes", "reconfig", "Traceback", "MemoryError"))))
+        print("reconfiguration session %.1f s" % (time.monotonic() - t1))
+        if rc == 0 and "reconfig ok" in out:
+            passed += 1
+        else:
+            failed += 1
+            print(out[-2000:])
+        data = ROOT / "tests" / "data" / "pluto"
+        code = (
+            "import obsw_heap; ok, free, total = obsw_heap.pluto('p.pluto', 'p.json'); "
+            "print('pluto', 'ok' if ok else 'FAILED')"
+        )
+        t1 = time.monotonic()
+        rc, out = firmware.mpremote(
+            q.pty,
+            "cp", str(data / "commissioning.pluto"), ":p.pluto", "+",
+            "cp", str(data / "commissioning.system.json"), ":p.json", "+",
+            "exec", code,
+            timeout=180,
+        )  # fmt: skip
+        lines = sum(1 for _ in open(data / "commissioning.pluto"))
+        print("PLUTO procedure tests/data/pluto/commissioning.pluto (%d lines)" % lines)
+        print("\n".join(_figures(out, ("pluto", "Traceback", "MemoryError"))))
+        print("PLUTO run %.1f s" % (time.monotonic() - t1))
+        if rc == 0 and "pluto ok" in out:
+            passed += 1
+        else:
+            failed += 1
+            print(out[-2000:])
+    return _close("heap", t0, passed, failed)
+
+
+def main(argv):
+    stages = {
+        "firmware": firmware.stage_sizes,
+        "upy-frozen": stage_upy_frozen,
+        "cortex-m": stage_cortex_m,
+        "heap": stage_heap,
+    }
+    if len(argv) != 1 or argv[0] not in stages:
+        print(__doc__)
+        return 2
+    return stages[argv[0]]()
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

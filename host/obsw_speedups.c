@@ -13,13 +13,16 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <structmember.h>
 #include <string.h>
 
-#define API_VERSION 1
+#define API_VERSION 2
 #define TC_ID 0x1800u
 #define TM_ID 0x0800u
 
-static unsigned short crc_table[256];
+/* slicing-by-8: crc_table[0] is the classic byte table, crc_table[k][n] the register after n
+ * followed by k zero octets, so eight octets cost eight lookups and no dependency chain */
+static unsigned short crc_table[8][256];
 
 static void
 crc_init(void)
@@ -28,16 +31,28 @@ crc_init(void)
         unsigned c = n << 8;
         for (int k = 0; k < 8; k++)
             c = (c & 0x8000u) ? ((c << 1) ^ 0x1021u) : (c << 1);
-        crc_table[n] = (unsigned short)(c & 0xFFFFu);
+        crc_table[0][n] = (unsigned short)(c & 0xFFFFu);
     }
+    for (int k = 1; k < 8; k++)
+        for (unsigned n = 0; n < 256; n++) {
+            unsigned c = crc_table[k - 1][n];
+            crc_table[k][n] = (unsigned short)(((c << 8) & 0xFFFFu) ^ crc_table[0][c >> 8]);
+        }
 }
 
 /* CRC-16/CCITT-FALSE (poly 0x1021, not reflected, no final XOR) continuing from reg */
 static unsigned
 crc16(unsigned reg, const unsigned char *p, Py_ssize_t n)
 {
+    while (n >= 8) {
+        unsigned a = ((reg >> 8) ^ p[0]) & 0xFFu, b = (reg ^ p[1]) & 0xFFu;
+        reg = crc_table[7][a] ^ crc_table[6][b] ^ crc_table[5][p[2]] ^ crc_table[4][p[3]] ^
+              crc_table[3][p[4]] ^ crc_table[2][p[5]] ^ crc_table[1][p[6]] ^ crc_table[0][p[7]];
+        p += 8;
+        n -= 8;
+    }
     while (n-- > 0)
-        reg = ((reg << 8) & 0xFFFFu) ^ crc_table[((reg >> 8) ^ *p++) & 0xFFu];
+        reg = ((reg << 8) & 0xFFFFu) ^ crc_table[0][((reg >> 8) ^ *p++) & 0xFFu];
     return reg;
 }
 
@@ -156,7 +171,7 @@ finish(PyObject *out, unsigned char *p, PyObject *data, int spare, int pec)
 /* tc_pack(apid, seq_count, seq_flags, ack, service, subtype, source_id, data, layout)
  * -> the whole TC as bytes, or None to take the Python path */
 static PyObject *
-tc_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+tc_pack_values(PyObject *const *args)
 {
     unsigned long long apid, count, flags, ack, service, subtype, source;
     long long layout;
@@ -165,11 +180,6 @@ tc_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     PyObject *data, *out;
     unsigned char *p;
 
-    (void)self;
-    if (nargs != 9) {
-        PyErr_SetString(PyExc_TypeError, "tc_pack takes 9 arguments");
-        return NULL;
-    }
     layout = layout_of(args[8]);
     if (layout < 0)
         Py_RETURN_NONE;
@@ -194,10 +204,21 @@ tc_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     return finish(out, p, data, spare, pec);
 }
 
+static PyObject *
+tc_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 9) {
+        PyErr_SetString(PyExc_TypeError, "tc_pack takes 9 arguments");
+        return NULL;
+    }
+    return tc_pack_values(args);
+}
+
 /* tm_pack(apid, seq_count, seq_flags, time_ref, service, subtype, message_counter,
  *         destination_id, time, data, layout) -> the whole TM as bytes, or None */
 static PyObject *
-tm_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+tm_pack_values(PyObject *const *args)
 {
     unsigned long long apid, count, flags, ref, service, subtype, counter, dest;
     unsigned long long coarse = 0, fine = 0;
@@ -207,11 +228,6 @@ tm_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     PyObject *data, *t, *out;
     unsigned char *p;
 
-    (void)self;
-    if (nargs != 11) {
-        PyErr_SetString(PyExc_TypeError, "tm_pack takes 11 arguments");
-        return NULL;
-    }
     layout = layout_of(args[10]);
     if (layout < 0)
         Py_RETURN_NONE;
@@ -249,6 +265,17 @@ tm_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     p = put(p, coarse, tc);
     p = put(p, fine, tf);
     return finish(out, p, data, spare, pec);
+}
+
+static PyObject *
+tm_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 11) {
+        PyErr_SetString(PyExc_TypeError, "tm_pack takes 11 arguments");
+        return NULL;
+    }
+    return tm_pack_values(args);
 }
 
 static PyObject *s_apid, *s_service, *s_subtype, *s_data, *s_seq_count, *s_ack, *s_source_id,
@@ -289,6 +316,124 @@ frame_ok(const unsigned char *b, Py_ssize_t n, Py_ssize_t min, unsigned id, long
     return 0;
 }
 
+/* Direct slot access. PusTc and PusTm keep their fields in __slots__; reading and writing
+ * them at their offsets skips the attribute protocol. A class qualifies only if every field
+ * name resolves to a plain writable object slot (a subclass that turns one into a property
+ * does not); the offsets are cached per class and type version, so changing the class
+ * invalidates them. */
+#define TC_FIELDS 9 /* apid seq_count seq_flags ack service subtype source_id data config */
+#define TM_FIELDS 11 /* apid seq_count seq_flags time_ref service subtype message_counter
+                        destination_id time data config */
+#define MAX_FIELDS 11
+
+typedef struct {
+    PyTypeObject *type;
+    unsigned int tag;
+    Py_ssize_t offset[MAX_FIELDS];
+} slot_cache;
+
+static PyObject **tc_names[TC_FIELDS] = {&s_apid,    &s_seq_count, &s_seq_flags,
+                                         &s_ack,     &s_service,   &s_subtype,
+                                         &s_source_id, &s_data,    &s_config};
+static PyObject **tm_names[TM_FIELDS] = {
+    &s_apid,    &s_seq_count,       &s_seq_flags,      &s_time_ref, &s_service, &s_subtype,
+    &s_message_counter, &s_destination_id, &s_time, &s_data,     &s_config};
+static slot_cache tc_slots, tm_slots;
+
+/* the slot offsets of type t for names, or NULL if t does not qualify (no error left set) */
+static const Py_ssize_t *
+slots_of(PyTypeObject *t, PyObject **names[], int count, slot_cache *cache)
+{
+    Py_ssize_t offset[MAX_FIELDS];
+
+    if (cache->type == t && cache->tag != 0 && cache->tag == t->tp_version_tag &&
+        PyType_HasFeature(t, Py_TPFLAGS_VALID_VERSION_TAG))
+        return cache->offset;
+    for (int i = 0; i < count; i++) {
+        PyObject *d = _PyType_Lookup(t, *names[i]); /* borrowed */
+        PyMemberDef *m;
+        if (d == NULL || Py_TYPE(d) != &PyMemberDescr_Type)
+            return NULL;
+        m = ((PyMemberDescrObject *)d)->d_member;
+        if (m->type != T_OBJECT_EX || (m->flags & READONLY))
+            return NULL;
+        offset[i] = m->offset;
+    }
+    if (!PyType_HasFeature(t, Py_TPFLAGS_VALID_VERSION_TAG) || t->tp_version_tag == 0)
+        return NULL; /* nothing to key a cache on: take the attribute path */
+    cache->type = t;
+    cache->tag = t->tp_version_tag;
+    memcpy(cache->offset, offset, sizeof(offset));
+    return cache->offset;
+}
+
+#define SLOT(obj, off) (*(PyObject **)((char *)(obj) + (off)))
+
+/* gather the values of the first count slots; -1 if one is unset or the class does not
+ * qualify */
+static int
+gather(PyObject *obj, PyObject **names[], int count, slot_cache *cache, PyObject **out)
+{
+    const Py_ssize_t *off = slots_of(Py_TYPE(obj), names, count + 1, cache);
+    if (off == NULL)
+        return -1;
+    for (int i = 0; i < count; i++)
+        if ((out[i] = SLOT(obj, off[i])) == NULL)
+            return -1;
+    return 0;
+}
+
+/* tc_pack_slots(tc, layout) -> tc.pack() for a whole-octet layout, or None */
+static PyObject *
+tc_pack_slots(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    PyObject *v[9];
+    (void)self;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "tc_pack_slots takes 2 arguments");
+        return NULL;
+    }
+    if (gather(args[0], tc_names, 8, &tc_slots, v))
+        Py_RETURN_NONE;
+    v[8] = args[1];
+    return tc_pack_values(v);
+}
+
+/* tm_pack_slots(tm, layout) -> tm.pack() for a whole-octet layout, or None */
+static PyObject *
+tm_pack_slots(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    PyObject *v[11];
+    (void)self;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "tm_pack_slots takes 2 arguments");
+        return NULL;
+    }
+    if (gather(args[0], tm_names, 10, &tm_slots, v))
+        Py_RETURN_NONE;
+    v[10] = args[1];
+    return tm_pack_values(v);
+}
+
+/* fill the slots of a blank object with new references from values (stolen, all non-NULL);
+ * on a NULL value releases the rest and returns -1 */
+static int
+fill(PyObject *obj, const Py_ssize_t *off, PyObject **values, int count)
+{
+    int bad = 0;
+    for (int i = 0; i < count; i++)
+        if (values[i] == NULL)
+            bad = 1;
+    if (bad) {
+        for (int i = 0; i < count; i++)
+            Py_XDECREF(values[i]);
+        return -1;
+    }
+    for (int i = 0; i < count; i++)
+        SLOT(obj, off[i]) = values[i];
+    return 0;
+}
+
 /* tc_unpack(cls, buf, layout, config) -> a cls instance for a well-formed TC, or None */
 static PyObject *
 tc_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
@@ -300,6 +445,7 @@ tc_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     Py_ssize_t n, off;
     unsigned pid, psc;
     PyObject *obj = NULL, *cls;
+    const Py_ssize_t *slot;
 
     (void)self;
     if (nargs != 4) {
@@ -325,7 +471,23 @@ tc_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     pid = (unsigned)get(b, 2);
     psc = (unsigned)get(b + 2, 2);
     obj = blank(cls);
-    if (obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
+    slot = obj == NULL ? NULL : slots_of(Py_TYPE(obj), tc_names, TC_FIELDS, &tc_slots);
+    if (slot != NULL) {
+        PyObject *v[TC_FIELDS] = {
+            PyLong_FromLong(pid & 0x7FF),
+            PyLong_FromLong(psc & 0x3FFF),
+            PyLong_FromLong(psc >> 14),
+            PyLong_FromLong(b[6] & 15),
+            PyLong_FromLong(b[7]),
+            PyLong_FromLong(b[8]),
+            PyLong_FromUnsignedLongLong(get(b + 9, sid)),
+            PyBytes_FromStringAndSize((const char *)b + off, n - off - 2 * pec),
+            Py_NewRef(args[3]),
+        };
+        if (fill(obj, slot, v, TC_FIELDS))
+            Py_CLEAR(obj);
+    }
+    else if (obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
         set_new(obj, s_service, PyLong_FromLong(b[7])) ||
         set_new(obj, s_subtype, PyLong_FromLong(b[8])) ||
         set_new(obj, s_data,
@@ -353,6 +515,7 @@ tm_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     unsigned pid, psc;
     const unsigned char *q;
     PyObject *obj = NULL, *cls, *t;
+    const Py_ssize_t *slot;
 
     (void)self;
     if (nargs != 4) {
@@ -384,7 +547,25 @@ tm_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     q = b + 9 + cnt + dst;
     t = Py_BuildValue("(KK)", get(q, tc), get(q + tc, tf));
     obj = blank(cls);
-    if (t == NULL || obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
+    slot = obj == NULL ? NULL : slots_of(Py_TYPE(obj), tm_names, TM_FIELDS, &tm_slots);
+    if (t != NULL && slot != NULL) {
+        PyObject *v[TM_FIELDS] = {
+            PyLong_FromLong(pid & 0x7FF),
+            PyLong_FromLong(psc & 0x3FFF),
+            PyLong_FromLong(psc >> 14),
+            PyLong_FromLong(b[6] & 15),
+            PyLong_FromLong(b[7]),
+            PyLong_FromLong(b[8]),
+            PyLong_FromUnsignedLongLong(get(b + 9, cnt)),
+            PyLong_FromUnsignedLongLong(get(b + 9 + cnt, dst)),
+            Py_NewRef(t),
+            PyBytes_FromStringAndSize((const char *)b + off, n - off - 2 * pec),
+            Py_NewRef(args[3]),
+        };
+        if (fill(obj, slot, v, TM_FIELDS))
+            Py_CLEAR(obj);
+    }
+    else if (t == NULL || obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
         set_new(obj, s_service, PyLong_FromLong(b[7])) ||
         set_new(obj, s_subtype, PyLong_FromLong(b[8])) ||
         set_new(obj, s_data,
@@ -424,6 +605,8 @@ crc16_ccitt(PyObject *self, PyObject *args)
 static PyMethodDef methods[] = {
     {"tc_pack", FASTCALL(tc_pack), "Pack a TC of a whole-octet layout, or None."},
     {"tm_pack", FASTCALL(tm_pack), "Pack a TM of a whole-octet layout, or None."},
+    {"tc_pack_slots", FASTCALL(tc_pack_slots), "tc.pack() for a whole-octet layout, or None."},
+    {"tm_pack_slots", FASTCALL(tm_pack_slots), "tm.pack() for a whole-octet layout, or None."},
     {"tc_unpack", FASTCALL(tc_unpack), "Decode a well-formed TC into cls, or None."},
     {"tm_unpack", FASTCALL(tm_unpack), "Decode a well-formed TM into cls, or None."},
     {"crc16_ccitt", crc16_ccitt, METH_VARARGS, "CRC-16/CCITT-FALSE continuing a register."},

@@ -132,7 +132,7 @@ def crc_accelerator(width, poly, init, reflect, xorout):
     return crcmod.mkCrcFun((1 << width) | poly, initCrc=init ^ xorout, rev=reflect, xorOut=xorout)
 
 
-_PUS_API = const(1)  # the obsw_speedups interface this core speaks
+_PUS_API = const(2)  # the obsw_speedups interface this core speaks
 
 
 def pus_accelerator():

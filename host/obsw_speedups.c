@@ -600,6 +600,436 @@ crc16_ccitt(PyObject *self, PyObject *args)
     return PyLong_FromUnsignedLong(c);
 }
 
+
+/* ------------------------------------------------------------------------------------------
+ * CBOR for the interaction layer's wire: the deterministic encoding of obsw.cbor (and
+ * cbor2.dumps(canonical=True)) for exact int, bool, None, float, str, bytes, bytearray, list,
+ * tuple and dict, and a decoder for the same subset with definite lengths. Anything else
+ * (tags, bignums, memoryviews, subclasses, simple values, indefinite lengths, malformed or
+ * too deep input) is declined, and the caller takes the Python path, which decides and raises.
+ */
+#define CBOR_MAX_DEPTH 16 /* deeper values go the Python way, which knows the limits */
+
+typedef struct {
+    unsigned char *buf;
+    Py_ssize_t len, cap;
+} cbuf;
+
+static int
+cb_reserve(cbuf *b, Py_ssize_t more)
+{
+    if (b->len + more <= b->cap)
+        return 0;
+    Py_ssize_t cap = b->cap ? b->cap : 64;
+    while (cap < b->len + more)
+        cap *= 2;
+    unsigned char *n = PyMem_Realloc(b->buf, (size_t)cap);
+    if (n == NULL)
+        return -1;
+    b->buf = n;
+    b->cap = cap;
+    return 0;
+}
+
+static int
+cb_put(cbuf *b, const void *p, Py_ssize_t n)
+{
+    if (cb_reserve(b, n))
+        return -1;
+    memcpy(b->buf + b->len, p, (size_t)n);
+    b->len += n;
+    return 0;
+}
+
+static int
+cb_head(cbuf *b, unsigned major, unsigned long long n)
+{
+    unsigned char h[9];
+    int k;
+    if (n < 24) {
+        h[0] = (unsigned char)(major | n);
+        k = 1;
+    }
+    else if (n < 0x100) {
+        h[0] = (unsigned char)(major | 24);
+        k = 2;
+    }
+    else if (n < 0x10000) {
+        h[0] = (unsigned char)(major | 25);
+        k = 3;
+    }
+    else if (n < 0x100000000ULL) {
+        h[0] = (unsigned char)(major | 26);
+        k = 5;
+    }
+    else {
+        h[0] = (unsigned char)(major | 27);
+        k = 9;
+    }
+    put(h + 1, n, k - 1);
+    return cb_put(b, h, k);
+}
+
+/* 1 encoded, 0 declined, -1 error (set) */
+static int cb_encode(cbuf *b, PyObject *v, int depth);
+
+static int
+cb_float(cbuf *b, double x)
+{
+    unsigned char h[9];
+    if (x != x)
+        return cb_put(b, "\xf9\x7e\x00", 3);
+    if (PyFloat_Pack2(x, (char *)h + 1, 0) == 0) {
+        if (PyFloat_Unpack2((const char *)h + 1, 0) == x) {
+            h[0] = 0xF9;
+            return cb_put(b, h, 3);
+        }
+    }
+    else
+        PyErr_Clear();
+    if (PyFloat_Pack4(x, (char *)h + 1, 0) == 0) {
+        if (PyFloat_Unpack4((const char *)h + 1, 0) == x) {
+            h[0] = 0xFA;
+            return cb_put(b, h, 5);
+        }
+    }
+    else
+        PyErr_Clear();
+    h[0] = 0xFB;
+    if (PyFloat_Pack8(x, (char *)h + 1, 0))
+        return -1;
+    return cb_put(b, h, 9);
+}
+
+typedef struct {
+    Py_ssize_t off, len; /* the encoded key within the key buffer */
+    PyObject *value;
+} cb_pair;
+
+static const unsigned char *cb_sort_base;
+
+static int
+cb_pair_cmp(const void *x, const void *y)
+{
+    const cb_pair *a = x, *c = y;
+    if (a->len != c->len)
+        return a->len < c->len ? -1 : 1;
+    return memcmp(cb_sort_base + a->off, cb_sort_base + c->off, (size_t)a->len);
+}
+
+static int
+cb_dict(cbuf *b, PyObject *d, int depth)
+{
+    Py_ssize_t n = PyDict_GET_SIZE(d), pos = 0, i = 0;
+    PyObject *k, *v;
+    cbuf keys = {NULL, 0, 0};
+    cb_pair *pairs;
+    int rc = 1;
+
+    if (cb_head(b, 0xA0, (unsigned long long)n))
+        return -1;
+    if (n == 0)
+        return 1;
+    pairs = PyMem_Malloc(sizeof(cb_pair) * (size_t)n);
+    if (pairs == NULL) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    while (PyDict_Next(d, &pos, &k, &v)) {
+        Py_ssize_t start = keys.len;
+        if (i >= n) { /* changed size while encoding: let Python decide */
+            rc = 0;
+            break;
+        }
+        rc = cb_encode(&keys, k, depth - 1);
+        if (rc != 1)
+            break;
+        pairs[i].off = start;
+        pairs[i].len = keys.len - start;
+        pairs[i].value = v;
+        i++;
+    }
+    if (rc == 1 && i != n)
+        rc = 0;
+    if (rc == 1) {
+        cb_sort_base = keys.buf; /* callers hold the GIL: one sort at a time */
+        qsort(pairs, (size_t)n, sizeof(cb_pair), cb_pair_cmp);
+        for (i = 0; i < n && rc == 1; i++) {
+            if (cb_put(b, keys.buf + pairs[i].off, pairs[i].len))
+                rc = -1;
+            else
+                rc = cb_encode(b, pairs[i].value, depth - 1);
+        }
+    }
+    PyMem_Free(pairs);
+    PyMem_Free(keys.buf);
+    return rc;
+}
+
+static int
+cb_encode(cbuf *b, PyObject *v, int depth)
+{
+    PyTypeObject *t = Py_TYPE(v);
+    if (t == &PyLong_Type) {
+        int overflow;
+        long long x = PyLong_AsLongLongAndOverflow(v, &overflow);
+        if (overflow == 0) {
+            if (x == -1 && PyErr_Occurred())
+                return -1;
+            if (x >= 0)
+                return cb_head(b, 0x00, (unsigned long long)x) ? -1 : 1;
+            return cb_head(b, 0x20, (unsigned long long)(-1 - x)) ? -1 : 1;
+        }
+        if (overflow > 0) {
+            unsigned long long u = PyLong_AsUnsignedLongLong(v);
+            if (u == (unsigned long long)-1 && PyErr_Occurred()) {
+                PyErr_Clear();
+                return 0; /* a bignum */
+            }
+            return cb_head(b, 0x00, u) ? -1 : 1;
+        }
+        return 0; /* below -2**63: bignum or not, Python decides */
+    }
+    if (t == &PyUnicode_Type) {
+        Py_ssize_t n;
+        const char *s = PyUnicode_AsUTF8AndSize(v, &n);
+        if (s == NULL) {
+            PyErr_Clear();
+            return 0;
+        }
+        return (cb_head(b, 0x60, (unsigned long long)n) || cb_put(b, s, n)) ? -1 : 1;
+    }
+    if (t == &PyBytes_Type) {
+        Py_ssize_t n = PyBytes_GET_SIZE(v);
+        return (cb_head(b, 0x40, (unsigned long long)n) || cb_put(b, PyBytes_AS_STRING(v), n))
+                   ? -1
+                   : 1;
+    }
+    if (t == &PyByteArray_Type) {
+        Py_ssize_t n = PyByteArray_GET_SIZE(v);
+        return (cb_head(b, 0x40, (unsigned long long)n) ||
+                cb_put(b, PyByteArray_AS_STRING(v), n))
+                   ? -1
+                   : 1;
+    }
+    if (t == &PyList_Type || t == &PyTuple_Type) {
+        Py_ssize_t n = t == &PyList_Type ? PyList_GET_SIZE(v) : PyTuple_GET_SIZE(v);
+        if (depth <= 0)
+            return 0;
+        if (cb_head(b, 0x80, (unsigned long long)n))
+            return -1;
+        for (Py_ssize_t i = 0; i < n; i++) {
+            PyObject *x;
+            int rc;
+            if (t == &PyList_Type) {
+                if (i >= PyList_GET_SIZE(v))
+                    return 0; /* shrank while encoding */
+                x = PyList_GET_ITEM(v, i);
+            }
+            else
+                x = PyTuple_GET_ITEM(v, i);
+            Py_INCREF(x);
+            rc = cb_encode(b, x, depth - 1);
+            Py_DECREF(x);
+            if (rc != 1)
+                return rc;
+        }
+        if (t == &PyList_Type && PyList_GET_SIZE(v) != n)
+            return 0;
+        return 1;
+    }
+    if (t == &PyDict_Type)
+        return depth <= 0 ? 0 : cb_dict(b, v, depth);
+    if (v == Py_True || v == Py_False)
+        return cb_put(b, v == Py_True ? "\xf5" : "\xf4", 1) ? -1 : 1;
+    if (v == Py_None)
+        return cb_put(b, "\xf6", 1) ? -1 : 1;
+    if (t == &PyFloat_Type)
+        return cb_float(b, PyFloat_AS_DOUBLE(v)) ? -1 : 1;
+    return 0;
+}
+
+/* cbor_frame(value) -> 4-byte big-endian length + deterministic CBOR of value, or None */
+static PyObject *
+cbor_frame(PyObject *self, PyObject *v)
+{
+    cbuf b = {NULL, 0, 0};
+    PyObject *out = NULL;
+    int rc;
+    (void)self;
+    if (cb_reserve(&b, 64)) {
+        PyErr_NoMemory();
+        return NULL;
+    }
+    b.len = 4;
+    rc = cb_encode(&b, v, CBOR_MAX_DEPTH);
+    if (rc == 1 && b.len - 4 <= 0xFFFFFFFFLL) {
+        put(b.buf, (unsigned long long)(b.len - 4), 4);
+        out = PyBytes_FromStringAndSize((const char *)b.buf, b.len);
+    }
+    else if (rc >= 0) {
+        out = Py_NewRef(Py_None);
+    }
+    PyMem_Free(b.buf);
+    return out;
+}
+
+/* the decoder: 1 with *out set, 0 declined, -1 error (set) */
+static int
+cd_item(const unsigned char *p, Py_ssize_t n, Py_ssize_t *pos, int depth, PyObject **out)
+{
+    unsigned ib, major, ai;
+    unsigned long long arg;
+    Py_ssize_t i = *pos;
+
+    if (i >= n)
+        return 0;
+    ib = p[i++];
+    major = ib & 0xE0;
+    ai = ib & 0x1F;
+    if (ai < 24)
+        arg = ai;
+    else if (ai < 28) {
+        int k = 1 << (ai - 24);
+        if (n - i < k)
+            return 0;
+        arg = get(p + i, k);
+        i += k;
+    }
+    else
+        return 0; /* indefinite lengths and reserved values: Python */
+    switch (major) {
+    case 0x00:
+        *out = PyLong_FromUnsignedLongLong(arg);
+        break;
+    case 0x20:
+        if (arg > (unsigned long long)LLONG_MAX)
+            return 0;
+        *out = PyLong_FromLongLong(-1 - (long long)arg);
+        break;
+    case 0x40:
+    case 0x60:
+        if (arg > (unsigned long long)(n - i))
+            return 0;
+        if (major == 0x40)
+            *out = PyBytes_FromStringAndSize((const char *)p + i, (Py_ssize_t)arg);
+        else {
+            *out = PyUnicode_DecodeUTF8((const char *)p + i, (Py_ssize_t)arg, NULL);
+            if (*out == NULL) {
+                PyErr_Clear();
+                return 0;
+            }
+        }
+        i += (Py_ssize_t)arg;
+        break;
+    case 0x80: {
+        PyObject *list;
+        if (depth <= 0 || arg > (unsigned long long)(n - i))
+            return 0;
+        list = PyList_New((Py_ssize_t)arg);
+        if (list == NULL)
+            return -1;
+        for (Py_ssize_t k = 0; k < (Py_ssize_t)arg; k++) {
+            PyObject *x;
+            int rc = cd_item(p, n, &i, depth - 1, &x);
+            if (rc != 1) {
+                Py_DECREF(list);
+                return rc;
+            }
+            PyList_SET_ITEM(list, k, x);
+        }
+        *out = list;
+        break;
+    }
+    case 0xA0: {
+        PyObject *d;
+        if (depth <= 0 || arg > (unsigned long long)(n - i) / 2)
+            return 0;
+        d = PyDict_New();
+        if (d == NULL)
+            return -1;
+        for (unsigned long long k = 0; k < arg; k++) {
+            PyObject *key, *val;
+            int rc;
+            if (i < n && ((p[i] & 0xE0) == 0x80 || (p[i] & 0xE0) == 0xA0)) {
+                Py_DECREF(d); /* array or map keys become tuples in Python: let it */
+                return 0;
+            }
+            rc = cd_item(p, n, &i, depth - 1, &key);
+            if (rc != 1) {
+                Py_DECREF(d);
+                return rc;
+            }
+            rc = cd_item(p, n, &i, depth - 1, &val);
+            if (rc != 1) {
+                Py_DECREF(key);
+                Py_DECREF(d);
+                return rc;
+            }
+            rc = PyDict_SetItem(d, key, val);
+            Py_DECREF(key);
+            Py_DECREF(val);
+            if (rc) {
+                Py_DECREF(d);
+                return -1;
+            }
+        }
+        *out = d;
+        break;
+    }
+    case 0xE0:
+        if (ai == 20)
+            *out = Py_NewRef(Py_False);
+        else if (ai == 21)
+            *out = Py_NewRef(Py_True);
+        else if (ai == 22)
+            *out = Py_NewRef(Py_None);
+        else if (ai == 25 || ai == 26 || ai == 27) {
+            double x = ai == 25   ? PyFloat_Unpack2((const char *)p + i - 2, 0)
+                       : ai == 26 ? PyFloat_Unpack4((const char *)p + i - 4, 0)
+                                  : PyFloat_Unpack8((const char *)p + i - 8, 0);
+            if (x == -1.0 && PyErr_Occurred())
+                return -1;
+            *out = PyFloat_FromDouble(x);
+        }
+        else
+            return 0; /* undefined and the other simple values: Python */
+        break;
+    default:
+        return 0; /* tags */
+    }
+    if (*out == NULL)
+        return -1;
+    *pos = i;
+    return 1;
+}
+
+/* cbor_loads(data, declined) -> the value of the one CBOR item data holds, or declined */
+static PyObject *
+cbor_loads(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    Py_buffer view;
+    Py_ssize_t pos = 0;
+    PyObject *v = NULL;
+    int rc;
+    (void)self;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "cbor_loads takes 2 arguments");
+        return NULL;
+    }
+    if (octets_of(args[0], &view))
+        return Py_NewRef(args[1]);
+    rc = cd_item((const unsigned char *)view.buf, view.len, &pos, CBOR_MAX_DEPTH, &v);
+    PyBuffer_Release(&view);
+    if (rc < 0)
+        return NULL;
+    if (rc == 0 || pos != view.len) {
+        Py_XDECREF(v);
+        return Py_NewRef(args[1]);
+    }
+    return v;
+}
+
 #define FASTCALL(f) (PyCFunction)(void (*)(void))(f), METH_FASTCALL
 
 static PyMethodDef methods[] = {
@@ -609,6 +1039,8 @@ static PyMethodDef methods[] = {
     {"tm_pack_slots", FASTCALL(tm_pack_slots), "tm.pack() for a whole-octet layout, or None."},
     {"tc_unpack", FASTCALL(tc_unpack), "Decode a well-formed TC into cls, or None."},
     {"tm_unpack", FASTCALL(tm_unpack), "Decode a well-formed TM into cls, or None."},
+    {"cbor_frame", cbor_frame, METH_O, "Length-prefixed deterministic CBOR, or None."},
+    {"cbor_loads", FASTCALL(cbor_loads), "Decode one CBOR item, or return the second arg."},
     {"crc16_ccitt", crc16_ccitt, METH_VARARGS, "CRC-16/CCITT-FALSE continuing a register."},
     {NULL, NULL, 0, NULL},
 };

@@ -135,11 +135,12 @@ def crc_accelerator(width, poly, init, reflect, xorout):
 _PUS_API = const(2)  # the obsw_speedups interface this core speaks
 
 
-def pus_accelerator():
-    """The C packet codec ``obsw_speedups`` (built with the host package on CPython) or None.
+def speedups():
+    """The C hot paths ``obsw_speedups`` (built with the host package on CPython) or None:
+    the PUS packet codec and the interaction layer's CBOR framing.
 
-    It only ever takes the inputs it can handle without doubt and returns None for the rest,
-    so the pure-Python codec stays the definition and raises the errors.
+    It only ever takes the inputs it can handle without doubt and declines the rest, so the
+    Python code stays the definition and raises the errors.
     """
     if pure():
         return None
@@ -150,3 +151,6 @@ def pus_accelerator():
     if getattr(obsw_speedups, "API", None) != _PUS_API:
         return None  # a stale build from other sources
     return obsw_speedups
+
+
+pus_accelerator = speedups  # the PUS codec's name for it

@@ -2,7 +2,9 @@
 
 from hal_pyb import PybHal
 from obsw.reconfig.app import ReconfigApp
+from obsw.reconfig.essential import security_from_file
 
 hal = PybHal()
-app = ReconfigApp(hal)
+# TC frames are authenticated with the SDLS key file on the board's flash, when there is one
+app = ReconfigApp(hal, essential_security=security_from_file("tc.keys"))
 app.run()

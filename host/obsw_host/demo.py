@@ -15,6 +15,7 @@ SECTIONS = (
     ("Storage and files: store, pass, CFDP copies", "obsw_host.pus.storage_demo", "run"),
     ("OBCPs: ground uploads a PLUTO procedure with service 18", "obsw_host.pus.obcp_demo", "run"),
     ("Reconfiguration module: two MicroPython controllers", "obsw_host.reconfig_sim", "demo"),
+    ("The whole OBC: the 12-step chain and its faults", "obsw_host.obc.chain", "demo"),
 )
 
 

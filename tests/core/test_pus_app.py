@@ -239,7 +239,7 @@ class TestBadInput(unittest.TestCase):
         def broken(raw):
             raise OSError("link down")
 
-        loop.app._put = broken
+        loop.app.out = broken
         loop.app.register(ServiceTest())
         loop.app.receive(tc(17, 1))
         self.assertEqual(loop.app.counters["tm_lost"], 4)

@@ -155,7 +155,7 @@ class TestDownlink(unittest.TestCase):
     def test_ground_drops_a_downlink_out_of_sequence(self):
         loop, large, user = make(part_size=10, parts_per_cycle=None)
         lost = []
-        loop.app._put = lambda raw: (
+        loop.app.out = lambda raw: (
             lost.append(raw) if raw[8] == 2 and not lost else loop.down.append(raw)
         )
         large.downlink(bytes(35))

@@ -26,7 +26,7 @@ class Harness:
         app.register(EventReporting())
         self.storage = app.register(Storage(initial, self.fs, rate=rate))
         self.fwd = app.register(ForwardingControl())
-        app.tm_router.playback = self.playback
+        app.playback = self.playback
         self.user = self.loop.ground.register(StorageUser())
         self.fwd_user = self.loop.ground.register(ForwardingUser())
         self.test = self.loop.ground.register(ServiceTestUser())

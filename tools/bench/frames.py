@@ -2,7 +2,8 @@
 
 frames.py [--quick] [--json]
 Peers measured in the same run where one exists: spacepackets (TM frame decode) and ccsds-cop
-(COP-1 FOP and FARM). CLTU/BCH and the randomizer have no Python peer.
+(COP-1 FOP and FARM). CLTU/BCH and the randomizer have no Python peer. SDLS authentication
+(HMAC-SHA-256 in obsw, for MicroPython) is set against CPython's C hmac on the same bytes.
 """
 
 import argparse
@@ -15,7 +16,7 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT / "micropython"), str(ROOT / "host")]
 
-from obsw.frames import asm, cltu, farm, tc, tm, tm_demux, tm_mux  # noqa: E402
+from obsw.frames import asm, cltu, farm, sdls, tc, tm, tm_demux, tm_mux  # noqa: E402
 from obsw.frames import fop as F  # noqa: E402
 
 TC_LEN = 1024
@@ -60,7 +61,15 @@ def cases():
         for raw in dec.feed(cadu):
             demux.feed(raw)
 
+    secured = sdls.TcSecurity([sdls.SecurityAssociation(1, 0, bytes(range(32)))])
+    plain = tc.Segment(1, bytes(TC_LEN - 7 - 1 - 6 - 16)).pack()
+    signed = tc.TcFrame(0x2A, 0, secured.apply(0x2A, 0, plain), 0).pack()
+
     rows = [
+        ("SDLS sign (HMAC-SHA-256), 1024-byte TC frame", "frame/s",
+         lambda: secured.apply(0x2A, 0, plain), TC_LEN),
+        ("SDLS verify (HMAC-SHA-256), 1024-byte TC frame", "frame/s",
+         lambda: secured.process(signed, TC_LEN), TC_LEN),
         ("CLTU encode, 1024-byte TC frame", "frame/s", lambda: cltu.encode(tc_frame), TC_LEN),
         ("CLTU decode, 1024-byte TC frame", "frame/s", lambda: cltu.decode(encoded), TC_LEN),
         ("TC frame pack (FECF)", "frame/s",
@@ -71,6 +80,16 @@ def cases():
         ("TM frame unpack (FECF)", "frame/s", lambda: tm.TmFrame.unpack(tm_raw), TM_LEN),
     ]  # fmt: skip
     peers = {}
+    import hashlib
+    import hmac
+
+    key = bytes(range(32))
+    peers["SDLS verify (HMAC-SHA-256), 1024-byte TC frame"] = (
+        "reference",
+        lambda: hmac.compare_digest(
+            hmac.new(key, signed[:-18], hashlib.sha256).digest()[:16], signed[-18:-2]
+        ),
+    )
     try:
         from spacepackets.ccsds.tm_frame import TmTransferFrame
 

@@ -14,6 +14,8 @@ from obsw.cfdp.entity import CfdpEntity
 from obsw.cfdp.mib import Mib, RemoteEntity
 from obsw.spp import TYPE_TC, TYPE_TM, SpacePacket, SppError
 
+from obsw_host.net import DEFAULT_HOST
+
 CFDP_APID = int(os.environ.get("OBSW_CFDP_APID", "100"))
 BASE_PORT = 5000  # the project's convention: UDP port 5000 + APID
 
@@ -22,7 +24,7 @@ def parse_peer(text):
     """'2=127.0.0.1:5101' -> (2, ('127.0.0.1', 5101))."""
     eid, _, addr = text.partition("=")
     host, _, port = addr.rpartition(":")
-    return int(eid, 0), (host or "127.0.0.1", int(port))
+    return int(eid, 0), (host or DEFAULT_HOST, int(port))
 
 
 class UdpEntity:

@@ -7,6 +7,8 @@ import time
 from obsw.cfdp import msgs
 from obsw.cfdp.defs import CONDITION_NAMES, NO_ERROR
 
+from obsw_host.net import DEFAULT_HOST
+
 DEFAULT_PEER = "2=127.0.0.1:5100"
 STATUS_NAMES = {0: "undefined", 1: "active", 2: "terminated", 3: "unrecognized"}
 FILE_STATUS = {0: "discarded", 1: "discarded by filestore", 2: "retained", 3: "unreported"}
@@ -69,6 +71,9 @@ def add_parser(sub):
 
 def _serve_args(p):
     _common(p, 2, 5000 + 100)
+    p.add_argument(
+        "--host", default=DEFAULT_HOST, help="address to listen on (default %(default)s)"
+    )
     p.add_argument("--ground", action="store_true", help="send TC packets (default TM)")
 
 
@@ -85,7 +90,7 @@ def _setup(args, onboard=False):
         ent.load_seq()
     udp = UdpEntity(
         ent,
-        ("0.0.0.0" if onboard else "127.0.0.1", args.port),
+        (getattr(args, "host", DEFAULT_HOST), args.port),
         peers,
         packet_type=packet_type_for(onboard),
         loss=args.loss,

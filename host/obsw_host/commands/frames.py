@@ -1,7 +1,10 @@
-"""`obsw frames`: the frame processor on two UARTs, CLTU and TM frame tools, the link demo."""
+"""`obsw frames`: the frame processor on two UARTs, CLTU and TM frame tools, TC security keys
+and signing (SDLS), the link demo."""
 
 import binascii
 import json
+
+from obsw_host.net import DEFAULT_HOST
 
 
 def add_parser(sub):
@@ -16,7 +19,9 @@ def add_parser(sub):
     proc.add_argument("--uart-b", required=True, help="second, hot-redundant link")
     proc.add_argument("--scid", type=lambda v: int(v, 0), default=0x2A, help="spacecraft id")
     proc.add_argument("--baudrate", type=int, default=115200)
-    proc.add_argument("--host", default="127.0.0.1", help="where the application processes are")
+    proc.add_argument(
+        "--host", default=DEFAULT_HOST, help="where the application processes are (%(default)s)"
+    )
     proc.add_argument("--port-base", type=int, default=5000, help="TC packets go to base+APID")
     proc.add_argument("--tm-port", type=int, default=4999, help="UDP port receiving TM packets")
     proc.add_argument(
@@ -30,7 +35,37 @@ def add_parser(sub):
     proc.add_argument("--frame-length", type=int, default=256, help="TM frame length")
     proc.add_argument("--essential-map", type=int, default=None, help="MAP ID of HPCs")
     proc.add_argument("--duration", type=float, default=None, help="stop after N seconds")
+    proc.add_argument("--keys", help="SDLS key file: authenticate every TC frame")
+    proc.add_argument("--key-state", help="sequence number state file (default KEYS.state)")
+    proc.add_argument("--sdb", help="spacecraft database for the event APID and IDs (sample)")
     proc.set_defaults(func=processor)
+
+    kg = s.add_parser("keygen", help="write a new SDLS key file (outside any repository)")
+    kg.add_argument("file")
+    kg.add_argument("--vcid", type=int, action="append", help="VC with an SA (repeat; 0)")
+    kg.add_argument("--essential-map", type=int, default=63, help="MAP of the HPC SA (63)")
+    kg.add_argument("--no-essential", action="store_true", help="no SA for essential TCs")
+    kg.add_argument("--mac-length", type=int, default=16, help="MAC octets, 8..32 (16)")
+    kg.add_argument("--window", type=int, default=64, help="anti-replay window (64)")
+    kg.add_argument("--ahead", type=int, help="refuse numbers this far above the last (none)")
+    kg.set_defaults(func=keygen)
+
+    sign = s.add_parser("sign", help="a signed TC frame (hex, or a CLTU) carrying a packet")
+    sign.add_argument("hex", help="the TC packet")
+    sign.add_argument("--keys", required=True, help="SDLS key file")
+    sign.add_argument("--key-state", help="sequence number state file (default KEYS.state)")
+    sign.add_argument("--scid", type=lambda v: int(v, 0), default=0x2A, help="spacecraft id")
+    sign.add_argument("--vcid", type=int, default=0)
+    sign.add_argument("--map", type=int, default=1, help="MAP ID (1)")
+    sign.add_argument("--ad", action="store_true", help="Type-AD frame (default BD)")
+    sign.add_argument("--seq", type=int, default=0, help="frame sequence number N(S)")
+    sign.add_argument("--cltu", action="store_true", help="print the CLTU instead")
+    sign.set_defaults(func=sign_frame)
+
+    ver = s.add_parser("verify", help="check a signed TC frame or CLTU (hex) against a key file")
+    ver.add_argument("hex")
+    ver.add_argument("--keys", required=True, help="SDLS key file")
+    ver.set_defaults(func=verify_frame)
 
     cltu = s.add_parser("cltu", help="encode or decode a CLTU")
     cs = cltu.add_subparsers(dest="cltu_action", metavar="ACTION")
@@ -68,6 +103,18 @@ def processor(args):
     playback = args.playback_port
     if playback is None:
         playback = args.tm_port + 1 if args.tm_port else 0
+    security = {}
+    if args.keys:
+        from obsw import sdb as sdb_module
+
+        from obsw_host.frames.processor import security_options
+        from obsw_host.pus.demo import SDB_PATH
+
+        try:
+            db = sdb_module.load(args.sdb or SDB_PATH)
+            security = security_options(args.keys, db, args.key_state)
+        except (OSError, ValueError, KeyError) as e:
+            raise SystemExit("obsw frames processor: %s" % e) from None
     try:
         host = FrameProcessorHost(
             args.uart_a,
@@ -80,6 +127,7 @@ def processor(args):
             tm_frame_length=args.frame_length,
             essential_map=args.essential_map,
             tm_plan=plan,
+            **security,
         )
     except ValueError as e:
         raise SystemExit("obsw frames processor: %s" % e) from None
@@ -89,11 +137,57 @@ def processor(args):
           "TM on UDP %d (VC %d)" % (
         args.uart_a, args.uart_b, args.host, args.port_base, host.tm_port, args.realtime_vc,
         host.playback_port, args.playback_vc))  # fmt: skip
+    if args.keys:
+        print("TC security: %d SA(s) from %s, events on APID %d" % (
+            len(security["security"].sas), args.keys, security["event_apid"]))  # fmt: skip
+    else:
+        print("TC security: off (no --keys): every well-formed TC frame is accepted")
     try:
         host.run(duration=args.duration)
     finally:
         print(json.dumps(host.core.counters))
+        if args.keys:
+            print(json.dumps(host.core.security.counters))
         host.close()
+    return 0
+
+
+def keygen(args):
+    from obsw_host.frames import keys
+
+    try:
+        sas = keys.generate(
+            args.file,
+            tuple(args.vcid or (0,)),
+            None if args.no_essential else args.essential_map,
+            args.mac_length,
+            args.window,
+            args.ahead,
+        )
+    except (OSError, ValueError) as e:
+        raise SystemExit("obsw frames keygen: %s" % e) from None
+    for sa in sas:
+        print("SA %d: VC %d MAP %s, HMAC-SHA-256 MAC %d octets, window %d" % (
+            sa.spi, sa.vcid, "any" if sa.map_id is None else sa.map_id, sa.mac_length,
+            sa.window.size))  # fmt: skip
+    print("wrote %s (mode 600): keep it out of repositories" % args.file)
+    return 0
+
+
+def sign_frame(args):
+    from obsw.frames.cltu import encode
+
+    from obsw_host.frames import keys
+
+    try:
+        security, state = keys.load(args.keys, args.key_state)
+        frame = keys.signed_frame(
+            security, args.scid, args.vcid, _hex(args.hex), args.map, args.seq, not args.ad
+        )
+        state.save()
+    except (OSError, ValueError) as e:
+        raise SystemExit("obsw frames sign: %s" % e) from None
+    print(binascii.hexlify(encode(frame) if args.cltu else frame).decode())
     return 0
 
 
@@ -157,6 +251,30 @@ def tm_decode(args):
     }
     print(json.dumps(out))
     return 0
+
+
+def verify_frame(args):
+    from obsw.frames.cltu import decode
+    from obsw.frames.errors import FrameError
+    from obsw.frames.sdls import OUTCOME_NAMES
+    from obsw.frames.tc import TcFrame
+
+    from obsw_host.frames import keys
+
+    raw = _hex(args.hex)
+    try:
+        security, _ = keys.load(args.keys, False)  # no state: any fresh number is taken
+        if raw[:2] == b"\xeb\x90":
+            raw, _ = decode(raw)
+        frame = TcFrame.unpack(raw, trailing=True)
+    except (OSError, FrameError) as e:
+        raise SystemExit("obsw frames verify: %s" % e) from None
+    outcome, sa, sn, clear = security.process(raw, len(frame))
+    out = _frame_json(frame)
+    out.update(outcome=OUTCOME_NAMES[outcome], spi=None if sa is None else sa.spi, sn=sn)
+    out["data"] = None if clear is None else binascii.hexlify(clear).decode()
+    print(json.dumps(out))
+    return 0 if clear is not None else 1
 
 
 def run_demo(args):

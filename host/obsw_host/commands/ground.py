@@ -34,6 +34,8 @@ A request to schedule, sequence or run as an action is ``ping``, ``function NAME
 import json
 import sys
 
+from obsw_host.net import DEFAULT_HOST
+
 
 def add_parser(sub):
     p = sub.add_parser(
@@ -43,7 +45,7 @@ def add_parser(sub):
         formatter_class=_raw(),
     )
     p.add_argument("--sdb", help="spacecraft database JSON (default: the sample database)")
-    p.add_argument("--host", default="127.0.0.1", help="on-board host (default %(default)s)")
+    p.add_argument("--host", default=DEFAULT_HOST, help="on-board host (default %(default)s)")
     p.add_argument("--port", type=int, help="on-board UDP port (default 5000 + APID)")
     p.add_argument("--apid", type=int, help="on-board APID (default: the database's 'pus')")
     p.add_argument("--timeout", type=float, default=2.0, help="seconds per request")

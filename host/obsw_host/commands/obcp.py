@@ -25,6 +25,8 @@
 import json
 import sys
 
+from obsw_host.net import DEFAULT_HOST
+
 _SIMPLE = {
     "stop": "stop",
     "suspend": "suspend",
@@ -65,7 +67,7 @@ def add_to_ground(ground_actions):
 
 def add_client_options(p):
     p.add_argument("--sdb", help="spacecraft database JSON (default: the sample database)")
-    p.add_argument("--host", default="127.0.0.1", help="on-board host (default %(default)s)")
+    p.add_argument("--host", default=DEFAULT_HOST, help="on-board host (default %(default)s)")
     p.add_argument("--port", type=int, help="on-board UDP port (default 5000 + APID)")
     p.add_argument("--apid", type=int, help="on-board APID (default: the database's 'pus')")
     p.add_argument("--timeout", type=float, default=2.0, help="seconds per request")

@@ -18,6 +18,9 @@ class Ground:
 
     ``corrupt(link_index, cltu) -> cltu`` lets tests and the demo damage what one link carries.
     ``packets`` holds the TM packets decoded, ``channel_packets`` the same as (VC ID, packet).
+    With ``security`` (an ``obsw.frames.sdls.TcSecurity``) each segment is signed with its
+    channel's SA before FOP-1 (ApplySecurity in virtual channel generation), and ``state`` (a
+    ``keys.StateFile``) saves the sequence numbers after each one.
     """
 
     def __init__(
@@ -33,9 +36,14 @@ class Ground:
         t1=2.0,
         transmission_limit=5,
         corrupt=None,
+        security=None,
+        state=None,
     ):
         self.links = list(links)
         self.scid = scid
+        self.vcid = vcid
+        self.security = security
+        self.state = state
         self.map_id = map_id
         self.tc_randomize = tc_randomize
         self.fop = F.Fop1(scid, vcid, window, t1, transmission_limit)
@@ -59,6 +67,10 @@ class Ground:
     def send(self, packet, now, map_id=None, bypass=False):
         """Queue a packet; AD service unless ``bypass`` (sent at once with the BD service)."""
         seg = Segment(self.map_id if map_id is None else map_id, packet).pack()
+        if self.security is not None:
+            seg = self.security.apply(self.scid, self.vcid, seg, bypass)
+            if self.state is not None:
+                self.state.save()
         if bypass:
             self.fop.send_bd(seg, now)
         else:

@@ -7,17 +7,52 @@ packets sent to ``tm_port`` (4999) leave as TM frames on both links, on the VC o
 input whose packets all go on that VC, unchanged: by default the playback VC of the plan on
 ``tm_port + 1`` (5000 would collide with APID 0), where the PUS application process sends
 what service 15 retrieves from its packet stores.
+
+TC security: with ``security`` (an ``obsw.frames.sdls.TcSecurity``, see
+``obsw_host.frames.keys``) every TC frame is authenticated before FARM-1. A rejected frame is
+counted and, with ``event_apid``, reported to ground as a PUS service 5 event (TM[5,3], medium
+severity, aux: VC ID u8, SPI u16, sequence number u64) of the frame processor's own application
+process, which also serves TCs to that APID (e.g. TC[5,6] to disable an event). At most
+``event_limit`` such reports go out per second; the others are counted (``events_limited``).
+``state`` (a ``keys.StateFile``) saves the sequence numbers each time a frame is accepted.
 """
 
 import select
 import socket
+import struct
 import time
 
 from obsw.frames.processor import FrameProcessor
+from obsw.frames.sdls import EVENT_IDS, OUTCOME_NAMES
+from obsw.pus.app import ApplicationProcess
+from obsw.pus.services.s05_events import EventReporting
 
 from obsw_host.frames.links import SerialLink
+from obsw_host.net import DEFAULT_HOST
 
 DEFAULT_TM_PORT = 4999
+
+
+def sdb_events(sdb):
+    """(event APID, event IDs by outcome) of the frame processor in a spacecraft database: its
+    'frames' APID and the events named frames.tc_<outcome>."""
+    ids = [0] + [sdb.event("frames.tc_" + name).id for name in OUTCOME_NAMES[1:]]
+    return sdb.apid("frames"), tuple(ids)
+
+
+def security_options(key_path, sdb, state_path=None):
+    """The FrameProcessorHost options that authenticate TC frames with the key file at
+    ``key_path`` and report rejections as the events of ``sdb`` (a spacecraft database)."""
+    from obsw_host.frames import keys
+
+    security, state = keys.load(key_path, state_path)
+    event_apid, event_ids = sdb_events(sdb)
+    return {"security": security, "state": state, "event_apid": event_apid, "event_ids": event_ids}
+
+
+class _Clock:
+    def __init__(self, fn):
+        self.now = fn
 
 
 class FrameProcessorHost:
@@ -28,12 +63,17 @@ class FrameProcessorHost:
         link_a,
         link_b,
         scid,
-        host="127.0.0.1",
+        host=DEFAULT_HOST,
         port_base=5000,
         tm_port=DEFAULT_TM_PORT,
         essential_port=None,
         vc_ports=None,
         clock=time.monotonic,
+        security=None,
+        state=None,
+        event_apid=None,
+        event_ids=EVENT_IDS,
+        event_limit=10,
         **options,
     ):
         self.links = [
@@ -44,7 +84,20 @@ class FrameProcessorHost:
         self.essential_port = essential_port
         self.clock = clock
         self.essential = []
-        self.core = FrameProcessor(scid, self._route, self._essential, **options)
+        self.core = FrameProcessor(
+            scid, self._route, self._essential, security=security, **options
+        )
+        self.state = state
+        self.event_ids = event_ids
+        self.event_limit = event_limit
+        self.events_limited = 0
+        self._event_window = (None, 0)  # (second, reports in it)
+        self.pus = None
+        if event_apid is not None:
+            self.pus = ApplicationProcess(event_apid, self.core.send_packet, _Clock(clock))
+            self.pus.register(EventReporting(known=[i for i in event_ids if i]))
+        self.core.rejected_listeners.append(self._rejected)
+        self._accepted = 0
         if vc_ports is None:
             pb = self.core.playback_vcid
             vc_ports = {} if pb is None else {pb: tm_port + 1 if tm_port else 0}
@@ -79,7 +132,24 @@ class FrameProcessorHost:
         s.setblocking(False)
         return s
 
+    def _rejected(self, outcome, vcid, spi, sn):
+        if self.pus is None:
+            return
+        second = int(self.clock())
+        start, n = self._event_window
+        if start != second:
+            start, n = second, 0
+        if n >= self.event_limit:
+            self.events_limited += 1
+            return
+        self._event_window = (start, n + 1)
+        aux = struct.pack(">BHQ", vcid, spi, sn)
+        self.pus.event(self.event_ids[outcome], 3, aux)
+
     def _route(self, apid, packet):
+        if self.pus is not None and apid == self.pus.apid:
+            self.pus.receive(packet)
+            return
         try:
             self.out.sendto(packet, (self.host, self.port_base + apid))
         except OSError:
@@ -100,6 +170,9 @@ class FrameProcessorHost:
                 data = link.read()
                 if data and link.enabled:
                     self.core.receive(i, data, now)
+        if self.state is not None and self.core.counters["accepted"] != self._accepted:
+            self._accepted = self.core.counters["accepted"]
+            self.state.save()
         if self.tm in readable:
             while True:
                 try:

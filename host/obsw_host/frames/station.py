@@ -12,15 +12,17 @@ import time
 from collections import deque
 
 from obsw.frames import fop as F
+from obsw.frames.errors import FrameError
 
 from obsw_host.frames.ground import Ground
+from obsw_host.net import DEFAULT_HOST
 
 
 class GroundStation:
     """``Ground`` (FOP-1, CLTUs, TM decoding) between ``links`` and one UDP socket."""
 
     def __init__(
-        self, links, scid, host="127.0.0.1", port=0, mcs=None, keep=10000, clock=None, **options
+        self, links, scid, host=DEFAULT_HOST, port=0, mcs=None, keep=10000, clock=None, **options
     ):
         self.ground = Ground(links, scid, **options)
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -32,6 +34,7 @@ class GroundStation:
         self.clock = clock or time.monotonic
         self._t0 = self.clock()
         self.uplinked = 0
+        self.refused = 0  # packets that could not go up (too long, or no operational SA)
         self._initiated = False
 
     def now(self):
@@ -50,7 +53,11 @@ class GroundStation:
                 break
             if self.mcs is None or self.mcs != sender:
                 self.mcs = sender
-            self.ground.send(packet, now)
+            try:
+                self.ground.send(packet, now)
+            except FrameError:
+                self.refused += 1
+                continue
             self.uplinked += 1
         self.ground.poll(now, timeout)
         ch = self.ground.channel_packets

@@ -35,6 +35,7 @@ from obsw.pus.services.s21_sequencing import RequestSequencingUser
 from obsw.pus.services.s22_position_scheduling import PositionSchedulingUser
 from obsw.pus.user import UserProcess
 
+from obsw_host.net import DEFAULT_HOST
 from obsw_host.pus import text
 from obsw_host.pus.onboard import port_for, tai_now
 
@@ -59,7 +60,7 @@ class Ground:
         *,
         apid=None,
         target=None,
-        host="127.0.0.1",
+        host=DEFAULT_HOST,
         timeout=2.0,
         source_id=None,
         log=None,

@@ -20,7 +20,6 @@ from obsw.il.node import Node
 from obsw.pus.app import EVENT_CYCLE_OVERRUN, ApplicationProcess
 from obsw.pus.events import EventManager
 from obsw.pus.parameters import ParameterPool
-from obsw.pus.services.report_types import router_of
 from obsw.pus.services.s03_housekeeping import Housekeeping
 from obsw.pus.services.s05_events import EventReporting
 from obsw.pus.services.s08_functions import FunctionManagement, functions
@@ -32,6 +31,8 @@ from obsw.pus.services.s19_event_action import EventAction
 from obsw.pus.services.s20_parameters import ParameterManagement
 from obsw.pus.services.s21_sequencing import RequestSequencing
 from obsw.pus.services.s22_position_scheduling import PositionScheduling
+
+from obsw_host.net import DEFAULT_HOST
 
 PORT_BASE = 5000
 TAI_MINUS_UNIX = 378691200 + 37  # seconds from 1958-01-01 TAI to 1970-01-01 UTC, now
@@ -70,7 +71,7 @@ class Onboard:
         *,
         node=None,
         apid=None,
-        host="127.0.0.1",
+        host=DEFAULT_HOST,
         port=None,
         period=0.1,
         store=None,
@@ -112,6 +113,7 @@ class Onboard:
             task_timeout=10.0,
             overrun_event=overrun,
         )
+        self.tasks = []  # more coroutine functions to run on the process's loop
         self.providers = [self.node.provide(itf, impl) for itf, impl in components]
         self.pool = ParameterPool(sdb, self.node)
         self.events = EventManager(sdb, self.node)
@@ -121,7 +123,7 @@ class Onboard:
         self.events.bind()
         app = self.app
         if self.playback_to:
-            router_of(app).playback = self._playback
+            app.playback = self._playback
         app.register(Housekeeping(self.pool, sdb.housekeeping))
         app.register(EventReporting(known=sdb.events))
         app.register(TimeManagement(time_exponent))
@@ -130,7 +132,7 @@ class Onboard:
         app.register(FunctionManagement(functions(sdb), self.node))
         app.register(TimeScheduling())
         app.register(OnBoardMonitoring(self.pool, sdb.events))
-        app.register(EventAction(known=sdb.events))  # after service 5: it wraps its sink
+        app.register(EventAction(known=sdb.events))
         app.register(RequestSequencing())
         position = sdb.extra.get("position_scheduling")
         if position:
@@ -165,7 +167,7 @@ class Onboard:
             self.app.count("tm_no_ground")
 
     def _playback(self, raw, vc):
-        """TmRouter.playback: a retrieved packet on the frame processor's input of ``vc``."""
+        """The app's playback: a retrieved packet to the frame processor's ``vc`` input."""
         address = self.playback_to.get(vc)
         if address is None:
             self.app.count("playback_realtime")
@@ -198,6 +200,8 @@ class Onboard:
         tasks = [asyncio.ensure_future(self.app.run(self.period))]
         if self.node is not None:
             tasks.append(asyncio.ensure_future(self.node.serve()))
+        for make in self.tasks:
+            tasks.append(asyncio.ensure_future(make()))
         self._ready.set()
         try:
             await self._stopping.wait()

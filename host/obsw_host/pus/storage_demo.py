@@ -111,21 +111,30 @@ class Segment:
         self._running = False
 
     def _open_link(self, sdb, frame_length):
-        """The frame processor and a ground station on two pseudo-UART pairs."""
+        """The frame processor and a ground station on two pseudo-UART pairs; TC frames are
+        signed (SDLS) with keys made for the run in the work folder."""
+        from obsw_host.frames import keys
         from obsw_host.frames.links import FdLink, SerialLink, open_pty_pair
-        from obsw_host.frames.processor import FrameProcessorHost
+        from obsw_host.frames.processor import FrameProcessorHost, security_options
         from obsw_host.frames.station import GroundStation
+
+        key_file = os.path.join(self.work, "tc.keys")
+        if not os.path.exists(key_file):
+            keys.generate(key_file)
+        onboard_keys = security_options(key_file, sdb, key_file + ".onboard")
+        ground_keys, ground_state = keys.load(key_file, key_file + ".ground")
 
         plan = (sdb.extra.get("frames") or {}).get("tm_vcs")
         ctrl_a, dev_a = open_pty_pair()
         ctrl_b, dev_b = open_pty_pair()
         self.fp = FrameProcessorHost(
             SerialLink(dev_a), SerialLink(dev_b), SCID, port_base=0, tm_port=0,
-            tm_frame_length=frame_length, tm_plan=plan, clcw_period=0.5,
+            tm_frame_length=frame_length, tm_plan=plan, clcw_period=0.5, **onboard_keys,
         )  # fmt: skip
         self.station = GroundStation(
-            [FdLink(ctrl_a, "A"), FdLink(ctrl_b, "B")], SCID, tm_frame_length=frame_length
-        )
+            [FdLink(ctrl_a, "A"), FdLink(ctrl_b, "B")], SCID, tm_frame_length=frame_length,
+            security=ground_keys, state=ground_state,
+        )  # fmt: skip
 
     def start(self):
         import threading

@@ -9,11 +9,13 @@ import select
 import socket
 import threading
 
+from obsw_host.net import DEFAULT_HOST
+
 
 class CanHub:
     """Two buses (A, B) as UDP ports; ``kill(bus)`` cuts one (fault injection)."""
 
-    def __init__(self, host="127.0.0.1"):
+    def __init__(self, host=DEFAULT_HOST):
         self.socks = []
         self.ports = []
         self.clients = [[], []]
@@ -75,7 +77,7 @@ class CanHub:
 class HubBus:
     """A python-can-like bus (send / recv / shutdown) on one hub port."""
 
-    def __init__(self, port, host="127.0.0.1"):
+    def __init__(self, port, host=DEFAULT_HOST):
         self.addr = (host, port)
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind((host, 0))

@@ -26,6 +26,7 @@ from obsw.reconfig.hal import RESET_NAMES, RESET_POWER, RESET_STUCK, RESET_WATCH
 from obsw.reconfig.models import Tps3813Model
 
 import obsw_host
+from obsw_host.frames import keys
 from obsw_host.frames.links import open_pty_pair
 from obsw_host.reconfig import simhal as W
 from obsw_host.reconfig.canhub import CanHub
@@ -142,10 +143,13 @@ class ReconfigSim:
         watchdog_timeout_ms=3000,
         heapsize="1M",
         out=None,
+        key_file=None,
+        obc_command=None,
     ):
         self.own_dir = directory is None
         self.dir = directory or tempfile.mkdtemp(prefix="obsw-reconfig-")
         self.obc_calls = list(obc_calls)
+        self.obc_command = obc_command  # callable(sim) -> argv of the OBC, or the sample OBC
         self.scid = scid
         self.obc_line = obc_line
         self.initial_lines = initial_lines
@@ -155,6 +159,11 @@ class ReconfigSim:
         self.wd = (watchdog_open_ms, watchdog_timeout_ms)
         self.heapsize = heapsize
         self.out = out
+        # TC frames to the controllers are signed (SDLS); keys made for the run unless given
+        self.key_file = key_file or os.path.join(self.dir, "tc.keys")
+        if key_file is None and not os.path.exists(self.key_file):
+            keys.generate(self.key_file)
+        self.security, _ = keys.load(self.key_file, os.path.join(self.dir, "ground.state"))
         self.events = []
         self.ctrl = [None, None]
         self.obc = None
@@ -270,6 +279,7 @@ class ReconfigSim:
             self.dir,
             str(cause),
             str(self.bit_error_gap),
+            self.key_file,
         ]
         p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
         self.ctrl[role] = _Proc(ROLES[role], p, self)
@@ -281,11 +291,14 @@ class ReconfigSim:
         core, host = roots()
         old = os.environ.get("PYTHONPATH")
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([core, host] + ([old] if old else [])))
-        cmd = [sys.executable, "-m", "obsw_host.reconfig.obc"]
-        cmd += [str(self.hub.ports[0]), str(self.hub.ports[1])]
-        if self.obc_boots == 0:
-            for c in self.obc_calls:
-                cmd += ["--call", c]
+        if self.obc_command is not None:
+            cmd = list(self.obc_command(self))
+        else:
+            cmd = [sys.executable, "-m", "obsw_host.reconfig.obc"]
+            cmd += [str(self.hub.ports[0]), str(self.hub.ports[1])]
+            if self.obc_boots == 0:
+                for c in self.obc_calls:
+                    cmd += ["--call", c]
         p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
         self.obc_boots += 1
         self.obc = _Proc("obc", p, self)
@@ -375,8 +388,9 @@ class ReconfigSim:
     # -- ground and COM module ----------------------------------------------------------------
 
     def send_hpc(self, hpc):
-        """Send an HPC as a BD frame on the essential MAP to both controllers' COM UARTs."""
+        """Send an HPC as a signed BD frame on the essential MAP to both controllers' COM UARTs."""
         seg = tc.Segment(ESSENTIAL_MAP, hpc.packet(seq_count=self._seq)).pack()
+        seg = self.security.apply(self.scid, 0, seg, True)  # signed with the essential MAP's SA
         frame = tc.TcFrame(self.scid, 0, seg, self._seq & 0xFF, bypass=True).pack()
         self._seq += 1
         data = cltu.encode(frame)

@@ -233,7 +233,14 @@ def main(argv):
         int(argv[7]),
         int(argv[8]) if len(argv) > 8 else 0,
     )
-    app = ReconfigApp(hal)
+    security = None
+    if len(argv) > 9:
+        from obsw.reconfig.essential import security_from_file
+
+        security = security_from_file(argv[9])
+        if security is None:
+            raise OSError("no SDLS key file %s" % argv[9])
+    app = ReconfigApp(hal, essential_security=security)
     tag = "NR"[role]
 
     def log(text):

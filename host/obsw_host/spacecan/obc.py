@@ -32,26 +32,19 @@ from obsw.spacecan.responder import Responder
 
 from obsw_host.spacecan.adapter import CanAdapter
 
-# A sample definition: the reconfiguration module's CPDU as seen on SpaceCAN (12 D lines).
-CPDU_NODE = {
-    "parameters": [
-        {"parameter_id": 1, "parameter_name": "state_bits", "encoding": "u16", "value": 0},
-        {"parameter_id": 2, "parameter_name": "supply_mv", "encoding": "u16", "value": 5020},
-        {"parameter_id": 3, "parameter_name": "board_temp", "encoding": "f32", "value": 24.5},
-    ],
-    "housekeeping_reports": [
-        {"report_id": 1, "interval": 0.5, "enabled": True, "parameter_ids": [1, 2, 3]}
-    ],
-    "functions": [
-        {
-            "function_id": 1,
-            "function_name": "set_state_bits",
-            "arguments": [{"argument_id": 1, "argument_name": "state_bits", "encoding": "u16"}],
-        }
-    ],
-}
+# The reconfiguration module's CPDU as seen on SpaceCAN: the one definition the firmware also
+# uses (``obsw.reconfig.node``; nominal controller node 10, redundant 11).
+CPDU_NODE_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "cpdu_node.json")
+
+
+def cpdu_node():
+    """The CPDU node definition (a fresh dict from ``CPDU_NODE_PATH``)."""
+    with open(CPDU_NODE_PATH) as f:
+        return json.load(f)
+
+
 CPDU_NAME = "CpduN"
-CPDU_NODE_ID = 5
+CPDU_NODE_ID = 10
 
 _IDLE_WAIT = 0.2  # longest a wait blocks with nothing due (stop() is seen this soon)
 
@@ -113,6 +106,7 @@ class ObcSpaceCan:
         timeout=0.5,
         retries=2,
         policy=None,
+        device_access=False,
     ):
         self.node = node if node is not None else Node("spacecan-master")
         self.interface = interface
@@ -142,6 +136,12 @@ class ObcSpaceCan:
             t._fds[self._waker.fileno()] = self._waker
             t._poll.register(self._waker.fileno(), select.POLLIN)
         self.node.provide(MASTER, self.master)
+        self.access = None
+        if device_access:  # PUS service 2's way to the equipment (packet mode)
+            from obsw.spacecan.device_access import DEVICE_ACCESS, SpaceCanDeviceAccess
+
+            self.access = SpaceCanDeviceAccess(self.controller, timeout=timeout * (retries + 1))
+            self.node.provide(DEVICE_ACCESS, self.access)
         for eq in self.equipment:
             eq.provide(self.node)
         self.node.wait = self.wait
@@ -230,6 +230,8 @@ class ObcSpaceCan:
 
     def pump(self):
         """Handle what is queued on both sides: IL requests, frames, deadlines, callbacks."""
+        if self.access is not None:
+            self.access.now = self.node.clock.now()
         self._poll_node()
         self.adapter.run_pending()
         self._poll_node()
@@ -287,7 +289,7 @@ def parse_equipment(spec):
     if len(parts) == 3:
         nodedef = NodeDefinition.load(parts[2], node_id)
     else:
-        nodedef = NodeDefinition.from_dict(json.loads(json.dumps(CPDU_NODE)), node_id)
+        nodedef = NodeDefinition.from_dict(cpdu_node(), node_id)
     return Equipment(parts[0], node_id, nodedef)
 
 

@@ -30,6 +30,7 @@ COUNTERS = (
     "tm_dropped",
     "tm_unknown_vc",
     "tm_frames",
+    "tc_rejected",
 )
 
 
@@ -61,6 +62,11 @@ class FrameProcessor:
     ``tm_channels`` replace the plan's channels (with ``tm_plan`` given too, it still names
     their roles); without a plan, packets whose APID is not mapped go to ``tm_default_vcid``
     (default: the lowest-priority channel) and there is no playback VC.
+
+    TC security: with ``security`` (an ``obsw.frames.sdls.TcSecurity``) every frame but a
+    control command is verified after duplicate removal and before FARM-1; a rejected frame is
+    counted (``tc_rejected``, and by outcome in ``security.counters``) and each of
+    ``rejected_listeners`` is called with (outcome, VC ID, SPI, sequence number).
     """
 
     def __init__(
@@ -81,6 +87,7 @@ class FrameProcessor:
         farm_window=10,
         dedup_window=2.0,
         clcw_period=1.0,
+        security=None,
     ):
         self.scid = scid
         self.route = route
@@ -89,6 +96,10 @@ class FrameProcessor:
         self.segment_header = segment_header
         self.tm_randomize = tm_randomize
         self.clcw_period = clcw_period
+        if security is not None and security.segment_header != segment_header:
+            raise ValueError("TC security and frame processor disagree on segment headers")
+        self.security = security
+        self.rejected_listeners = []  # callables(outcome, vcid, spi, sn)
         self.farms = {}
         self._reassembly = {}
         for v in tc_vcids:
@@ -152,9 +163,18 @@ class FrameProcessor:
             self._count("duplicates")
             return
         self._report = True
+        sa = None
+        if self.security is not None and frame.frame_type != TYPE_BC:
+            outcome, sa, sn, clear = self.security.process(data, n)
+            if clear is None:
+                self._rejected(outcome, frame.vcid, sa, sn, data, n)
+                return
+            frame.data = clear
         if farm.on_frame(frame) != ACCEPT:
             self._count("discarded")
             return
+        if sa is not None:
+            self.security.commit(sa, sn)
         self._count("accepted")
         while True:
             accepted = farm.take()
@@ -162,6 +182,16 @@ class FrameProcessor:
                 break
             if accepted.frame_type != TYPE_BC:
                 self._deliver(accepted)
+
+    def _rejected(self, outcome, vcid, sa, sn, data, n):
+        self._count("tc_rejected")
+        if sa is not None:
+            spi = sa.spi
+        else:
+            at = 6 if self.segment_header else 5
+            spi = (data[at] << 8) | data[at + 1] if n >= at + 2 else 0
+        for fn in self.rejected_listeners:
+            fn(outcome, vcid, spi, sn)
 
     def _deliver(self, frame):
         data = frame.data

@@ -9,6 +9,18 @@ reports go out. A handler that is a coroutine runs as an asyncio task, so slow r
 once. ``tick()`` is one cycle of the activity loop that drives the services' periodic work;
 a service still busy with its previous cycle is stopped and an overrun event raised.
 
+Wiring is declared here and services add themselves to it; none replaces another's
+attributes, so the order of ``register`` calls carries no meaning:
+- the TM pipeline: every packed TM is offered to each of ``tm_stores`` (``store(header, raw,
+  time)``, e.g. service 15's packet stores), then asked of each of ``tm_filters``
+  (``forwards(header)`` -> bool, e.g. service 14); it goes out in real time unless a filter
+  says no. All stages see every packet whatever the others decide. ``play(raw, vc)`` sends a
+  retrieved packet to ``playback`` (set by the host to the frame processor's input of that
+  virtual channel), or out in real time when there is none.
+- events: ``event()`` calls every ``event_reporters`` entry (service 5: the report to the
+  ground), then every ``event_listeners`` entry (service 19, a platform manager, ...), each
+  as ``listener(event_id, severity, aux)``.
+
 Sans-I/O: TM bytes go to ``out`` (a callable, or anything with ``put``, e.g. an
 ``obsw.il.queue.Queue``); time comes from ``clock.now()``; ``run()`` is the only coroutine
 that sleeps, and it is optional.
@@ -33,6 +45,7 @@ from obsw.pus.packets import (
     RequestId,
     failure_code,
 )
+from obsw.pus.services.report_types import TmHeader
 from obsw.pus.services.s01_verification import (
     ACCEPTANCE,
     COMPLETION,
@@ -178,7 +191,12 @@ class ApplicationProcess:
         self.task_timeout = task_timeout
         self.period = period  # the cycle of the activity loop, seconds
         self.overrun_event = overrun_event
-        self._put = out.put if hasattr(out, "put") else out
+        self.out = out.put if hasattr(out, "put") else out
+        self.tm_stores = []  # store(header, raw, time) for every TM
+        self.tm_filters = []  # forwards(header) -> False withholds a TM from real time
+        self.playback = None  # callable(raw, vc) for TM retrieved from packet stores
+        self.event_reporters = []  # callable(event_id, severity, aux) -> True if reported
+        self.event_listeners = []  # callable(event_id, severity, aux), after the reporters
         self.services = {}
         self.sequence = SequenceCounter()
         self.message_counters = {}  # (service << 8 | subtype) -> next message type counter
@@ -186,7 +204,6 @@ class ApplicationProcess:
         self.counters = {}
         self.failures = {}  # failure code -> count
         self.tasks = []  # [request, task] of handlers running as asyncio tasks
-        self.event_sink = None  # callable(event_id, severity, aux) set by the event service
         self.events_lost = 0
         self.last_cycle = None
         self.verification = Verification()
@@ -324,21 +341,65 @@ class ApplicationProcess:
         except ValueError:
             self.count("tm_unpackable")
             return None
+        if self.tm_stores or self.tm_filters:
+            if not self._pipeline(raw):
+                self.count("tm_withheld")
+                return raw
+        if self._emit(raw):
+            self.count("tm_sent")
+            return raw
+        return None
+
+    def _pipeline(self, raw):
+        """Offer ``raw`` to every store, ask every filter; True if it goes out in real time."""
         try:
-            self._put(raw)
+            h = TmHeader(raw, self.config)
+        except ValueError:
+            self.count("tm_malformed")
+            return True
+        t = self.time()
+        for store in self.tm_stores:
+            store(h, raw, t)
+        keep = True
+        for forwards in self.tm_filters:
+            if not forwards(h):
+                keep = False
+        return keep
+
+    def _emit(self, raw):
+        try:
+            self.out(raw)
         except Exception:  # the output's failure is counted; the process keeps going
             self.count("tm_lost")
-            return None
-        self.count("tm_sent")
-        return raw
+            return False
+        return True
+
+    def play(self, raw, vc):
+        """Send a TM retrieved from a packet store on virtual channel ``vc``."""
+        play = self.playback
+        if play is None:
+            return self._emit(raw)
+        try:
+            play(raw, vc)
+        except Exception:
+            self.count("tm_lost")
+            return False
+        return True
 
     def event(self, event_id, severity, aux=b""):
-        """Raise an on-board event; the event reporting service decides whether it goes out."""
-        sink = self.event_sink
-        if sink is None:
+        """Raise an on-board event: reporters first, then listeners; True if it was reported."""
+        reported = False
+        if not self.event_reporters:
             self.events_lost += 1
-            return False
-        return sink(event_id, severity, aux)
+        for report in self.event_reporters:
+            if report(event_id, severity, aux):
+                reported = True
+        for listener in self.event_listeners:
+            try:
+                listener(event_id, severity, aux)
+            except Exception:
+                self.count("listener_errors")
+        return reported
 
     # -------------------------------------------------------------------------- activity loop
 

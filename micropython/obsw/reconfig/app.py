@@ -59,6 +59,7 @@ class ReconfigApp:
         cpdu_budget_us=20000,
         tm_frame_length=64,
         cpdu_options=None,
+        essential_security=None,
     ):
         self.hal = hal
         self.role = hal.role
@@ -73,7 +74,12 @@ class ReconfigApp:
             node_id = NODE_NOMINAL if self.role == NOMINAL else NODE_REDUNDANT
         self.node = CpduNode(self, node_id, heartbeat_period)
         self.essential = Essential(
-            scid, self.role, self.in_charge, obc_lines=obc_lines, tm_frame_length=tm_frame_length
+            scid,
+            self.role,
+            self.in_charge,
+            obc_lines=obc_lines,
+            tm_frame_length=tm_frame_length,
+            security=essential_security,
         )
         self.report_period = report_period
         self.status_period = status_period

@@ -6,6 +6,9 @@ TC: CLTUs from the COM UART go through the frames core (CLTU, TC frame, FARM, se
 MAP service data units of ``essential_map`` are HPCs, the rest belongs to the OBC and is only
 counted. Send HPCs as Type-BD frames: this module's FARM does not follow the OBC's sequence.
 An HPC is a TC space packet (or the bare bytes) whose data are ``code u8, target u8, args``.
+With ``security`` (an ``obsw.frames.sdls.TcSecurity``, e.g. from ``security_from_file``) every
+frame must be authenticated (SDLS), HPCs by the SA of the essential MAP; rejected frames are
+counted in ``frames.counters["tc_rejected"]`` and by outcome in ``security.counters``.
 """
 
 import struct
@@ -157,6 +160,24 @@ class Report:
         return d
 
 
+def security_from_file(path):
+    """The TcSecurity of the SDLS key file at ``path``, or None when there is none. A key file
+    that cannot be read as one gives a TcSecurity with no SA: every TC frame is then rejected,
+    but the module keeps running (a boot that raised would reset it forever)."""
+    try:
+        f = open(path)
+    except OSError:
+        return None
+    from obsw.frames.sdls import SdlsError, TcSecurity
+    from obsw.frames.sdls_keys import load_security
+
+    try:
+        with f:
+            return load_security(f.read())
+    except (SdlsError, OSError, ValueError):
+        return TcSecurity(())
+
+
 class Essential:
     """HPCs in (``feed``), CPDU writes out (``take_writes``), HPTM CADUs out (``report``).
 
@@ -176,6 +197,7 @@ class Essential:
         obc_lines=(0, 1),
         tc_randomized=False,
         tm_randomize=True,
+        security=None,
     ):
         self.role = role
         self.in_charge = in_charge or (lambda: role == NOMINAL)
@@ -190,6 +212,7 @@ class Essential:
             essential_map=essential_map,
             tc_vcids=tc_vcids,
             tc_randomized=tc_randomized,
+            security=security,
         )
         self.mux = TmMultiplexer(scid, tm_frame_length, [TmVirtualChannel(hptm_vcid, 1)])
         self.seq = SequenceCounter()

@@ -1,10 +1,10 @@
-"""Report-type selections shared by ST[14] forwarding and ST[15] storage, and the TM router.
+"""Report-type selections shared by ST[14] forwarding and ST[15] storage, and the TM header.
 
 A ``ReportTypes`` selection maps APIDs to services to subtypes; an empty list at a level means
 "all" (ECSS-E-ST-70-41C 6.14 and 6.15: N2 = 0 selects every service type of the APID, N3 = 0
 every subtype of the service). ``IdSelection`` is the same for housekeeping structure IDs and
-event IDs per APID. ``TmRouter`` sits between an application process and its TM output: every
-packet goes to the packet stores that select it, then out in real time if forwarding allows.
+event IDs per APID. ``TmHeader`` is what the application process's TM pipeline stages see of
+each packet.
 """
 
 from obsw.pus.services.base import APID_FIELD, EVENT_ID, STRUCTURE_ID, U8, U16
@@ -219,7 +219,7 @@ class IdSelection:
 
 
 class TmHeader:
-    """What the router needs from a packed TM, read without decoding the whole packet."""
+    """What the TM pipeline needs from a packed TM, read without decoding the whole packet."""
 
     __slots__ = ("apid", "service", "subtype", "data")
 
@@ -237,61 +237,6 @@ class TmHeader:
         """The structure ID of a housekeeping report, the event ID of an event report."""
         d = self.data
         return (d[0] << 8) | d[1] if len(d) >= 2 else None
-
-
-class TmRouter:
-    """Between ``app`` and its TM output: packet stores first, then real-time forwarding.
-
-    ``install(app)`` takes the application process's output over (its TM bytes now pass
-    through ``route``). Stores are given by ST[15] (``stores.offer(header, raw, time)``), the
-    forwarding decision by ST[14] (``forwarding.forwards(header)``). ``playback(raw, vc)``
-    sends retrieved packets on their virtual channel; by default they go out in real time.
-    """
-
-    def __init__(self):
-        self.app = None
-        self.downstream = None
-        self.playback = None
-        self.storage = None
-        self.forwarding = None
-        self.forwarded = 0
-        self.withheld = 0
-        self.malformed = 0
-
-    def install(self, app):
-        if self.app is app:
-            return self
-        existing = getattr(app, "tm_router", None)
-        if existing is not None:
-            return existing
-        self.app = app
-        self.downstream = app._put
-        app._put = self.route
-        app.tm_router = self
-        return self
-
-    def route(self, raw):
-        app = self.app
-        try:
-            h = TmHeader(raw, app.config)
-        except ValueError:
-            self.malformed += 1
-            self.downstream(raw)
-            return
-        if self.storage is not None:
-            self.storage.offer(h, raw, app.time())
-        fwd = self.forwarding
-        if fwd is None or fwd.forwards(h):
-            self.forwarded += 1
-            self.downstream(raw)
-        else:
-            self.withheld += 1
-
-
-def router_of(app):
-    """The application process's TmRouter, installed on first use."""
-    r = getattr(app, "tm_router", None)
-    return r if r is not None else TmRouter().install(app)
 
 
 def hk_or_event_id(h):

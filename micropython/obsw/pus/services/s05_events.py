@@ -47,7 +47,7 @@ class EventReporting(Service):
 
     def attach(self, app):
         super().attach(app)
-        app.event_sink = self.report
+        app.event_reporters.append(self.report)
 
     def context(self):
         return sorted(self.disabled)

@@ -2,10 +2,9 @@
 
 Three selections decide (ECSS-E-ST-70-41C 6.14): the report types (APID, service, subtype),
 the housekeeping structure IDs per APID for TM[3,25], and the event IDs per APID whose
-TM[5,x] are blocked. The provider takes the application process's TM output over through
-the shared ``TmRouter`` (``obsw.pus.services.report_types``); what it withholds can still be
-stored by ST[15]. Initially every report of the process's own APID is forwarded. The three
-selections persist in the context store.
+TM[5,x] are blocked. The provider is one of the application process's ``tm_filters``; what
+it withholds can still be stored by ST[15]. Initially every report of the process's own APID
+is forwarded. The three selections persist in the context store.
 """
 
 from obsw.pus.messages import (
@@ -31,7 +30,6 @@ from obsw.pus.services.report_types import (
     IdSelection,
     ReportTypes,
     hk_or_event_id,
-    router_of,
 )
 from obsw.pus.structure import Structure
 
@@ -96,7 +94,7 @@ class ForwardingControl(Service):
         self.types.apids[app.apid] = {}
         self.hk.apids[app.apid] = set()
         super().attach(app)
-        router_of(app).forwarding = self
+        app.tm_filters.append(self.forwards)
 
     # -------------------------------------------------------------------------- decision
 

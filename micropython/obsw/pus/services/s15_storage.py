@@ -1,11 +1,11 @@
 """ST[15] on-board storage and retrieval: packet stores filled while out of contact.
 
-Every TM of the application process passes the shared ``TmRouter``; each packet store whose
+Every TM of the application process passes its TM pipeline (``tm_stores``); each packet store whose
 storage function is enabled keeps the packets its storage-control configuration selects
 (report types per APID, housekeeping structure IDs, blocked event IDs; ECSS-E-ST-70-41C
 6.15). Stores are circular (the oldest packets make room) or bounded (new packets are
 refused when full). Retrieval sends the stored packets unchanged on the store's virtual
-channel (``TmRouter.playback``): by time range (TC[15,9]), by storage sequence numbers
+channel (``ApplicationProcess.play``): by time range (TC[15,9]), by storage sequence numbers
 (TC[15,7], project-defined after PUS-A's packet range downlink) or as the open retrieval,
 which follows the store from a start time tag as packets arrive. ``rate`` packets per store
 go out per cycle of the application process. Store configuration and control persist in the
@@ -57,7 +57,6 @@ from obsw.pus.services.report_types import (
     IdSelection,
     ReportTypes,
     hk_or_event_id,
-    router_of,
 )
 from obsw.pus.services.s01_verification import PusFailure
 from obsw.pus.services.s15_layouts import (
@@ -183,7 +182,7 @@ class Storage(Service):
                 st.load()
             if self.initial:
                 self.persist()
-        router_of(app).storage = self
+        app.tm_stores.append(self.offer)
 
     def _new(self, sid, size, kind, vc):
         st = PacketStore(sid, size, kind, vc, self.fs, self.folder)
@@ -213,7 +212,7 @@ class Storage(Service):
     # -------------------------------------------------------------------------- storing
 
     def offer(self, h, raw, t):
-        """The router's call for every TM: store it where the configuration says."""
+        """The TM pipeline's call for every TM: store it where the configuration says."""
         for sid in self.stores:
             st = self.stores[sid]
             if st.enabled and self.controls[sid].selects(h):
@@ -236,14 +235,12 @@ class Storage(Service):
         return sids
 
     def cyclic(self, now):
-        router = self.app.tm_router if hasattr(self.app, "tm_router") else None
-        if router is None:
-            return
+        play = self.app.play
         for st in self.stores.values():
             n = 0
             q = st.range_queue
             while q and n < self.rate:
-                self._play(router, st, q.pop(0))
+                self._play(play, st, q.pop(0))
                 n += 1
             if q is not None and not q:
                 st.range_queue = None
@@ -252,19 +249,15 @@ class Storage(Service):
                     raw = st.next_open()
                     if raw is None:
                         break
-                    self._play(router, st, raw)
+                    self._play(play, st, raw)
                     n += 1
                     self._dirty = True
         if self._dirty:
             self._dirty = False
             self.persist()
 
-    def _play(self, router, st, raw):
-        play = router.playback
-        if play is not None:
-            play(raw, st.vc)
-        else:
-            router.downstream(raw)
+    def _play(self, play, st, raw):
+        play(raw, st.vc)
         self.retrieved += 1
 
     # -------------------------------------------------------------------------- handlers

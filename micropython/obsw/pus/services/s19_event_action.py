@@ -98,13 +98,11 @@ class EventAction(Service):
         self.definitions = {}  # (apid, event ID) -> [enabled, request bytes]
         self.function = True
         self.fired = 0
-        self._next = None
         self._depth = 0
 
     def attach(self, app):
         super().attach(app)
-        self._next = app.event_sink
-        app.event_sink = self.on_event
+        app.event_listeners.append(self.on_event)
 
     # -------------------------------------------------------------------------- context
 
@@ -128,11 +126,8 @@ class EventAction(Service):
     # -------------------------------------------------------------------------- events
 
     def on_event(self, event_id, severity, aux=b""):
-        """The application process's event sink: report on, then act."""
-        nxt = self._next
-        out = nxt(event_id, severity, aux) if nxt is not None else False
+        """The application process's event listener: run the event's action, if any."""
         self.trigger(self.app.apid, event_id)
-        return out
 
     def trigger(self, apid, event_id):
         """Run the action of event ``event_id`` of process ``apid``; True if one ran."""

@@ -1,0 +1,7 @@
+"""The onboard computer assembled from one mission configuration file.
+
+``config`` reads the file, ``units`` builds each component from its section, ``assembly``
+runs the components of one process with its heartbeat, ``platform`` starts and watches the
+processes. ``obsw obc serve [CONFIG]`` runs it all; without a file, the sample spacecraft
+(``data/spacecraft.json``).
+"""

@@ -1,0 +1,349 @@
+"""The thesis' twelve-step chain on one machine, every step a real process or a real link.
+
+ground (PUS user) -> TC frames in CLTUs on two pseudo-terminal UARTs -> frame processor ->
+PUS application process -> service 18 -> PLUTO procedure on the OBCP engine -> interaction
+layer -> CpduN equipment component -> SpaceCAN master -> CAN (the reconfiguration module's
+UDP hub, buses A and B) -> both reconfiguration controllers as MicroPython unix-port processes
+-> CPDU lines switch -> housekeeping and verification back through TM frames.
+
+``Chain(work)`` writes a mission configuration with the OBC split into three processes
+(``core``: PUS, CFDP, OBCP and the sample solar panel; ``can``: SpaceCAN master and equipment;
+``frames``: the frame processor), starts the simulated reconfiguration module
+(``obsw_host.reconfig.sim.ReconfigSim``), whose CPDU line 0 powers the OBC: the OBC is
+``obsw obc serve`` of that configuration (the platform manager and its three processes).
+The ground station holds the other ends of the OBC's UARTs; the ground's PUS user talks to it.
+"""
+
+import json
+import os
+import select
+import sys
+import threading
+import time
+
+from obsw_host.frames.links import FdLink
+
+SCID = 0x42
+SWITCH = """\
+// Switch CPDU lines through the nominal controller and confirm the new state.
+procedure
+  main
+    initiate and confirm set_state_bits of CpduN with arguments state := %d end with;
+  end main
+end procedure
+"""
+OBC_LINE = 0x001  # CPDU line 0 powers the OBC: every state the chain sets keeps it on
+
+
+def _station_class():
+    from obsw.frames import fop as F
+
+    from obsw_host.frames.station import GroundStation
+
+    class OperatorStation(GroundStation):
+        """A ground station whose operator, when FOP-1 has given up (a restarted frame
+        processor's FARM-1 starts again at V(R) = 0), initiates the AD service with Set V(R),
+        so frame numbering restarts on both sides."""
+
+        started = False
+
+        def step(self, timeout=0.02):
+            # wait on the mission control socket as well as on the links, so a TC goes out
+            # as soon as it comes (the base class waits on the links only)
+            select.select([self.sock] + self.ground.links, [], [], timeout)
+            fop = self.ground.fop
+            if self.started and fop.state == F.INITIAL:
+                self.ground.initiate(self.now(), F.INITIATE_AD_WITH_SET_VR, fop.vs)
+                self._initiated = True
+            self.started = True
+            super().step(0)
+
+    return OperatorStation
+
+
+class Chain:
+    """The chain (see the module text); ``start()``/``stop()`` or a context manager."""
+
+    def __init__(self, work, out=None, timeout=10.0):
+        self.work = work
+        self.out = out
+        self.timeout = timeout
+        self.state = os.path.join(work, "obc-state")
+        self.config_path = os.path.join(work, "mission.json")
+        self.sim = None
+        self.station = None
+        self.ground = None
+        self.obcp = None
+        self.sdb = None
+        self._uarts = []
+        self._hk = set()  # structures defined on board
+        self._stop = threading.Event()
+        self._thread = None
+
+    def say(self, text):
+        if self.out is not None:
+            self.out(text)
+
+    # -------------------------------------------------------------------------- set-up
+
+    def _pty(self):
+        import tty
+
+        controller, device = os.openpty()
+        tty.setraw(device)
+        self._uarts.append(device)  # kept open: a restarted frame processor finds it as it was
+        return controller, os.ttyname(device)
+
+    def write_config(self, hub_ports, uart_a, uart_b):
+        from obsw_host.obc.config import SAMPLE
+
+        base = os.path.dirname(SAMPLE)
+        with open(SAMPLE) as f:
+            doc = json.load(f)
+        doc["name"] = "chain"
+        doc["sdb"] = os.path.join(base, doc["sdb"])
+        doc["state"] = self.state
+        doc["processes"] = {
+            "core": ["pus", "cfdp", "obcp", "solar_panel"],
+            "can": ["spacecan"],
+            "frames": ["frames"],
+        }
+        doc["pus"]["port"] = self.pus_port
+        doc["cfdp"]["port"] = self.cfdp_port
+        doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])
+        doc["spacecan"].update(
+            interface="hub",
+            channels=list(hub_ports),
+            simulate=False,
+            heartbeat_period=0.2,
+            timeout=0.3,
+            retries=3,
+        )
+        for n in doc["spacecan"]["nodes"]:
+            n["definition"] = os.path.join(base, n["definition"])
+        doc["frames"].update(
+            uart_a=uart_a, uart_b=uart_b, scid=SCID, tm_port=self.tm_port, clcw_period=0.2
+        )
+        doc["platform"].update(heartbeat=0.2, deadline=2.0, start_timeout=30.0, max_failures=20)
+        with open(self.config_path, "w") as f:
+            json.dump(doc, f, indent=2)
+        return doc
+
+    def _obc_command(self, sim):
+        self.write_config(sim.hub.ports, self.uart_paths[0], self.uart_paths[1])
+        return [sys.executable, "-m", "obsw_host.obc", self.config_path]
+
+    def start(self):
+        from obsw import sdb as sdb_module
+
+        from obsw_host.obc.config import load
+        from obsw_host.pus.ground import Ground
+        from obsw_host.pus.obcp_ground import ObcpGround
+        from obsw_host.reconfig.sim import ReconfigSim
+
+        os.makedirs(self.state, exist_ok=True)
+        self.pus_port, self.cfdp_port, self.tm_port = _free_ports(3)
+        ends = [self._pty(), self._pty()]
+        self.uart_paths = [path for _, path in ends]
+        self.links = [FdLink(ends[0][0], "A"), FdLink(ends[1][0], "B")]
+        self.station = _station_class()(self.links, SCID, tm_frame_length=256)
+        self._thread = threading.Thread(target=self.station.run, args=(self._stop,), daemon=True)
+        self._thread.start()
+        self.sim = ReconfigSim(
+            os.path.join(self.work, "reconfig"), obc_command=self._obc_command, out=self.out
+        )
+        os.makedirs(self.sim.dir, exist_ok=True)
+        self.sim.start()
+        if not self.sim.wait_for(lambda: os.path.exists(self.config_path), 20.0):
+            raise TimeoutError("the OBC was never powered")
+        self.config = load(self.config_path)
+        self.sdb = sdb_module.load(self.config.sdb_path)
+        self.ground = Ground(self.sdb, target=self.station.address[:2], timeout=self.timeout)
+        self.obcp = ObcpGround(self.ground)
+        return self
+
+    def stop(self):
+        if self.ground is not None:
+            self.ground.close()
+        if self.sim is not None:
+            self.sim.stop()  # kills the OBC (the platform manager: its processes follow it)
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(2.0)
+        if self.station is not None:
+            self.station.close()
+        for fd in self._uarts:
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        self.stop()
+
+    # -------------------------------------------------------------------------- operations
+
+    def wait_up(self, timeout=60.0):
+        """Ping through the whole chain until one completes; the time it took."""
+        t0 = time.monotonic()
+        end = t0 + timeout
+        while time.monotonic() < end:
+            try:
+                if self.ground.ping(timeout=1.0).ok:
+                    return time.monotonic() - t0
+            except Exception:
+                pass
+        raise TimeoutError("no ping completed through the chain within %ss" % timeout)
+
+    def switch(self, state, name="switch", timeout=None):
+        """Load and activate the CPDU procedure for ``state``; wait for its end event.
+
+        Returns the transaction of the activation and the procedure's final event."""
+        timeout = timeout or self.timeout
+        tx = self.obcp.load(name, SWITCH % (state | OBC_LINE), timeout=timeout)
+        if not tx.ok:
+            raise RuntimeError("load refused: %s" % tx.verification())
+        since = len(self.ground.received)
+        tx = self.obcp.activate(name, timeout=timeout)
+        done = self.wait_event(("obcp.finished", "obcp.failed"), since, timeout)
+        return tx, done
+
+    def wait_event(self, names, since=0, timeout=None):
+        """The first event named in ``names`` received after index ``since``, or None."""
+        ids = {self.sdb.event(n).id: n for n in names}
+        end = time.monotonic() + (timeout or self.timeout)
+        while time.monotonic() < end:
+            self.ground.poll(0.02)
+            for tm, _ in self.ground.received[since:]:
+                if tm.service == 5 and len(tm.data) >= 2:
+                    eid = (tm.data[0] << 8) | tm.data[1]
+                    if eid in ids:
+                        return ids[eid]
+        return None
+
+    def cpdu_housekeeping(self, sid=9):
+        """CpduN's parameters in a one-shot housekeeping report through the TM frames."""
+        names = ["CpduN.state_bits", "CpduN.health", "CpduN.in_charge"]
+        if sid not in self._hk:
+            self.ground.disable_hk([1])  # the sample's periodic report: one-shots only here
+            tx = self.ground.create_hk(sid, 10, names)
+            if not tx.ok:
+                raise RuntimeError("structure %d not created: %s" % (sid, tx.verification()))
+            self._hk.add(sid)
+        tx = self.ground.housekeeping(sid)
+        if not tx.ok or not tx.reply or "values" not in tx.reply:
+            raise RuntimeError(
+                "no housekeeping report %d: %s %r" % (sid, tx.verification(), tx.reply)
+            )
+        return tx.reply["values"]
+
+    def lines(self):
+        return self.sim.lines()
+
+    def pid_of(self, process):
+        """The pid of OBC process ``process`` as the platform manager last reported it."""
+        mark = "[platform] %s up (pid " % process
+        with self.sim._lock:
+            events = list(self.sim.events)
+        for _, text in reversed(events):
+            i = text.find(mark)
+            if i >= 0:
+                return int(text[i + len(mark) :].split(")")[0])
+        return None
+
+
+def _free_ports(n):
+    import socket
+
+    socks = []
+    for _ in range(n):
+        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        s.bind(("127.0.0.1", 0))
+        socks.append(s)
+    ports = [s.getsockname()[1] for s in socks]
+    for s in socks:
+        s.close()
+    return ports
+
+
+def demo(out=print):
+    """The chain, then its faults, narrated; returns 0 if every step went as expected."""
+    import shutil
+    import signal
+    import tempfile
+
+    from obsw.reconfig.essential import HPC_POWER_CYCLE, Hpc
+
+    work = tempfile.mkdtemp(prefix="obsw-chain-")
+    ok = True
+
+    def check(what, good, t0):
+        nonlocal ok
+        ok = ok and bool(good)
+        out("  %-66s %s (%.2f s)" % (what, "ok" if good else "FAILED", time.monotonic() - t0))
+
+    def ping_until_ok(chain, timeout=60.0):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            try:
+                if chain.ground.ping(timeout=3.0).ok:
+                    return True
+            except Exception:
+                pass
+        return False
+
+    try:
+        out("  starting: ground station on two pty UARTs, the OBC (frames, core, can processes")
+        out("  under the platform manager), the CAN hub, both MicroPython reconfiguration")
+        out("  controllers; CPDU line 0 powers the OBC")
+        with Chain(work) as chain:
+            t = time.monotonic()
+            chain.wait_up(60.0)
+            check("ping through CLTUs, frame processor, PUS, TM frames", True, t)
+            t = time.monotonic()
+            tx, end = chain.switch(0x005, timeout=20.0)
+            check(
+                "TC[18,3] -> PLUTO -> CpduN.set_state_bits -> SpaceCAN -> CPDU 0x%03x"
+                % chain.lines(),
+                tx.ok and end == "obcp.finished" and chain.lines() == 0x005,
+                t,
+            )
+            t = time.monotonic()
+            end_t = t + 20.0
+            hk = None
+            while time.monotonic() < end_t:
+                hk = chain.cpdu_housekeeping()
+                if hk.get("CpduN.state_bits") == 5:
+                    break
+            check("housekeeping through TM frames: CpduN.state_bits = %s" % hk.get(
+                "CpduN.state_bits"), hk.get("CpduN.state_bits") == 5, t)  # fmt: skip
+            for name in ("core", "can", "frames"):
+                pid = chain.pid_of(name)
+                t = time.monotonic()
+                os.kill(pid, signal.SIGKILL)
+                while chain.pid_of(name) in (None, pid) and time.monotonic() < t + 30:
+                    time.sleep(0.05)
+                check("OBC process %s killed: restarted, serving again" % name,
+                      ping_until_ok(chain), t)  # fmt: skip
+            chain.sim.hub.kill(0)
+            t = time.monotonic()
+            tx, end = chain.switch(0x007, name="bus_b", timeout=20.0)
+            check("bus A cut: CPDU switched over bus B", tx.ok and chain.lines() == 0x007, t)
+            chain.sim.hub.revive(0)
+            chain.links[0].enabled = False
+            t = time.monotonic()
+            check("UART A cut: ping over UART B", ping_until_ok(chain), t)
+            chain.links[0].enabled = True
+            boots = chain.sim.obc_boots
+            chain.sim.kill_obc()
+            t = time.monotonic()
+            chain.sim.send_hpc(Hpc(HPC_POWER_CYCLE, (0, 200)))
+            chain.sim.wait_for(lambda: chain.sim.obc_boots == boots + 1, 30.0)
+            check("OBC killed: power-cycled by an essential TC, serving again",
+                  ping_until_ok(chain), t)  # fmt: skip
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return 0 if ok else 1

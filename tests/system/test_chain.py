@@ -1,0 +1,154 @@
+"""The twelve-step chain end to end (``obsw_host.obc.chain``), then its faults: each OBC process
+killed in turn, bus A cut, UART A cut, the whole OBC killed and power-cycled by the
+reconfiguration module on an essential TC. Every wait has a deadline; the figures are printed,
+nothing asserts on time."""
+
+import os
+import signal
+import time
+
+import pytest
+from obsw.reconfig.essential import HPC_POWER_CYCLE, Hpc
+from obsw.spacecan.master import MASTER
+from obsw_host.obc.chain import OBC_LINE, Chain
+from obsw_host.reconfig.sim import micropython_binary
+
+pytestmark = pytest.mark.skipif(
+    micropython_binary() is None or not hasattr(os, "openpty"),
+    reason="needs the MicroPython unix port and pseudo-terminals",
+)
+
+WAIT = 60.0
+
+
+def wait_for(predicate, timeout=WAIT, step=0.05):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        v = predicate()
+        if v:
+            return v
+        time.sleep(step)
+    return predicate()
+
+
+class Ledger:
+    """Every TC sent through the chain: none that was accepted may stay without completion."""
+
+    def __init__(self, chain):
+        self.chain = chain
+        self.sent = []
+
+    def ping(self, timeout=3.0):
+        try:
+            tx = self.chain.ground.ping(timeout=timeout)
+        except Exception as e:  # a timeout: the transaction is inside the exception
+            tx = getattr(e, "transaction", None)
+        if tx is not None:
+            self.sent.append(tx)
+        return tx is not None and tx.ok
+
+    def ping_until_ok(self, timeout=WAIT):
+        """Ping until one completes (the ground repeats a TC that was never accepted)."""
+        end = time.monotonic() + timeout
+        tries = 0
+        while time.monotonic() < end:
+            tries += 1
+            if self.ping():
+                return tries
+        log = "\n".join("%6.2f %s" % e for e in self.chain.sim.events[-40:])
+        raise AssertionError("no ping completed within %ss\n%s" % (timeout, log))
+
+    def lost(self):
+        self.chain.ground.poll(0.5)  # late reports still on their way
+        return [
+            tx.verification()
+            for tx in self.sent
+            if "acceptance success" in tx.verification()
+            and "completion success" not in tx.verification()
+        ]
+
+
+def master_proxy(chain):
+    from obsw.il.node import Node
+    from obsw_host.il.transport import SocketTransport
+
+    node = Node("chain-test")
+    transport = SocketTransport(node, chain.config.il_directory, listen=False)
+    return node.proxy(MASTER, timeout=5.0, retries=2), transport
+
+
+def test_twelve_steps_and_faults(tmp_path, capsys):
+    figures = []
+    t_start = time.monotonic()
+    with Chain(str(tmp_path)) as chain:
+        led = Ledger(chain)
+        figures.append(("chain up (first ping through frames)", chain.wait_up(WAIT)))
+
+        # the twelve steps: procedure -> CPDU lines -> housekeeping, all through TM frames
+        t = time.monotonic()
+        tx, end = chain.switch(0x005, timeout=20.0)
+        assert tx.ok, tx.verification()
+        assert end == "obcp.finished"
+        assert wait_for(lambda: chain.lines() == 0x005 | OBC_LINE)
+        figures.append(("CPDU switch: TC[18,3] to obcp.finished", time.monotonic() - t))
+        hk = wait_for(lambda: chain.cpdu_housekeeping()["CpduN.state_bits"] == 5)
+        assert hk
+        assert chain.sim.seen("[N] function 1 {1: 5} -> True")
+
+        # each OBC process killed in turn: restarted, and the chain serves again
+        for name in ("core", "can", "frames"):
+            pid = chain.pid_of(name)
+            assert pid is not None
+            t = time.monotonic()
+            os.kill(pid, signal.SIGKILL)
+            assert wait_for(lambda n=name, p=pid: chain.pid_of(n) not in (None, p)), name
+            tries = led.ping_until_ok()
+            figures.append(("%s killed: back in service (%d pings)" % (name, tries),
+                            time.monotonic() - t))  # fmt: skip
+        tx, end = chain.switch(0x003, name="after_restarts", timeout=20.0)
+        assert (tx.ok, end) == (True, "obcp.finished")
+        assert wait_for(lambda: chain.lines() == 0x003 | OBC_LINE)
+
+        # bus A cut: the SpaceCAN traffic moves to bus B
+        master, transport = master_proxy(chain)
+        try:
+            chain.sim.hub.kill(0)
+            t = time.monotonic()
+            tx, end = chain.switch(0x007, name="bus_b", timeout=20.0)
+            assert (tx.ok, end) == (True, "obcp.finished")
+            assert wait_for(lambda: chain.lines() == 0x007 | OBC_LINE)
+            figures.append(("bus A cut: switch completed on bus B", time.monotonic() - t))
+            assert master.active_bus == 1
+        finally:
+            chain.sim.hub.revive(0)
+            transport.close()
+
+        # UART A cut: link B carries on
+        chain.links[0].enabled = False
+        t = time.monotonic()
+        tries = led.ping_until_ok()
+        tx, end = chain.switch(0x00F, name="uart_b", timeout=20.0)
+        assert (tx.ok, end) == (True, "obcp.finished")
+        figures.append(("UART A cut: ping and switch over UART B (%d pings)" % tries,
+                        time.monotonic() - t))  # fmt: skip
+        chain.links[0].enabled = True
+
+        assert led.lost() == []  # no TC that was accepted went without its completion
+
+        # the OBC killed: only an essential TC to the reconfiguration module brings it back
+        boots = chain.sim.obc_boots
+        chain.sim.kill_obc()
+        assert not led.ping(timeout=1.0)
+        t = time.monotonic()
+        chain.sim.send_hpc(Hpc(HPC_POWER_CYCLE, (0, 200)))
+        assert chain.sim.wait_for(lambda: chain.sim.obc_boots == boots + 1, WAIT)
+        tries = led.ping_until_ok()
+        figures.append(("OBC killed: power-cycled by an essential TC, serving again (%d pings)"
+                        % tries, time.monotonic() - t))  # fmt: skip
+        tx, end = chain.switch(0x005, name="after_power_cycle", timeout=20.0)
+        assert (tx.ok, end) == (True, "obcp.finished")
+        assert wait_for(lambda: chain.lines() == 0x005 | OBC_LINE)
+    with capsys.disabled():
+        print("\n  12-step chain and faults, %.1f s in all:" % (time.monotonic() - t_start))
+        for what, seconds in figures:
+            print("    %-70s %6.2f s" % (what, seconds))

@@ -125,9 +125,12 @@ def crc_accelerator(width, poly, init, reflect, xorout):
 
         return binascii.crc_hqx
     if (width, poly, init, reflect, xorout) == (32, 0x04C11DB7, 0xFFFFFFFF, True, 0xFFFFFFFF):
-        import zlib  # CRC-32 (IEEE, the CFDP file checksum 3): zlib's is several times crcmod's
-
-        return zlib.crc32
+        try:
+            import zlib  # CRC-32 (IEEE, the CFDP file checksum 3): several times crcmod's
+        except ImportError:
+            pass
+        else:
+            return zlib.crc32
     try:
         import crcmod
     except ImportError:

@@ -4,7 +4,8 @@
     micropython board_ops.py --list    the operation names
 
 Everything before the timed loop (imports, the application's boot, the inputs) is the same
-whatever N is, so the instructions of one operation are the difference between two runs with
+whatever N is (every case imports every module, so every collection marks the same heap), so
+the instructions of one operation are the difference between two runs with
 different N divided by the difference of N. Every counted operation starts on a freshly
 collected heap (the collection is counted by the `gc_collect` case and subtracted), so its count
 includes sweeping its own garbage, and the same operation costs the same whatever N is. `alloc`
@@ -16,6 +17,10 @@ import gc
 import sys
 
 from obsw.frames import cltu, tc
+from obsw.pluto.interp import Procedure, load
+from obsw.pluto.system import SimulatedSystem
+from obsw.pus.tc import PusTc
+from obsw.pus.tm import PusTm
 from obsw.reconfig.app import RECORD_CONTEXT, ReconfigApp
 from obsw.reconfig.essential import HPC_LINES, TARGET_BOTH, Hpc
 from obsw.reconfig.models import ModelHal
@@ -167,8 +172,6 @@ def _sgm_read(rig):
 
 
 def _pus_tc_decode(rig):
-    from obsw.pus.tc import PusTc
-
     raw = PusTc(0x65, 17, 1, b"", 7).pack()
     unpack = PusTc.unpack
 
@@ -179,8 +182,6 @@ def _pus_tc_decode(rig):
 
 
 def _pus_tm_encode(rig):
-    from obsw.pus.tm import PusTm
-
     data = bytes(range(16))
 
     def op():
@@ -205,9 +206,6 @@ end procedure
 
 def _pluto(rig):
     # one statement per operation (Procedure.step: the loop's `i := i + 1;` or its test)
-    from obsw.pluto.interp import Procedure, load
-    from obsw.pluto.system import SimulatedSystem
-
     p = Procedure(load(PLUTO), SimulatedSystem({}))
     p.start(0)
     step = p.step

@@ -13,8 +13,6 @@ import os
 import sys
 import tempfile
 
-from obsw_host.net import DEFAULT_HOST
-
 
 def add_parser(sub):
     p = sub.add_parser("obc", help="the onboard computer", description=__doc__)

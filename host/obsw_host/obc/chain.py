@@ -125,8 +125,10 @@ class Chain:
             uart_a=uart_a, uart_b=uart_b, scid=SCID, tm_port=self.tm_port, clcw_period=0.2
         )
         doc["platform"].update(heartbeat=0.2, deadline=2.0, start_timeout=30.0, max_failures=20)
-        with open(self.config_path, "w") as f:
+        partial = self.config_path + ".part"
+        with open(partial, "w") as f:
             json.dump(doc, f, indent=2)
+        os.replace(partial, self.config_path)  # the test polls for the file: never half written
         return doc
 
     def _obc_command(self, sim):

@@ -148,6 +148,7 @@ class ReconfigSim:
     ):
         self.own_dir = directory is None
         self.dir = directory or tempfile.mkdtemp(prefix="obsw-reconfig-")
+        os.makedirs(self.dir, exist_ok=True)
         self.obc_calls = list(obc_calls)
         self.obc_command = obc_command  # callable(sim) -> argv of the OBC, or the sample OBC
         self.scid = scid

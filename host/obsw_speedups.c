@@ -13,13 +13,16 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <structmember.h>
 #include <string.h>
 
-#define API_VERSION 1
+#define API_VERSION 2
 #define TC_ID 0x1800u
 #define TM_ID 0x0800u
 
-static unsigned short crc_table[256];
+/* slicing-by-8: crc_table[0] is the classic byte table, crc_table[k][n] the register after n
+ * followed by k zero octets, so eight octets cost eight lookups and no dependency chain */
+static unsigned short crc_table[8][256];
 
 static void
 crc_init(void)
@@ -28,16 +31,28 @@ crc_init(void)
         unsigned c = n << 8;
         for (int k = 0; k < 8; k++)
             c = (c & 0x8000u) ? ((c << 1) ^ 0x1021u) : (c << 1);
-        crc_table[n] = (unsigned short)(c & 0xFFFFu);
+        crc_table[0][n] = (unsigned short)(c & 0xFFFFu);
     }
+    for (int k = 1; k < 8; k++)
+        for (unsigned n = 0; n < 256; n++) {
+            unsigned c = crc_table[k - 1][n];
+            crc_table[k][n] = (unsigned short)(((c << 8) & 0xFFFFu) ^ crc_table[0][c >> 8]);
+        }
 }
 
 /* CRC-16/CCITT-FALSE (poly 0x1021, not reflected, no final XOR) continuing from reg */
 static unsigned
 crc16(unsigned reg, const unsigned char *p, Py_ssize_t n)
 {
+    while (n >= 8) {
+        unsigned a = ((reg >> 8) ^ p[0]) & 0xFFu, b = (reg ^ p[1]) & 0xFFu;
+        reg = crc_table[7][a] ^ crc_table[6][b] ^ crc_table[5][p[2]] ^ crc_table[4][p[3]] ^
+              crc_table[3][p[4]] ^ crc_table[2][p[5]] ^ crc_table[1][p[6]] ^ crc_table[0][p[7]];
+        p += 8;
+        n -= 8;
+    }
     while (n-- > 0)
-        reg = ((reg << 8) & 0xFFFFu) ^ crc_table[((reg >> 8) ^ *p++) & 0xFFu];
+        reg = ((reg << 8) & 0xFFFFu) ^ crc_table[0][((reg >> 8) ^ *p++) & 0xFFu];
     return reg;
 }
 
@@ -156,7 +171,7 @@ finish(PyObject *out, unsigned char *p, PyObject *data, int spare, int pec)
 /* tc_pack(apid, seq_count, seq_flags, ack, service, subtype, source_id, data, layout)
  * -> the whole TC as bytes, or None to take the Python path */
 static PyObject *
-tc_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+tc_pack_values(PyObject *const *args)
 {
     unsigned long long apid, count, flags, ack, service, subtype, source;
     long long layout;
@@ -165,11 +180,6 @@ tc_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     PyObject *data, *out;
     unsigned char *p;
 
-    (void)self;
-    if (nargs != 9) {
-        PyErr_SetString(PyExc_TypeError, "tc_pack takes 9 arguments");
-        return NULL;
-    }
     layout = layout_of(args[8]);
     if (layout < 0)
         Py_RETURN_NONE;
@@ -194,10 +204,21 @@ tc_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     return finish(out, p, data, spare, pec);
 }
 
+static PyObject *
+tc_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 9) {
+        PyErr_SetString(PyExc_TypeError, "tc_pack takes 9 arguments");
+        return NULL;
+    }
+    return tc_pack_values(args);
+}
+
 /* tm_pack(apid, seq_count, seq_flags, time_ref, service, subtype, message_counter,
  *         destination_id, time, data, layout) -> the whole TM as bytes, or None */
 static PyObject *
-tm_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+tm_pack_values(PyObject *const *args)
 {
     unsigned long long apid, count, flags, ref, service, subtype, counter, dest;
     unsigned long long coarse = 0, fine = 0;
@@ -207,11 +228,6 @@ tm_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     PyObject *data, *t, *out;
     unsigned char *p;
 
-    (void)self;
-    if (nargs != 11) {
-        PyErr_SetString(PyExc_TypeError, "tm_pack takes 11 arguments");
-        return NULL;
-    }
     layout = layout_of(args[10]);
     if (layout < 0)
         Py_RETURN_NONE;
@@ -249,6 +265,17 @@ tm_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     p = put(p, coarse, tc);
     p = put(p, fine, tf);
     return finish(out, p, data, spare, pec);
+}
+
+static PyObject *
+tm_pack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 11) {
+        PyErr_SetString(PyExc_TypeError, "tm_pack takes 11 arguments");
+        return NULL;
+    }
+    return tm_pack_values(args);
 }
 
 static PyObject *s_apid, *s_service, *s_subtype, *s_data, *s_seq_count, *s_ack, *s_source_id,
@@ -289,6 +316,124 @@ frame_ok(const unsigned char *b, Py_ssize_t n, Py_ssize_t min, unsigned id, long
     return 0;
 }
 
+/* Direct slot access. PusTc and PusTm keep their fields in __slots__; reading and writing
+ * them at their offsets skips the attribute protocol. A class qualifies only if every field
+ * name resolves to a plain writable object slot (a subclass that turns one into a property
+ * does not); the offsets are cached per class and type version, so changing the class
+ * invalidates them. */
+#define TC_FIELDS 9 /* apid seq_count seq_flags ack service subtype source_id data config */
+#define TM_FIELDS 11 /* apid seq_count seq_flags time_ref service subtype message_counter
+                        destination_id time data config */
+#define MAX_FIELDS 11
+
+typedef struct {
+    PyTypeObject *type;
+    unsigned int tag;
+    Py_ssize_t offset[MAX_FIELDS];
+} slot_cache;
+
+static PyObject **tc_names[TC_FIELDS] = {&s_apid,    &s_seq_count, &s_seq_flags,
+                                         &s_ack,     &s_service,   &s_subtype,
+                                         &s_source_id, &s_data,    &s_config};
+static PyObject **tm_names[TM_FIELDS] = {
+    &s_apid,    &s_seq_count,       &s_seq_flags,      &s_time_ref, &s_service, &s_subtype,
+    &s_message_counter, &s_destination_id, &s_time, &s_data,     &s_config};
+static slot_cache tc_slots, tm_slots;
+
+/* the slot offsets of type t for names, or NULL if t does not qualify (no error left set) */
+static const Py_ssize_t *
+slots_of(PyTypeObject *t, PyObject **names[], int count, slot_cache *cache)
+{
+    Py_ssize_t offset[MAX_FIELDS];
+
+    if (cache->type == t && cache->tag != 0 && cache->tag == t->tp_version_tag &&
+        PyType_HasFeature(t, Py_TPFLAGS_VALID_VERSION_TAG))
+        return cache->offset;
+    for (int i = 0; i < count; i++) {
+        PyObject *d = _PyType_Lookup(t, *names[i]); /* borrowed */
+        PyMemberDef *m;
+        if (d == NULL || Py_TYPE(d) != &PyMemberDescr_Type)
+            return NULL;
+        m = ((PyMemberDescrObject *)d)->d_member;
+        if (m->type != T_OBJECT_EX || (m->flags & READONLY))
+            return NULL;
+        offset[i] = m->offset;
+    }
+    if (!PyType_HasFeature(t, Py_TPFLAGS_VALID_VERSION_TAG) || t->tp_version_tag == 0)
+        return NULL; /* nothing to key a cache on: take the attribute path */
+    cache->type = t;
+    cache->tag = t->tp_version_tag;
+    memcpy(cache->offset, offset, sizeof(offset));
+    return cache->offset;
+}
+
+#define SLOT(obj, off) (*(PyObject **)((char *)(obj) + (off)))
+
+/* gather the values of the first count slots; -1 if one is unset or the class does not
+ * qualify */
+static int
+gather(PyObject *obj, PyObject **names[], int count, slot_cache *cache, PyObject **out)
+{
+    const Py_ssize_t *off = slots_of(Py_TYPE(obj), names, count + 1, cache);
+    if (off == NULL)
+        return -1;
+    for (int i = 0; i < count; i++)
+        if ((out[i] = SLOT(obj, off[i])) == NULL)
+            return -1;
+    return 0;
+}
+
+/* tc_pack_slots(tc, layout) -> tc.pack() for a whole-octet layout, or None */
+static PyObject *
+tc_pack_slots(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    PyObject *v[9];
+    (void)self;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "tc_pack_slots takes 2 arguments");
+        return NULL;
+    }
+    if (gather(args[0], tc_names, 8, &tc_slots, v))
+        Py_RETURN_NONE;
+    v[8] = args[1];
+    return tc_pack_values(v);
+}
+
+/* tm_pack_slots(tm, layout) -> tm.pack() for a whole-octet layout, or None */
+static PyObject *
+tm_pack_slots(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    PyObject *v[11];
+    (void)self;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "tm_pack_slots takes 2 arguments");
+        return NULL;
+    }
+    if (gather(args[0], tm_names, 10, &tm_slots, v))
+        Py_RETURN_NONE;
+    v[10] = args[1];
+    return tm_pack_values(v);
+}
+
+/* fill the slots of a blank object with new references from values (stolen, all non-NULL);
+ * on a NULL value releases the rest and returns -1 */
+static int
+fill(PyObject *obj, const Py_ssize_t *off, PyObject **values, int count)
+{
+    int bad = 0;
+    for (int i = 0; i < count; i++)
+        if (values[i] == NULL)
+            bad = 1;
+    if (bad) {
+        for (int i = 0; i < count; i++)
+            Py_XDECREF(values[i]);
+        return -1;
+    }
+    for (int i = 0; i < count; i++)
+        SLOT(obj, off[i]) = values[i];
+    return 0;
+}
+
 /* tc_unpack(cls, buf, layout, config) -> a cls instance for a well-formed TC, or None */
 static PyObject *
 tc_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
@@ -300,6 +445,7 @@ tc_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     Py_ssize_t n, off;
     unsigned pid, psc;
     PyObject *obj = NULL, *cls;
+    const Py_ssize_t *slot;
 
     (void)self;
     if (nargs != 4) {
@@ -325,7 +471,23 @@ tc_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     pid = (unsigned)get(b, 2);
     psc = (unsigned)get(b + 2, 2);
     obj = blank(cls);
-    if (obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
+    slot = obj == NULL ? NULL : slots_of(Py_TYPE(obj), tc_names, TC_FIELDS, &tc_slots);
+    if (slot != NULL) {
+        PyObject *v[TC_FIELDS] = {
+            PyLong_FromLong(pid & 0x7FF),
+            PyLong_FromLong(psc & 0x3FFF),
+            PyLong_FromLong(psc >> 14),
+            PyLong_FromLong(b[6] & 15),
+            PyLong_FromLong(b[7]),
+            PyLong_FromLong(b[8]),
+            PyLong_FromUnsignedLongLong(get(b + 9, sid)),
+            PyBytes_FromStringAndSize((const char *)b + off, n - off - 2 * pec),
+            Py_NewRef(args[3]),
+        };
+        if (fill(obj, slot, v, TC_FIELDS))
+            Py_CLEAR(obj);
+    }
+    else if (obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
         set_new(obj, s_service, PyLong_FromLong(b[7])) ||
         set_new(obj, s_subtype, PyLong_FromLong(b[8])) ||
         set_new(obj, s_data,
@@ -353,6 +515,7 @@ tm_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     unsigned pid, psc;
     const unsigned char *q;
     PyObject *obj = NULL, *cls, *t;
+    const Py_ssize_t *slot;
 
     (void)self;
     if (nargs != 4) {
@@ -384,7 +547,25 @@ tm_unpack(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     q = b + 9 + cnt + dst;
     t = Py_BuildValue("(KK)", get(q, tc), get(q + tc, tf));
     obj = blank(cls);
-    if (t == NULL || obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
+    slot = obj == NULL ? NULL : slots_of(Py_TYPE(obj), tm_names, TM_FIELDS, &tm_slots);
+    if (t != NULL && slot != NULL) {
+        PyObject *v[TM_FIELDS] = {
+            PyLong_FromLong(pid & 0x7FF),
+            PyLong_FromLong(psc & 0x3FFF),
+            PyLong_FromLong(psc >> 14),
+            PyLong_FromLong(b[6] & 15),
+            PyLong_FromLong(b[7]),
+            PyLong_FromLong(b[8]),
+            PyLong_FromUnsignedLongLong(get(b + 9, cnt)),
+            PyLong_FromUnsignedLongLong(get(b + 9 + cnt, dst)),
+            Py_NewRef(t),
+            PyBytes_FromStringAndSize((const char *)b + off, n - off - 2 * pec),
+            Py_NewRef(args[3]),
+        };
+        if (fill(obj, slot, v, TM_FIELDS))
+            Py_CLEAR(obj);
+    }
+    else if (t == NULL || obj == NULL || set_new(obj, s_apid, PyLong_FromLong(pid & 0x7FF)) ||
         set_new(obj, s_service, PyLong_FromLong(b[7])) ||
         set_new(obj, s_subtype, PyLong_FromLong(b[8])) ||
         set_new(obj, s_data,
@@ -419,13 +600,447 @@ crc16_ccitt(PyObject *self, PyObject *args)
     return PyLong_FromUnsignedLong(c);
 }
 
+
+/* ------------------------------------------------------------------------------------------
+ * CBOR for the interaction layer's wire: the deterministic encoding of obsw.cbor (and
+ * cbor2.dumps(canonical=True)) for exact int, bool, None, float, str, bytes, bytearray, list,
+ * tuple and dict, and a decoder for the same subset with definite lengths. Anything else
+ * (tags, bignums, memoryviews, subclasses, simple values, indefinite lengths, malformed or
+ * too deep input) is declined, and the caller takes the Python path, which decides and raises.
+ */
+#define CBOR_MAX_DEPTH 16 /* deeper values go the Python way, which knows the limits */
+
+typedef struct {
+    unsigned char *buf;
+    Py_ssize_t len, cap;
+} cbuf;
+
+static int
+cb_reserve(cbuf *b, Py_ssize_t more)
+{
+    if (b->len + more <= b->cap)
+        return 0;
+    Py_ssize_t cap = b->cap ? b->cap : 64;
+    while (cap < b->len + more)
+        cap *= 2;
+    unsigned char *n = PyMem_Realloc(b->buf, (size_t)cap);
+    if (n == NULL)
+        return -1;
+    b->buf = n;
+    b->cap = cap;
+    return 0;
+}
+
+static int
+cb_put(cbuf *b, const void *p, Py_ssize_t n)
+{
+    if (cb_reserve(b, n))
+        return -1;
+    memcpy(b->buf + b->len, p, (size_t)n);
+    b->len += n;
+    return 0;
+}
+
+static int
+cb_head(cbuf *b, unsigned major, unsigned long long n)
+{
+    unsigned char h[9];
+    int k;
+    if (n < 24) {
+        h[0] = (unsigned char)(major | n);
+        k = 1;
+    }
+    else if (n < 0x100) {
+        h[0] = (unsigned char)(major | 24);
+        k = 2;
+    }
+    else if (n < 0x10000) {
+        h[0] = (unsigned char)(major | 25);
+        k = 3;
+    }
+    else if (n < 0x100000000ULL) {
+        h[0] = (unsigned char)(major | 26);
+        k = 5;
+    }
+    else {
+        h[0] = (unsigned char)(major | 27);
+        k = 9;
+    }
+    put(h + 1, n, k - 1);
+    return cb_put(b, h, k);
+}
+
+/* 1 encoded, 0 declined, -1 error (set) */
+static int cb_encode(cbuf *b, PyObject *v, int depth);
+
+static int
+cb_float(cbuf *b, double x)
+{
+    unsigned char h[9];
+    if (x != x)
+        return cb_put(b, "\xf9\x7e\x00", 3);
+    if (PyFloat_Pack2(x, (char *)h + 1, 0) == 0) {
+        if (PyFloat_Unpack2((const char *)h + 1, 0) == x) {
+            h[0] = 0xF9;
+            return cb_put(b, h, 3);
+        }
+    }
+    else
+        PyErr_Clear();
+    if (PyFloat_Pack4(x, (char *)h + 1, 0) == 0) {
+        if (PyFloat_Unpack4((const char *)h + 1, 0) == x) {
+            h[0] = 0xFA;
+            return cb_put(b, h, 5);
+        }
+    }
+    else
+        PyErr_Clear();
+    h[0] = 0xFB;
+    if (PyFloat_Pack8(x, (char *)h + 1, 0))
+        return -1;
+    return cb_put(b, h, 9);
+}
+
+typedef struct {
+    Py_ssize_t off, len; /* the encoded key within the key buffer */
+    PyObject *value;
+} cb_pair;
+
+static const unsigned char *cb_sort_base;
+
+static int
+cb_pair_cmp(const void *x, const void *y)
+{
+    const cb_pair *a = x, *c = y;
+    if (a->len != c->len)
+        return a->len < c->len ? -1 : 1;
+    return memcmp(cb_sort_base + a->off, cb_sort_base + c->off, (size_t)a->len);
+}
+
+static int
+cb_dict(cbuf *b, PyObject *d, int depth)
+{
+    Py_ssize_t n = PyDict_GET_SIZE(d), pos = 0, i = 0;
+    PyObject *k, *v;
+    cbuf keys = {NULL, 0, 0};
+    cb_pair *pairs;
+    int rc = 1;
+
+    if (cb_head(b, 0xA0, (unsigned long long)n))
+        return -1;
+    if (n == 0)
+        return 1;
+    pairs = PyMem_Malloc(sizeof(cb_pair) * (size_t)n);
+    if (pairs == NULL) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    while (PyDict_Next(d, &pos, &k, &v)) {
+        Py_ssize_t start = keys.len;
+        if (i >= n) { /* changed size while encoding: let Python decide */
+            rc = 0;
+            break;
+        }
+        rc = cb_encode(&keys, k, depth - 1);
+        if (rc != 1)
+            break;
+        pairs[i].off = start;
+        pairs[i].len = keys.len - start;
+        pairs[i].value = v;
+        i++;
+    }
+    if (rc == 1 && i != n)
+        rc = 0;
+    if (rc == 1) {
+        cb_sort_base = keys.buf; /* callers hold the GIL: one sort at a time */
+        qsort(pairs, (size_t)n, sizeof(cb_pair), cb_pair_cmp);
+        for (i = 0; i < n && rc == 1; i++) {
+            if (cb_put(b, keys.buf + pairs[i].off, pairs[i].len))
+                rc = -1;
+            else
+                rc = cb_encode(b, pairs[i].value, depth - 1);
+        }
+    }
+    PyMem_Free(pairs);
+    PyMem_Free(keys.buf);
+    return rc;
+}
+
+static int
+cb_encode(cbuf *b, PyObject *v, int depth)
+{
+    PyTypeObject *t = Py_TYPE(v);
+    if (t == &PyLong_Type) {
+        int overflow;
+        long long x = PyLong_AsLongLongAndOverflow(v, &overflow);
+        if (overflow == 0) {
+            if (x == -1 && PyErr_Occurred())
+                return -1;
+            if (x >= 0)
+                return cb_head(b, 0x00, (unsigned long long)x) ? -1 : 1;
+            return cb_head(b, 0x20, (unsigned long long)(-1 - x)) ? -1 : 1;
+        }
+        if (overflow > 0) {
+            unsigned long long u = PyLong_AsUnsignedLongLong(v);
+            if (u == (unsigned long long)-1 && PyErr_Occurred()) {
+                PyErr_Clear();
+                return 0; /* a bignum */
+            }
+            return cb_head(b, 0x00, u) ? -1 : 1;
+        }
+        return 0; /* below -2**63: bignum or not, Python decides */
+    }
+    if (t == &PyUnicode_Type) {
+        Py_ssize_t n;
+        const char *s = PyUnicode_AsUTF8AndSize(v, &n);
+        if (s == NULL) {
+            PyErr_Clear();
+            return 0;
+        }
+        return (cb_head(b, 0x60, (unsigned long long)n) || cb_put(b, s, n)) ? -1 : 1;
+    }
+    if (t == &PyBytes_Type) {
+        Py_ssize_t n = PyBytes_GET_SIZE(v);
+        return (cb_head(b, 0x40, (unsigned long long)n) || cb_put(b, PyBytes_AS_STRING(v), n))
+                   ? -1
+                   : 1;
+    }
+    if (t == &PyByteArray_Type) {
+        Py_ssize_t n = PyByteArray_GET_SIZE(v);
+        return (cb_head(b, 0x40, (unsigned long long)n) ||
+                cb_put(b, PyByteArray_AS_STRING(v), n))
+                   ? -1
+                   : 1;
+    }
+    if (t == &PyList_Type || t == &PyTuple_Type) {
+        Py_ssize_t n = t == &PyList_Type ? PyList_GET_SIZE(v) : PyTuple_GET_SIZE(v);
+        if (depth <= 0)
+            return 0;
+        if (cb_head(b, 0x80, (unsigned long long)n))
+            return -1;
+        for (Py_ssize_t i = 0; i < n; i++) {
+            PyObject *x;
+            int rc;
+            if (t == &PyList_Type) {
+                if (i >= PyList_GET_SIZE(v))
+                    return 0; /* shrank while encoding */
+                x = PyList_GET_ITEM(v, i);
+            }
+            else
+                x = PyTuple_GET_ITEM(v, i);
+            Py_INCREF(x);
+            rc = cb_encode(b, x, depth - 1);
+            Py_DECREF(x);
+            if (rc != 1)
+                return rc;
+        }
+        if (t == &PyList_Type && PyList_GET_SIZE(v) != n)
+            return 0;
+        return 1;
+    }
+    if (t == &PyDict_Type)
+        return depth <= 0 ? 0 : cb_dict(b, v, depth);
+    if (v == Py_True || v == Py_False)
+        return cb_put(b, v == Py_True ? "\xf5" : "\xf4", 1) ? -1 : 1;
+    if (v == Py_None)
+        return cb_put(b, "\xf6", 1) ? -1 : 1;
+    if (t == &PyFloat_Type)
+        return cb_float(b, PyFloat_AS_DOUBLE(v)) ? -1 : 1;
+    return 0;
+}
+
+/* cbor_frame(value) -> 4-byte big-endian length + deterministic CBOR of value, or None */
+static PyObject *
+cbor_frame(PyObject *self, PyObject *v)
+{
+    cbuf b = {NULL, 0, 0};
+    PyObject *out = NULL;
+    int rc;
+    (void)self;
+    if (cb_reserve(&b, 64)) {
+        PyErr_NoMemory();
+        return NULL;
+    }
+    b.len = 4;
+    rc = cb_encode(&b, v, CBOR_MAX_DEPTH);
+    if (rc == 1 && b.len - 4 <= 0xFFFFFFFFLL) {
+        put(b.buf, (unsigned long long)(b.len - 4), 4);
+        out = PyBytes_FromStringAndSize((const char *)b.buf, b.len);
+    }
+    else if (rc >= 0) {
+        out = Py_NewRef(Py_None);
+    }
+    PyMem_Free(b.buf);
+    return out;
+}
+
+/* the decoder: 1 with *out set, 0 declined, -1 error (set) */
+static int
+cd_item(const unsigned char *p, Py_ssize_t n, Py_ssize_t *pos, int depth, PyObject **out)
+{
+    unsigned ib, major, ai;
+    unsigned long long arg;
+    Py_ssize_t i = *pos;
+
+    if (i >= n)
+        return 0;
+    ib = p[i++];
+    major = ib & 0xE0;
+    ai = ib & 0x1F;
+    if (ai < 24)
+        arg = ai;
+    else if (ai < 28) {
+        int k = 1 << (ai - 24);
+        if (n - i < k)
+            return 0;
+        arg = get(p + i, k);
+        i += k;
+    }
+    else
+        return 0; /* indefinite lengths and reserved values: Python */
+    switch (major) {
+    case 0x00:
+        *out = PyLong_FromUnsignedLongLong(arg);
+        break;
+    case 0x20:
+        if (arg > (unsigned long long)LLONG_MAX)
+            return 0;
+        *out = PyLong_FromLongLong(-1 - (long long)arg);
+        break;
+    case 0x40:
+    case 0x60:
+        if (arg > (unsigned long long)(n - i))
+            return 0;
+        if (major == 0x40)
+            *out = PyBytes_FromStringAndSize((const char *)p + i, (Py_ssize_t)arg);
+        else {
+            *out = PyUnicode_DecodeUTF8((const char *)p + i, (Py_ssize_t)arg, NULL);
+            if (*out == NULL) {
+                PyErr_Clear();
+                return 0;
+            }
+        }
+        i += (Py_ssize_t)arg;
+        break;
+    case 0x80: {
+        PyObject *list;
+        if (depth <= 0 || arg > (unsigned long long)(n - i))
+            return 0;
+        list = PyList_New((Py_ssize_t)arg);
+        if (list == NULL)
+            return -1;
+        for (Py_ssize_t k = 0; k < (Py_ssize_t)arg; k++) {
+            PyObject *x;
+            int rc = cd_item(p, n, &i, depth - 1, &x);
+            if (rc != 1) {
+                Py_DECREF(list);
+                return rc;
+            }
+            PyList_SET_ITEM(list, k, x);
+        }
+        *out = list;
+        break;
+    }
+    case 0xA0: {
+        PyObject *d;
+        if (depth <= 0 || arg > (unsigned long long)(n - i) / 2)
+            return 0;
+        d = PyDict_New();
+        if (d == NULL)
+            return -1;
+        for (unsigned long long k = 0; k < arg; k++) {
+            PyObject *key, *val;
+            int rc;
+            if (i < n && ((p[i] & 0xE0) == 0x80 || (p[i] & 0xE0) == 0xA0)) {
+                Py_DECREF(d); /* array or map keys become tuples in Python: let it */
+                return 0;
+            }
+            rc = cd_item(p, n, &i, depth - 1, &key);
+            if (rc != 1) {
+                Py_DECREF(d);
+                return rc;
+            }
+            rc = cd_item(p, n, &i, depth - 1, &val);
+            if (rc != 1) {
+                Py_DECREF(key);
+                Py_DECREF(d);
+                return rc;
+            }
+            rc = PyDict_SetItem(d, key, val);
+            Py_DECREF(key);
+            Py_DECREF(val);
+            if (rc) {
+                Py_DECREF(d);
+                return -1;
+            }
+        }
+        *out = d;
+        break;
+    }
+    case 0xE0:
+        if (ai == 20)
+            *out = Py_NewRef(Py_False);
+        else if (ai == 21)
+            *out = Py_NewRef(Py_True);
+        else if (ai == 22)
+            *out = Py_NewRef(Py_None);
+        else if (ai == 25 || ai == 26 || ai == 27) {
+            double x = ai == 25   ? PyFloat_Unpack2((const char *)p + i - 2, 0)
+                       : ai == 26 ? PyFloat_Unpack4((const char *)p + i - 4, 0)
+                                  : PyFloat_Unpack8((const char *)p + i - 8, 0);
+            if (x == -1.0 && PyErr_Occurred())
+                return -1;
+            *out = PyFloat_FromDouble(x);
+        }
+        else
+            return 0; /* undefined and the other simple values: Python */
+        break;
+    default:
+        return 0; /* tags */
+    }
+    if (*out == NULL)
+        return -1;
+    *pos = i;
+    return 1;
+}
+
+/* cbor_loads(data, declined) -> the value of the one CBOR item data holds, or declined */
+static PyObject *
+cbor_loads(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    Py_buffer view;
+    Py_ssize_t pos = 0;
+    PyObject *v = NULL;
+    int rc;
+    (void)self;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "cbor_loads takes 2 arguments");
+        return NULL;
+    }
+    if (octets_of(args[0], &view))
+        return Py_NewRef(args[1]);
+    rc = cd_item((const unsigned char *)view.buf, view.len, &pos, CBOR_MAX_DEPTH, &v);
+    PyBuffer_Release(&view);
+    if (rc < 0)
+        return NULL;
+    if (rc == 0 || pos != view.len) {
+        Py_XDECREF(v);
+        return Py_NewRef(args[1]);
+    }
+    return v;
+}
+
 #define FASTCALL(f) (PyCFunction)(void (*)(void))(f), METH_FASTCALL
 
 static PyMethodDef methods[] = {
     {"tc_pack", FASTCALL(tc_pack), "Pack a TC of a whole-octet layout, or None."},
     {"tm_pack", FASTCALL(tm_pack), "Pack a TM of a whole-octet layout, or None."},
+    {"tc_pack_slots", FASTCALL(tc_pack_slots), "tc.pack() for a whole-octet layout, or None."},
+    {"tm_pack_slots", FASTCALL(tm_pack_slots), "tm.pack() for a whole-octet layout, or None."},
     {"tc_unpack", FASTCALL(tc_unpack), "Decode a well-formed TC into cls, or None."},
     {"tm_unpack", FASTCALL(tm_unpack), "Decode a well-formed TM into cls, or None."},
+    {"cbor_frame", cbor_frame, METH_O, "Length-prefixed deterministic CBOR, or None."},
+    {"cbor_loads", FASTCALL(cbor_loads), "Decode one CBOR item, or return the second arg."},
     {"crc16_ccitt", crc16_ccitt, METH_VARARGS, "CRC-16/CCITT-FALSE continuing a register."},
     {NULL, NULL, 0, NULL},
 };

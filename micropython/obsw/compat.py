@@ -124,6 +124,13 @@ def crc_accelerator(width, poly, init, reflect, xorout):
         import binascii  # CPython's crc_hqx is this CRC family, C-fast and always present
 
         return binascii.crc_hqx
+    if (width, poly, init, reflect, xorout) == (32, 0x04C11DB7, 0xFFFFFFFF, True, 0xFFFFFFFF):
+        try:
+            import zlib  # CRC-32 (IEEE, the CFDP file checksum 3): several times crcmod's
+        except ImportError:
+            pass
+        else:
+            return zlib.crc32
     try:
         import crcmod
     except ImportError:
@@ -132,14 +139,15 @@ def crc_accelerator(width, poly, init, reflect, xorout):
     return crcmod.mkCrcFun((1 << width) | poly, initCrc=init ^ xorout, rev=reflect, xorOut=xorout)
 
 
-_PUS_API = const(1)  # the obsw_speedups interface this core speaks
+_PUS_API = const(2)  # the obsw_speedups interface this core speaks
 
 
-def pus_accelerator():
-    """The C packet codec ``obsw_speedups`` (built with the host package on CPython) or None.
+def speedups():
+    """The C hot paths ``obsw_speedups`` (built with the host package on CPython) or None:
+    the PUS packet codec and the interaction layer's CBOR framing.
 
-    It only ever takes the inputs it can handle without doubt and returns None for the rest,
-    so the pure-Python codec stays the definition and raises the errors.
+    It only ever takes the inputs it can handle without doubt and declines the rest, so the
+    Python code stays the definition and raises the errors.
     """
     if pure():
         return None
@@ -150,3 +158,6 @@ def pus_accelerator():
     if getattr(obsw_speedups, "API", None) != _PUS_API:
         return None  # a stale build from other sources
     return obsw_speedups
+
+
+pus_accelerator = speedups  # the PUS codec's name for it

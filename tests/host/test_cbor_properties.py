@@ -164,3 +164,57 @@ def test_deep_random_structures():
         for _ in range(rnd.randint(1, 30)):
             v = [v] if rnd.random() < 0.5 else {rnd.randint(0, 9): v}
         assert same(cbor.loads(cbor.dumps(v)), v)
+
+
+# the C framing and decoding of obsw_speedups against cbor2 and the core codec
+C = wire._C
+needs_c = pytest.mark.skipif(C is None, reason="obsw_speedups not built, OBSW_PURE or core codec")
+DECLINED = object()
+
+
+@needs_c
+@SETTINGS
+@given(values)
+def test_c_frame_is_cbor2_canonical_or_declines(v):
+    data = C.cbor_frame(v)
+    body = cbor2.dumps(v, canonical=True)
+    assert data is None or data == len(body).to_bytes(4, "big") + body
+    assert wire.frame(v) == len(body).to_bytes(4, "big") + body
+    assert body == cbor.dumps(v)
+
+
+@needs_c
+@SETTINGS
+@given(values, st.booleans())
+def test_c_decodes_like_cbor2_or_declines(v, canonical):
+    body = cbor2.dumps(v, canonical=canonical)
+    got = C.cbor_loads(body, DECLINED)
+    assert got is DECLINED or same(got, cbor2.loads(body))
+    assert same(wire.loads(body), cbor2.loads(body))
+
+
+@needs_c
+@SETTINGS
+@given(st.binary(max_size=64))
+def test_c_decoder_on_random_bytes_agrees_or_declines(data):
+    got = C.cbor_loads(data, DECLINED)
+    if got is not DECLINED:
+        assert same(got, cbor2.loads(data))
+
+
+@needs_c
+def test_c_path_declines_what_only_python_knows():
+    for v in (2**64, -(2**64) - 1, Tag(5, 1), UNDEFINED, Simple(99), memoryview(b"ab")):
+        assert C.cbor_frame(v) is None, v
+    deep = []
+    for _ in range(20):
+        deep = [deep]
+    assert C.cbor_frame(deep) is None  # deeper than the C path goes: Python decides
+    assert wire.frame(deep)[4:] == cbor.dumps(deep)
+    assert C.cbor_loads(cbor.dumps(Tag(99, 1)), DECLINED) is DECLINED
+    assert C.cbor_loads(b"\x9f\xff", DECLINED) is DECLINED  # indefinite length
+    assert C.cbor_loads(b"\x62\xff\xfe", DECLINED) is DECLINED  # not UTF-8
+    assert C.cbor_loads(b"\xa1\x81\x01\x02", DECLINED) is DECLINED  # array as a map key
+    assert C.cbor_loads(b"\x01\x02", DECLINED) is DECLINED  # trailing data
+    with pytest.raises(cbor.CborDecodeError):
+        wire.loads(b"\x62\xff\xfe")

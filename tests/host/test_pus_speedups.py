@@ -369,6 +369,42 @@ def test_unpack_keeps_config_and_subclass():
 
 
 @needs_c
+def test_pack_reads_slots_only_of_classes_it_can_vouch_for():
+    fast, slow = twins()
+
+    class Plain(PusTc):
+        __slots__ = ("extra",)
+
+    class Computed(PusTc):
+        # a field turned into a property: the slot is not where the value lives any more
+        @property
+        def apid(self):
+            return 0x42
+
+        @apid.setter
+        def apid(self, value):
+            pass
+
+    raw = PusTc(0x42, 17, 1, b"ab", 3).pack()
+    assert C.tc_pack_slots(Plain(0x42, 17, 1, b"ab", 3), fast.tc_fast) == raw
+    assert C.tc_pack_slots(Computed(7, 17, 1, b"ab", 3), fast.tc_fast) is None
+    assert Computed(7, 17, 1, b"ab", 3, config=fast).pack() == raw
+    tc = Computed.unpack(raw, fast)
+    assert type(tc) is Computed and tc.apid == 0x42 and tc.data == b"ab"
+    unset = PusTc.__new__(PusTc)
+    assert C.tc_pack_slots(unset, fast.tc_fast) is None
+    with pytest.raises(AttributeError):
+        unset.pack()
+    tm = PusTm(5, 3, 25, b"xyz", 9, 4, 0, (1, 2), config=fast)
+    assert (
+        C.tm_pack_slots(tm, fast.tm_fast)
+        == PusTm(5, 3, 25, b"xyz", 9, 4, 0, (1, 2), config=slow).pack()
+    )
+    PusTc.apid = PusTc.apid  # any change to the class invalidates the cached offsets
+    assert C.tc_pack_slots(Plain(0x42, 17, 1, b"ab", 3), fast.tc_fast) == raw
+
+
+@needs_c
 def test_odd_buffers_go_the_python_way():
     fast, slow = twins()
     raw = PusTc(1, 17, 1).pack()

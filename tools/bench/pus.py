@@ -214,23 +214,33 @@ IMPLS = (
 )
 
 
-def measure(run, seconds, repeats):
-    """Median round trips per second over ``repeats`` timed batches of about ``seconds``."""
+def batch_size(run, seconds):
+    """Round trips that take roughly ``seconds``."""
     n = 100
-    while True:  # size a batch to take roughly ``seconds``
+    while True:
         t0 = time.perf_counter()
         run(n)
         dt = time.perf_counter() - t0
         if dt >= seconds / 4 or n >= 1 << 22:
             break
         n *= 4
-    n = max(1, int(n * seconds / dt))
-    rates = []
+    return max(1, int(n * seconds / dt))
+
+
+def measure(runs, seconds, repeats):
+    """Median round trips per second of each run, the timed batches interleaved.
+
+    On a shared machine the load drifts; timing one batch of every implementation per repeat
+    gives each the same conditions, so the ratios stay honest even when the absolute figures
+    move."""
+    sizes = [batch_size(run, seconds) for run in runs]
+    rates = [[] for _ in runs]
     for _ in range(repeats):
-        t0 = time.perf_counter()
-        run(n)
-        rates.append(n / (time.perf_counter() - t0))
-    return statistics.median(rates)
+        for run, n, out in zip(runs, sizes, rates):
+            t0 = time.perf_counter()
+            run(n)
+            out.append(n / (time.perf_counter() - t0))
+    return [statistics.median(r) for r in rates]
 
 
 def main(argv=None):
@@ -241,12 +251,14 @@ def main(argv=None):
     seconds, repeats = (0.1, 3) if args.quick else (0.5, 7)
     rows = []
     for case, kind, service, subtype, data in CASES:
+        impls, runs = [], []
         for impl, make_tc, make_tm in IMPLS:
             try:
-                run = (make_tc if kind == "tc" else make_tm)(service, subtype, data)
+                runs.append((make_tc if kind == "tc" else make_tm)(service, subtype, data))
             except ImportError:
                 continue  # peer not installed
-            value = measure(run, seconds, repeats)
+            impls.append(impl)
+        for impl, value in zip(impls, measure(runs, seconds, repeats)):
             rows.append(
                 {
                     "case": case,

@@ -9,7 +9,11 @@ interaction layer sends; CBOR ``undefined`` decodes to ``cbor2.undefined`` and t
 array of ints, so values that cross processes carry ``bytes``, never memoryviews (the core
 encoder takes both; asking cbor2 to special-case it would double its encoding time).
 
-A frame is a 4-byte big-endian length followed by one CBOR item.
+A frame is a 4-byte big-endian length followed by one CBOR item. With the cbor2 codec, the
+C hot path of ``obsw_speedups`` frames and decodes the plain values that make up nearly every
+message (ints, floats, strings, bytes, lists, dicts, None, bools) and declines the rest, which
+cbor2 then handles; tests/host/test_cbor_properties.py proves both give the same bytes and
+values. ``OBSW_PURE=1`` turns it off.
 """
 
 import os
@@ -17,6 +21,7 @@ import struct
 
 from obsw import cbor as core
 from obsw.cbor import CborDecodeError, CborEncodeError
+from obsw.compat import speedups
 
 MAX_FRAME = 64 * 1024 * 1024
 _LEN = struct.Struct(">I")
@@ -65,9 +70,22 @@ def codec_name():
 
 
 CODEC = "cbor2" if cbor2 is not None and os.environ.get("OBSW_IL_CODEC") != "core" else "core"
+_C = speedups() if CODEC == "cbor2" else None
+_c_frame = _C.cbor_frame if _C is not None else None
+_c_loads = _C.cbor_loads if _C is not None else None
+_DECLINED = object()
+
+
+def _fast_loads(data):
+    v = _c_loads(data, _DECLINED)
+    if v is _DECLINED:
+        return _cbor2_loads(data)
+    return v
+
+
 if CODEC == "cbor2":
     dumps = _cbor2_dumps
-    loads = _cbor2_loads
+    loads = _fast_loads if _C is not None else _cbor2_loads
 else:
     dumps = core.dumps
     loads = core.loads
@@ -83,6 +101,10 @@ class FrameError(ValueError):
 
 def frame(msg):
     """One length-prefixed CBOR frame for ``msg``."""
+    if _c_frame is not None:
+        data = _c_frame(msg)
+        if data is not None:
+            return data
     body = dumps(msg)
     return _LEN.pack(len(body)) + body
 

@@ -21,7 +21,7 @@ _TC_ID = const(0x1800)  # version 0, type 1 (TC), secondary header flag 1
 _new = object.__new__
 _LAX = not STRUCT_CHECKS_RANGES  # check every field in Python, struct will not
 _C = pus_accelerator()  # the C codec; config.tc_fast is 0 whenever this is None
-_c_pack = _C.tc_pack if _C is not None else None
+_c_pack = _C.tc_pack_slots if _C is not None else None
 _c_unpack = _C.tc_unpack if _C is not None else None
 
 
@@ -83,17 +83,7 @@ class PusTc:
         f = c.tc_fast
         if f:
             # the C codec packs what it can vouch for and returns None for anything odd
-            raw = _c_pack(
-                self.apid,
-                self.seq_count,
-                self.seq_flags,
-                self.ack,
-                self.service,
-                self.subtype,
-                self.source_id,
-                self.data,
-                f,
-            )
+            raw = _c_pack(self, f)  # reads the fields straight from the slots
             if raw is not None:
                 return raw
         data = self.data

@@ -22,7 +22,7 @@ _NO_TIME = (0, 0)  # what time=None packs as in the struct layouts
 _new = object.__new__
 _LAX = not STRUCT_CHECKS_RANGES  # check every field in Python, struct will not
 _C = pus_accelerator()  # the C codec; config.tm_fast is 0 whenever this is None
-_c_pack = _C.tm_pack if _C is not None else None
+_c_pack = _C.tm_pack_slots if _C is not None else None
 _c_unpack = _C.tm_unpack if _C is not None else None
 
 
@@ -104,19 +104,7 @@ class PusTm:
         f = c.tm_fast
         if f:
             # the C codec packs what it can vouch for and returns None for anything odd
-            raw = _c_pack(
-                self.apid,
-                self.seq_count,
-                self.seq_flags,
-                self.time_ref,
-                self.service,
-                self.subtype,
-                self.message_counter,
-                self.destination_id,
-                self.time,
-                self.data,
-                f,
-            )
+            raw = _c_pack(self, f)  # reads the fields straight from the slots
             if raw is not None:
                 return raw
         data = self.data

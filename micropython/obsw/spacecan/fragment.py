@@ -126,6 +126,8 @@ class Reassembler:
 
     def expire(self, now):
         """Drop partial packets silent for longer than the timeout; return how many."""
+        if not self._partial:
+            return 0  # the usual case, and one that allocates nothing
         stale = [k for k, p in self._partial.items() if now - p[3] > self.timeout]
         for k in stale:
             del self._partial[k]

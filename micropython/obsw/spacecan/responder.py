@@ -5,6 +5,7 @@ Sans-I/O, the same interface as the controller: `receive(bus, can_id, data, now)
 replies go out on the bus the request came in on, periodic reports on the active bus.
 """
 
+from obsw.compat import const
 from obsw.spacecan import encoding as enc
 from obsw.spacecan import events as ev
 from obsw.spacecan import packets as pk
@@ -22,6 +23,9 @@ from obsw.spacecan.ids import (
 )
 from obsw.spacecan.redundancy import BusHealth, HeartbeatMonitor
 from obsw.spacecan.timeframes import FrameLengthError, ScetTime, UtcTime
+
+_CANNED_MAX = const(64)  # verification report frames kept ready
+_PING_REPORT_FRAME = split(bytes((pk.SERVICE_TEST, pk.PING_REPORT)))[0]
 
 _MIN_HK_INTERVAL = 0.01
 
@@ -78,6 +82,7 @@ class Responder:
         self._req_id = ID_REQ + node_id
         self._rep_id = ID_REP + node_id
         self._frames = []
+        self._canned = {}  # verification report frames by subtype, service, subtype
         self._events = []
         self._hk_due = {}  # report id -> next due time (None: set at the next poll)
         self._started = False
@@ -124,13 +129,18 @@ class Responder:
         return max(self.nodedef.reports[rid].interval, _MIN_HK_INTERVAL)
 
     def take_frames(self):
+        """The frames to send, as a list that is the caller's; with nothing to send, a shared
+        empty list (handed out instead of a new one in every poll: garbage costs a board)."""
         out = self._frames
-        self._frames = []
+        if out:
+            self._frames = []
         return out
 
     def take_events(self):
+        """The events since the last call; like ``take_frames``, an empty result is shared."""
         out = self._events
-        self._events = []
+        if out:
+            self._events = []
         return out
 
     def _emit(self, kind, now, **fields):
@@ -279,7 +289,15 @@ class Responder:
             self._tx(bus, frame)
 
     def _verify(self, bus, subtype, service, req_subtype):
-        self._reply(bus, pk.SERVICE_VERIFICATION, subtype, bytes((service, req_subtype)))
+        # verification reports depend on three small numbers only: each is made once, then sent
+        # from the table, so answering a request allocates next to nothing
+        key = (subtype << 16) | (service << 8) | req_subtype
+        frame = self._canned.get(key)
+        if frame is None:
+            frame = split(bytes((pk.SERVICE_VERIFICATION, subtype, service, req_subtype)))[0]
+            if len(self._canned) < _CANNED_MAX:
+                self._canned[key] = frame
+        self._tx(bus, frame)
 
     def _serve(self, packet, bus, now):
         self.counters["requests"] += 1
@@ -307,7 +325,7 @@ class Responder:
 
     def _ping(self, bus, service, subtype, data, now):
         self._verify(bus, pk.ACCEPT_OK, service, subtype)
-        self._reply(bus, pk.SERVICE_TEST, pk.PING_REPORT)
+        self._tx(bus, _PING_REPORT_FRAME)
         self._verify(bus, pk.COMPLETE_OK, service, subtype)
 
     def _param_request(self, bus, service, subtype, data, now):

@@ -2,9 +2,9 @@
 
 Everything the Yamcs side reads from the database goes through ``load(path)``, which returns
 plain records (``Spacecraft``, ``Param``, ``Event``, ``Function``, ``Structure``). The
-database file is parsed and checked by the project's own loader; the optional entries the
-loader keeps no object for (units, limits, calibrations, ranges of writable parameters) are
-read from the same JSON document, on each attribute or parameter:
+database file is parsed and checked by the project's own loader, which also keeps the optional
+entries for mission control (units, limits, calibrations, ranges of writable parameters), on
+each attribute or parameter:
 
     {"name": "speed", "parameter": 2, "type": "float32", "unit": "deg/s", "writable": true,
      "range": [0, 10],
@@ -14,8 +14,6 @@ read from the same JSON document, on each attribute or parameter:
 ``calibration`` is a polynomial (coefficients from the constant term up) or a spline
 (``{"spline": [[raw, eng], ...]}``) from the raw value to the engineering value.
 """
-
-import json
 
 from obsw.pus import sdb as sdb_module
 
@@ -89,36 +87,26 @@ def _pair(type_spec):
     return tuple(type_spec)
 
 
-def _extras(doc):
-    """qualified parameter name -> its raw JSON entry (for the keys the loader ignores)."""
-    out = {}
-    for comp in doc.get("components", []):
-        for a in comp.get("attributes", []):
-            out["%s.%s" % (comp["name"], a["name"])] = a
-    for p in doc.get("parameters", []):
-        out[p["name"]] = p
-    return out
-
-
 def loads(text):
     """The Spacecraft of a database given as JSON text (SdbError when it is malformed)."""
     db = sdb_module.loads(text)
-    doc = json.loads(text)
-    extras = _extras(doc)
     params = {}
     for pid, p in db.parameters.items():
-        params[pid] = Param(
-            pid, p.qualified, _pair(p.type_spec), p.unit, p.writable, extras.get(p.qualified, {})
-        )
+        extra = {
+            "range": p.range,
+            "limits": p.limits,
+            "calibration": p.calibration,
+            "description": p.description,
+        }
+        params[pid] = Param(pid, p.qualified, _pair(p.type_spec), p.unit, p.writable, extra)
     events = {}
     for eid, e in db.events.items():
-        raw = _event_entry(doc, e)
-        fields = [(f["name"], _pair(f["type"])) for f in raw.get("data", ())]
+        fields = [(name, _pair(spec)) for name, spec in e.type_specs]
         events[eid] = Event(eid, e.qualified, e.severity, fields)
     functions = {}
-    for f in db.extra.get("functions", ()):
-        args = [(a["id"], a["name"], _pair(a["type"])) for a in f.get("arguments", ())]
-        functions[f["id"]] = Function(f["id"], f["name"], args)
+    for fid, f in db.functions.items():
+        args = [(aid, name, _pair(spec)) for aid, name, spec, _ in f.arguments]
+        functions[fid] = Function(fid, f.name, args)
     structures = [
         Structure(h["sid"], h["interval"], list(h["parameters"]), h["enabled"])
         for h in db.housekeeping
@@ -126,19 +114,6 @@ def loads(text):
     return Spacecraft(
         db.mission, dict(db.apids), params, events, functions, structures, dict(db.filestores)
     )
-
-
-def _event_entry(doc, event):
-    if event.component:
-        for comp in doc.get("components", []):
-            if comp["name"] == event.component:
-                for e in comp.get("events", []):
-                    if e["name"] == event.name:
-                        return e
-    for e in doc.get("events", []):
-        if e["name"] == event.name:
-            return e
-    return {}
 
 
 def load(path=None):

@@ -80,9 +80,14 @@ def field_type(spec, where="type"):
 
 
 class Parameter:
-    """An attribute of a component as a PUS parameter."""
+    """An attribute of a component as a PUS parameter. ``extras`` are the optional entries for
+    mission control, kept as given: ``range`` ([low, high] a set may use), ``limits``
+    (``{"warning": [low, high], "critical": [low, high]}``), ``calibration``
+    (``{"polynomial": [c0, c1, ..]}`` or ``{"spline": [[raw, eng], ..]}``), ``description``."""
 
-    def __init__(self, id, component, name, type_spec, unit=None, writable=False, default=None):
+    def __init__(
+        self, id, component, name, type_spec, unit=None, writable=False, default=None, extras=None
+    ):
         self.id = id
         self.component = component
         self.name = name  # the attribute name
@@ -91,6 +96,11 @@ class Parameter:
         self.unit = unit
         self.writable = writable
         self.default = default
+        extras = extras or {}
+        self.range = extras.get("range")
+        self.limits = extras.get("limits")
+        self.calibration = extras.get("calibration")
+        self.description = extras.get("description")
 
     @property
     def qualified(self):
@@ -108,6 +118,7 @@ class EventDef:
         self.component = component
         self.name = name
         self.severity = severity
+        self.type_specs = [(f["name"], f["type"]) for f in data]
         self.fields = [
             (f["name"], field_type(f["type"], "event %s field %s" % (name, f.get("name"))))
             for f in data
@@ -256,6 +267,7 @@ class Sdb:
                         a.get("unit"),
                         bool(a.get("writable", False)),
                         a.get("default"),
+                        a,
                     )
                 )
             for e in comp.get("events", []):
@@ -275,6 +287,7 @@ class Sdb:
                     p.get("unit"),
                     bool(p.get("writable", False)),
                     p.get("default"),
+                    p,
                 )
             )
         for e in doc.get("events", []):

@@ -189,7 +189,11 @@ class Chain:
                 pass
 
     def __enter__(self):
-        return self.start()
+        try:
+            return self.start()
+        except BaseException:
+            self.stop()  # a chain that did not come up leaves no controller or OBC running
+            raise
 
     def __exit__(self, *exc):
         self.stop()

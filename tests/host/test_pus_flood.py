@@ -5,6 +5,7 @@ process alone, once against the OBC's core process (PUS services 1-23, CFDP, OBC
 
 import gc
 import json
+import logging
 import os
 import random
 import socket
@@ -12,12 +13,25 @@ import sys
 import tracemalloc
 from pathlib import Path
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
 
 from obsw.pus.tc import PusTc  # noqa: E402
 from obsw_host.pus.ground import Ground  # noqa: E402
 from obsw_host.pus.onboard import Onboard  # noqa: E402
 from pus_loop import APID, sdb  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def quiet_onboard_log():
+    """The onboard log writes a line per TC, and pytest keeps every record it captures: that
+    would be the test runner's memory growing, not the process's. Warnings still show."""
+    log = logging.getLogger("obsw.onboard")
+    level = log.level
+    log.setLevel(logging.WARNING)
+    yield
+    log.setLevel(level)
 
 
 def served(app):

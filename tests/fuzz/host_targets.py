@@ -25,11 +25,10 @@ class _Onboard:
         from pus_loop import APID, sdb
 
         self.apid = APID
-        self.onboard = Onboard(sdb(), port=0)
+        self.onboard = Onboard(sdb(), port=0, tm_to=("ground", 1))
         self.app = self.onboard.app
         self.cap = _Capture()
         self.onboard._transport = self.cap
-        self.onboard.ground = ("ground", 1)
         self.types = sorted(
             (s, sub)
             for s, svc in self.app.services.items()

@@ -210,8 +210,10 @@ def dims(text):
 def _decimal(ratio):
     """True when ``ratio`` is a power of ten (a change of decimal prefix only)."""
     p = 1.0
-    while p < ratio and p < 1e40:
+    n = 0
+    while p < ratio and n < 40:  # no float literal beyond single precision: boards freeze this
         p *= 10
+        n += 1
     return p == ratio
 
 

@@ -133,28 +133,9 @@ def test_flood_into_the_obc_core_process(tmp_path):
 
 def test_flood_of_malformed_tcs_into_every_service():
     onboard = Onboard(sdb(), port=0, period=0.05).start()
-    rng = random.Random(17)
     try:
-        types = served(onboard.app)
-        assert len(types) > 50
-        with Ground(sdb(), target=onboard.address[:2], timeout=5.0) as ground:
-            sent = flood(onboard, ground, rng, types, 10)  # warm-up: tables reach their size
-            gc.collect()
-            tracemalloc.start()
-            try:
-                base = tracemalloc.get_traced_memory()[0]
-                sent += flood(onboard, ground, rng, types, 30)
-                gc.collect()
-                grown = tracemalloc.get_traced_memory()[0] - base
-            finally:
-                tracemalloc.stop()
-            counters = onboard.call(lambda: dict(onboard.app.counters))
+        figures = measure(onboard, sdb(), onboard.address[:2], 17)
     finally:
         onboard.stop()
-    pings = 40
-    assert counters["received"] == sent + pings
-    assert counters.get("handler_errors", 0) == 0
-    ended = counters["failed"] + counters["dropped"] + counters.get("completed", 0)
-    assert ended == sent + pings, counters
-    print("flood: %d TCs, counters %s, memory grown %d octets" % (sent, counters, grown))
-    assert grown < 256 * 1024, grown
+    assert len(figures[0]) > 50
+    check(*figures)

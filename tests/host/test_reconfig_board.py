@@ -3,6 +3,7 @@ that record their arguments (no board is touched)."""
 
 import os
 import stat
+import tempfile
 
 import pytest
 from obsw_host import board
@@ -64,9 +65,13 @@ def test_the_pyboard_image_freezes_the_reconfiguration_manifest():
         assert "manifests/reconfig.py" in f.read()
 
 
-def test_deploy_compiles_for_the_pyboard_and_copies(fakes):
+def test_deploy_compiles_for_the_pyboard_and_copies(fakes, tmp_path, monkeypatch):
     tmp, calls = fakes
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
     assert run(["board", "deploy", "--port", "/dev/ttyACM0"]) == 0
+    assert os.listdir(scratch) == []  # the compiled files' folder is gone again
     c = calls()
     assert len(c) == 1 and c[0].startswith("mpremote connect /dev/ttyACM0")
     assert " cp -r " in c[0] and c[0].endswith("soft-reset")

@@ -64,7 +64,13 @@ def _candidates(explicit):
     if env:
         yield pathlib.Path(env)
         return
-    for base in (ROOT.parent / "shared" / "micropython", ROOT / "shared" / "micropython"):
+    # next to the repository, inside it, or in the workspace's shared folder (a clean clone
+    # elsewhere, as CI makes, still finds the pinned archive there)
+    for base in (
+        ROOT.parent / "shared" / "micropython",
+        ROOT / "shared" / "micropython",
+        pathlib.Path("/work/shared/micropython"),
+    ):
         yield base
 
 

@@ -15,33 +15,43 @@ class JsonDepthError(ValueError):
 
 
 def check_depth(text, limit=MAX_DEPTH):
-    """Raise JsonDepthError if ``text`` (str) opens more than ``limit`` arrays or objects at
-    once; brackets inside strings do not count. One pass, no recursion."""
+    """Raise JsonDepthError if ``text`` (str or UTF-8 bytes) opens more than ``limit`` arrays
+    or objects at once; brackets inside strings do not count. One pass over the octets (bytes
+    index in constant time on MicroPython, str characters do not), no recursion."""
+    data = text.encode() if isinstance(text, str) else text
     depth = 0
-    in_string = False
-    escaped = False
-    for c in text:
-        if in_string:
-            if escaped:
-                escaped = False
-            elif c == "\\":
-                escaped = True
-            elif c == '"':
-                in_string = False
-        elif c == '"':
-            in_string = True
-        elif c == "[" or c == "{":
+    i, n = 0, len(data)
+    while i < n:
+        o = data[i]
+        if o == 34:  # '"': on to the closing quote
+            i = _string_end(data, i + 1)
+        elif o == 91 or o == 123:  # "[" "{"
             depth += 1
             if depth > limit:
                 raise JsonDepthError(depth, limit)
-        elif c == "]" or c == "}":
+        elif o == 93 or o == 125:  # "]" "}"
             depth -= 1
+        i += 1
+
+
+def _string_end(data, start):
+    """Index of the quote closing a string that opened before ``start`` (len(data) if none):
+    a quote after an odd run of backslashes is escaped."""
+    j = data.find(b'"', start)
+    while j > 0:
+        k = j - 1
+        while k >= start and data[k] == 92:  # "\\"
+            k -= 1
+        if (j - 1 - k) % 2 == 0:
+            return j
+        j = data.find(b'"', j + 1)
+    return len(data)
 
 
 def loads(text, limit=MAX_DEPTH):
     """``json.loads`` of ``text`` (str or UTF-8 bytes) after ``check_depth``; every failure is
     a ValueError (UnicodeError and JsonDepthError included)."""
+    check_depth(text, limit)
     if isinstance(text, (bytes, bytearray)):
         text = bytes(text).decode()
-    check_depth(text, limit)
     return json.loads(text)

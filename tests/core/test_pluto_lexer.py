@@ -69,6 +69,36 @@ class TestNonAsciiDigits(unittest.TestCase):
         self.assertFalse(units.isdigits("1a"))
 
 
+class TestNonAscii(unittest.TestCase):
+    """The lexer reads UTF-8 octets: the same tokens and columns on both interpreters."""
+
+    def test_strings_and_comments_keep_their_characters(self):
+        toks = tokenize('log "\u00e9t\u00e9 \u2103" // \u00b0C\nx')
+        self.assertEqual(toks[1][1], "\u00e9t\u00e9 \u2103")
+        self.assertEqual(toks[2][:2], (WORD, "x"))
+
+    def test_columns_count_characters(self):
+        with self.assertRaises(PlutoSyntaxError) as cm:
+            tokenize('log "\u00e9\u00e9" $')
+        self.assertEqual((cm.exception.line, cm.exception.col), (1, 10))
+
+    def test_letters_are_ascii_letters(self):
+        # CPython's str.isalpha() takes "\u00e9"; MicroPython's does not: neither does PLUTO
+        with self.assertRaises(PlutoSyntaxError) as cm:
+            tokenize("caf\u00e9 := 1;")
+        self.assertEqual(cm.exception.col, 4)
+
+    def test_every_operator(self):
+        ops = ":= ** <= >= != = < > + - * / ( ) , ; : [ ] . ^ %".split()
+        self.assertEqual(kinds(" ".join(ops)), [(OP, o) for o in ops])
+        self.assertEqual(kinds("a!=b"), [(WORD, "a"), (OP, "!="), (WORD, "b")])
+        with self.assertRaises(PlutoSyntaxError):
+            tokenize("a ! b")
+
+    def test_escaped_quote(self):
+        self.assertEqual(tokenize('"a\\"b"')[0][1], 'a"b')
+
+
 class TestUnits(unittest.TestCase):
     def test_symbols_with_prefixes(self):
         self.assertEqual(units.symbol("km")[0], 1000)

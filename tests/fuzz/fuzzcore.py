@@ -126,7 +126,11 @@ def as_text(data):
     try:
         return data.decode()
     except UnicodeError:
-        return "".join(chr(c) if c < 128 else "?" for c in data)
+        ascii_only = bytearray(data)
+        for i in range(len(ascii_only)):
+            if ascii_only[i] > 127:
+                ascii_only[i] = 63  # "?"
+        return ascii_only.decode()
 
 
 def run(target, count=None, seconds=None, seed=1):

@@ -43,10 +43,6 @@ def line_col(p):
     return p >> 12, p & 4095
 
 
-def _isword(c):
-    return c.isalpha() or c == "_"
-
-
 _KINDS = WORD + NUM + STR + OP + ABST + RELT + EOF
 
 
@@ -86,137 +82,199 @@ class Tokens:
             yield self[j]
 
 
+# One class per ASCII octet: the lexer works on the UTF-8 octets of the source, because
+# MicroPython finds the i-th character of a str by walking from its start (a lexer indexing a
+# str is quadratic there) while indexing bytes is constant-time. Letters are ASCII letters on
+# both interpreters; any other octet >= 128 is only allowed inside strings and comments.
+_OTHER, _SPACE, _NL, _DIGIT, _LETTER, _UNDER, _QUOTE, _OP = 0, 1, 2, 3, 4, 5, 6, 7
+
+
+def _classes():
+    t = bytearray(256)
+    for c in b" \t\r\f":
+        t[c] = _SPACE
+    t[10] = _NL
+    for c in range(48, 58):
+        t[c] = _DIGIT
+    for c in range(26):
+        t[65 + c] = t[97 + c] = _LETTER
+    t[95] = _UNDER
+    t[34] = _QUOTE
+    for c in _OPS1.encode():
+        t[c] = _OP
+    return bytes(t)
+
+
+_CLASS = _classes()
+_OP2 = {}
+for _o in _OPS2:
+    _OP2[_o.encode()] = _o
+_SLASH, _BACKSLASH, _QUOTE_OCTET, _NEWLINE = 47, 92, 34, 10
+
+
+def _char_at(b, i):
+    """The character whose UTF-8 encoding starts at octet ``i`` (for messages)."""
+    k = 1
+    while i + k < len(b) and k < 4 and b[i + k] & 0xC0 == 0x80:
+        k += 1
+    try:
+        return b[i : i + k].decode()
+    except UnicodeError:
+        return "\\x%02x" % b[i]
+
+
 def tokenize(src, compact=False):
     """List of (kind, value, pos) tuples ending with an EOF token (``compact``: a Tokens of
-    them); raises PlutoSyntaxError."""
-    out = Tokens(len(src) // 4 + 8) if compact else []
-    i, n = 0, len(src)
-    line, start = 1, 0
+    them); raises PlutoSyntaxError. Columns count characters."""
+    b = src.encode() if isinstance(src, str) else bytes(src)
+    cls = _CLASS
+    out = Tokens(len(b) // 4 + 8) if compact else []
+    i, n = 0, len(b)
+    line, start = 1, 0  # start: where the line begins, moved on by one per UTF-8 continuation
     after_num = False
     seen = {}  # one string object per distinct word keeps the token list small
     while i < n:
-        c = src[i]
-        if c == "\n":
+        o = b[i]
+        k = cls[o]
+        if k == _NL:
             line, start, i = line + 1, i + 1, i + 1
             after_num = False
             continue
-        if c in " \t\r\f":
+        if k == _SPACE:
             i += 1
             after_num = False
             continue
         p = pos(line, i - start + 1)
-        if c == "/" and src[i + 1 : i + 2] == "/":
-            while i < n and src[i] != "\n":
+        if o == _SLASH and i + 1 < n and b[i + 1] == _SLASH:
+            while i < n and b[i] != _NEWLINE:
                 i += 1
             continue
-        if isdigits(c):
-            i = _number(src, i, n, out, p)
+        if k == _DIGIT:
+            i = _number(b, i, n, out, p)
             after_num = True
             continue
-        if _isword(c):
+        if k == _LETTER or k == _UNDER:
             j = i + 1
             if after_num:  # "10s", "1d2h": a unit glued to its number holds letters only
-                while j < n and src[j].isalpha():
+                while j < n and cls[b[j]] == _LETTER:
                     j += 1
             else:
-                while j < n and (src[j].isalpha() or isdigits(src[j]) or src[j] == "_"):
+                while j < n and _DIGIT <= cls[b[j]] <= _UNDER:
                     j += 1
-            w = src[i:j]
+            w = b[i:j].decode()
             out.append((WORD, seen.setdefault(w, w), p))
             i = j
             after_num = False
             continue
         after_num = False
-        if c == '"':
+        if k == _QUOTE:
             j = i + 1
-            buf = []
-            while j < n and src[j] != '"':
-                if src[j] == "\\" and j + 1 < n:
+            buf = bytearray()
+            while j < n and b[j] != _QUOTE_OCTET:
+                if b[j] == _BACKSLASH and j + 1 < n:
                     j += 1
-                if src[j] == "\n":
+                o = b[j]
+                if o == _NEWLINE:
                     break
-                buf.append(src[j])
+                if o & 0xC0 == 0x80:
+                    start += 1
+                buf.append(o)
                 j += 1
-            if j >= n or src[j] != '"':
+            if j >= n or b[j] != _QUOTE_OCTET:
                 raise PlutoSyntaxError("unterminated string", *line_col(p))
-            out.append((STR, "".join(buf), p))
+            out.append((STR, buf.decode(), p))
             i = j + 1
             continue
-        two = src[i : i + 2]
-        if two in _OPS2:
-            out.append((OP, two, p))
+        op = _OP2.get(b[i : i + 2])  # "!=" starts with an octet that is no operator alone
+        if op is not None:
+            out.append((OP, op, p))
             i += 2
             continue
-        if c in _OPS1:
-            out.append((OP, c, p))
+        if k == _OP:
+            out.append((OP, chr(o), p))
             i += 1
             continue
-        raise PlutoSyntaxError("unexpected character %r" % c, *line_col(p))
+        raise PlutoSyntaxError("unexpected character %r" % _char_at(b, i), *line_col(p))
     out.append((EOF, None, pos(line, i - start + 1)))
     return out
 
 
-def _digits(src, i, n):
+def _digits(b, i, n):
     j = i
-    while j < n and isdigits(src[j]):
+    while j < n and 48 <= b[j] <= 57:
         j += 1
     return j
+
+
+def _digit_at(b, j):
+    return j < len(b) and 48 <= b[j] <= 57
+
+
+def _text(b, i, j):
+    return b[i:j].decode()
 
 
 _MAX_DIGITS = 40  # a 64-bit integer has 20 digits; a real 17 significant ones and an exponent
 
 
-def _number(src, i, n, out, p):
-    if src[i] == "0" and src[i + 1 : i + 2] in ("x", "X"):
+def _number(b, i, n, out, p):
+    if b[i : i + 2] in (b"0x", b"0X"):
         j = i + 2
-        while j < n and src[j] in "0123456789abcdefABCDEF":
+        while j < n and b[j] in b"0123456789abcdefABCDEF":
             j += 1
         if j == i + 2:
             raise PlutoSyntaxError("hexadecimal constant needs digits", *line_col(p))
         if j - i - 2 > 16:
             raise PlutoSyntaxError("hexadecimal constant longer than 64 bits", *line_col(p))
-        out.append((NUM, int(src[i + 2 : j], 16), p))
+        out.append((NUM, int(_text(b, i + 2, j), 16), p))
         return j
-    j = _digits(src, i, n)
-    if src[j : j + 1] == "-" and j - i == 4 and isdigits(src[j + 1 : j + 2]):
+    j = _digits(b, i, n)
+    if b[j : j + 1] == b"-" and j - i == 4 and _digit_at(b, j + 1):
         k = j + 1
-        while k < n and (isdigits(src[k]) or src[k] in "-:.TZ"):
+        while k < n and b[k] in b"0123456789-:.TZ":
             k += 1
         try:
-            out.append((ABST, parse_iso(src[i:k]), p))
+            out.append((ABST, parse_iso(_text(b, i, k)), p))
         except UnitError:
-            raise PlutoSyntaxError("malformed absolute time %r" % src[i:k], *line_col(p)) from None
+            raise PlutoSyntaxError(
+                "malformed absolute time %r" % _text(b, i, k), *line_col(p)
+            ) from None
         return k
-    if src[j : j + 1] == ":" and isdigits(src[j + 1 : j + 3]) and src[j + 3 : j + 4] == ":":
+    if (
+        b[j : j + 1] == b":"
+        and _digit_at(b, j + 1)
+        and _digit_at(b, j + 2)
+        and b[j + 3 : j + 4] == b":"
+    ):
         k = j
-        while k < n and (isdigits(src[k]) or src[k] in ":."):
+        while k < n and b[k] in b"0123456789:.":
             k += 1
-        parts = src[i:k].split(":")
+        parts = _text(b, i, k).split(":")
         if len(parts) not in (4, 5) or not _relative_parts(parts):
-            raise PlutoSyntaxError("malformed relative time %r" % src[i:k], *line_col(p))
+            raise PlutoSyntaxError("malformed relative time %r" % _text(b, i, k), *line_col(p))
         v = int(parts[0]) * 86400 + int(parts[1]) * 3600 + int(parts[2]) * 60 + int(parts[3])
         if len(parts) == 5 and parts[4]:
             v += int(parts[4]) / 10 ** len(parts[4])
         out.append((RELT, v, p))
         return k
     real = False
-    if src[j : j + 1] == "." and isdigits(src[j + 1 : j + 2]):
-        j = _digits(src, j + 1, n)
+    if b[j : j + 1] == b"." and _digit_at(b, j + 1):
+        j = _digits(b, j + 1, n)
         real = True
-    if src[j : j + 1] in ("e", "E"):
+    if b[j : j + 1] in (b"e", b"E"):
         k = j + 1
-        if src[k : k + 1] in ("+", "-"):
+        if b[k : k + 1] in (b"+", b"-"):
             k += 1
-        if isdigits(src[k : k + 1]):
-            j = _digits(src, k, n)
+        if _digit_at(b, k):
+            j = _digits(b, k, n)
             real = True
     if j - i > _MAX_DIGITS:
         raise PlutoSyntaxError(
             "numeric constant of %d characters, at most %d" % (j - i, _MAX_DIGITS), *line_col(p)
         )
-    v = float(src[i:j]) if real else int(src[i:j])
+    v = float(_text(b, i, j)) if real else int(_text(b, i, j))
     if real and (v - v != 0):  # inf: beyond the largest real
-        raise PlutoSyntaxError("real constant out of range: %s" % src[i:j], *line_col(p))
+        raise PlutoSyntaxError("real constant out of range: %s" % _text(b, i, j), *line_col(p))
     out.append((NUM, v, p))
     return j
 

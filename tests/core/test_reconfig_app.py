@@ -23,9 +23,9 @@ def hpc_cltu(hpc, seq=0):
 
 
 class Rig:
-    def __init__(self, role=0, hal=None):
+    def __init__(self, role=0, hal=None, security=None):
         self.hal = hal or ModelHal(role, rtc_seconds=days_from_civil(2025, 1, 1) * 86400)
-        self.app = ReconfigApp(self.hal)
+        self.app = ReconfigApp(self.hal, essential_security=security)
         self.ctrl = Controller(heartbeat_period=0.5)
         self.ctrl.add_node(NODE_NOMINAL, definition(NODE_NOMINAL))
         self.ctrl.start(0.0)
@@ -160,6 +160,57 @@ class TestEssential(unittest.TestCase):
         r.hal.uart_rx[0].extend(hpc_cltu(E.Hpc(E.HPC_LINES, (0x00F, 0x005)), 1))
         r.until(lambda: r.hal.q == 0x005)
         self.assertEqual(r.hal.q, 0x005)
+
+
+def essential_sa():
+    from obsw.frames.sdls import SecurityAssociation, TcSecurity
+
+    return TcSecurity([SecurityAssociation(2, 0, bytes(range(32)), map_id=63)])
+
+
+class TestAuthenticatedHpcs(unittest.TestCase):
+    """The anti-replay window of the essential TCs lives in the safeguard memory: a frame
+    accepted before a reset is refused after it."""
+
+    def signed_cltu(self, ground, hpc):
+        data = ground.apply(SCID, 0, tc.Segment(63, hpc.packet()).pack(), True)
+        return cltu.encode(tc.TcFrame(SCID, 0, data, 0, True).pack())
+
+    def test_replay_after_reset_refused(self):
+        ground = essential_sa()
+        r = Rig(security=essential_sa())
+        r.step(3)
+        first = self.signed_cltu(ground, E.Hpc(E.HPC_LINES, (0x00F, 0x003)))
+        r.hal.uart_rx[0].extend(first)
+        self.assertTrue(r.until(lambda: r.hal.q == 0x003))
+        r.hal.cause = RESET_WATCHDOG
+        r2 = Rig(hal=r.hal, security=essential_sa())  # a fresh window, as after any reset
+        r2.step(3)
+        r2.hal.uart_rx[0].extend(first)
+        r2.step(5)
+        counters = r2.app.essential.frames.security.counters
+        self.assertEqual((counters["ok"], counters["replay"]), (0, 1))
+        self.assertEqual(r2.app.essential.counters["hpcs"], 0)
+        r2.hal.uart_rx[0].extend(self.signed_cltu(ground, E.Hpc(E.HPC_LINES, (0x00F, 0x00C))))
+        self.assertTrue(r2.until(lambda: r2.hal.q == 0x00C))
+        self.assertEqual(r2.app.essential.frames.security.sas[2].window.top, 2)
+
+    def test_saved_before_the_lines_change(self):
+        ground = essential_sa()
+        r = Rig(security=essential_sa())
+        r.step(3)
+        writes = r.app.sgm.counters["writes"]
+        r.hal.uart_rx[0].extend(self.signed_cltu(ground, E.Hpc(E.HPC_LINES, (0x00F, 0x003))))
+        while r.hal.q != 0x003:
+            r.step()
+            if r.app.sgm.counters["writes"] == writes:
+                self.assertEqual(r.hal.q, 0)  # no line changed before the window was saved
+        self.assertEqual(r.app.sgm.read(2), b"\x00\x02\x00\x00\x00\x01")
+
+    def test_without_security_nothing_is_written(self):
+        r = Rig()
+        r.step(3)
+        self.assertIsNone(r.app.sgm.read(2))
 
 
 class TestHealth(unittest.TestCase):

@@ -29,6 +29,7 @@ from obsw.spacecan import events as ev
 
 RECORD_STATE = const(0)  # boots, resets by cause, last commanded CPDU bits
 RECORD_CONTEXT = const(1)  # the OBC's context word (store_context)
+RECORD_SDLS = const(2)  # per SA of the essential TCs: the highest sequence number accepted
 
 H_RTC = const(0x01)
 H_SGM = const(0x02)
@@ -38,6 +39,11 @@ H_LOOP = const(0x10)
 H_IN_CHARGE = const(0x20)
 
 _STATE_FMT = ">HBBBBH"
+
+
+def _sdls_record(security):
+    """spi u16, top u32 per SA, in SPI order (RECORD_SDLS)."""
+    return b"".join(struct.pack(">HI", e[0], e[2]) for e in security.context())
 
 
 class ReconfigApp:
@@ -107,6 +113,7 @@ class ReconfigApp:
         self._next_save = 0
         self._dirty = False
         self._sgm_ok = 0
+        self._sdls_saved = None  # the anti-replay tops as last written to the safeguard memory
 
     # -- life cycle ---------------------------------------------------------------------------
 
@@ -130,6 +137,7 @@ class ReconfigApp:
             ctx = self.sgm.read(RECORD_CONTEXT)
             if ctx is not None and len(ctx) == 4:
                 self.context = struct.unpack(">I", ctx)[0]
+            self._restore_sdls()
         except (OSError, ValueError) as e:
             self._error(e, now)
         self.boots = (self.boots + 1) & 0xFFFF
@@ -158,6 +166,24 @@ class ReconfigApp:
             self._error(e, now)
         self._dirty = False
         self._next_save = now + self.save_period
+
+    def _restore_sdls(self):
+        security = self.essential.frames.security
+        if security is None:
+            return
+        rec = self.sgm.read(RECORD_SDLS)
+        if rec is not None and len(rec) % 6 == 0:
+            tops = [struct.unpack_from(">HI", rec, i) for i in range(0, len(rec), 6)]
+            security.restore([[spi, 0, top] for spi, top in tops])
+        self._sdls_saved = _sdls_record(security)
+
+    def _save_sdls(self):
+        """Before an authenticated HPC acts, the sequence number that carried it is in the
+        safeguard memory: no reset, however timed, lets that frame be accepted again."""
+        rec = _sdls_record(self.essential.frames.security)
+        if rec != self._sdls_saved:
+            self.sgm.write(RECORD_SDLS, rec)
+            self._sdls_saved = rec
 
     def _error(self, e, now):
         self.counters["loop_errors"] += 1
@@ -214,6 +240,8 @@ class ReconfigApp:
             data = hal.uart_read(PORT_COM)
             if data:
                 self.essential.feed(data, now)
+                if self.essential.frames.security is not None:
+                    self._save_sdls()
             for mask, value in self.essential.take_writes(now):
                 if not self.lines(mask, value, HPC_PRIORITY):
                     self.essential.failed()

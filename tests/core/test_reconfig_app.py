@@ -207,6 +207,28 @@ class TestAuthenticatedHpcs(unittest.TestCase):
                 self.assertEqual(r.hal.q, 0)  # no line changed before the window was saved
         self.assertEqual(r.app.sgm.read(2), b"\x00\x02\x00\x00\x00\x01")
 
+    def test_rejected_frames_in_the_report(self):
+        r = Rig(security=essential_sa())
+        r.step(3)
+        signed = self.signed_cltu(essential_sa(), E.Hpc(E.HPC_LINES, (0x00F, 0x003)))
+        unsigned = hpc_cltu(E.Hpc(E.HPC_LINES, (0x00F, 0x003)))
+        r.hal.uart_rx[0].extend(signed)
+        r.step(3)
+        r.hal.uart_rx[0].extend(signed)  # a replay now
+        r.hal.uart_rx[0].extend(unsigned)
+        r.step(5)
+        rep = E.Report.unpack(r.app.report().pack())
+        self.assertEqual((rep.version, rep.tc_rejected, rep.hpcs), (2, 2, 1))
+
+    def test_version_1_report_decodes(self):
+        v2 = E.Report(boots=7, uptime=99, tc_rejected=3).pack()
+        self.assertEqual(len(v2), 31)
+        v1 = b"\x01" + v2[1:29]
+        rep = E.Report.unpack(v1)
+        self.assertEqual((rep.version, rep.boots, rep.uptime, rep.tc_rejected), (1, 7, 99, 0))
+        with self.assertRaises(ValueError):
+            E.Report.unpack(v2[:30])
+
     def test_without_security_nothing_is_written(self):
         r = Rig()
         r.step(3)

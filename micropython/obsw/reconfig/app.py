@@ -366,6 +366,7 @@ class ReconfigApp:
             can_bus=self.node.responder.active,
             temperature_q=int(self.temperature * 4),
             uptime=int(now - (self._started or now)),
+            tc_rejected=e.frames.counters["tc_rejected"] & 0xFFFF,
         )
 
     def _idle_ms(self, now):

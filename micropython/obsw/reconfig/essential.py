@@ -110,9 +110,12 @@ def hpc_of_unit(unit):
 
 
 class Report:
-    """The essential telemetry report (HPTM data), 29 bytes, big-endian."""
+    """The essential telemetry report (HPTM data), big-endian: 31 bytes in version 2, which
+    adds ``tc_rejected`` (TC frames refused by TC security, modulo 2**16) to the 29 of
+    version 1; a version 1 report still decodes (``tc_rejected`` 0)."""
 
-    _FMT = ">BBHBBBBHHHIBBBBBhI"
+    _FMT = ">BBHBBBBHHHIBBBBBhIH"
+    _FMT_V1 = ">BBHBBBBHHHIBBBBBhI"
     FIELDS = (
         "version",
         "role",
@@ -132,24 +135,26 @@ class Report:
         "can_bus",
         "temperature_q",
         "uptime",
+        "tc_rejected",
     )
 
     def __init__(self, **fields):
         for k in self.FIELDS:
             setattr(self, k, fields.get(k, 0))
-        self.version = fields.get("version", 1)
+        self.version = fields.get("version", 2)
 
     def pack(self):
         return struct.pack(self._FMT, *[getattr(self, k) for k in self.FIELDS])
 
     @classmethod
     def unpack(cls, buf):
-        n = struct.calcsize(cls._FMT)
+        fmt = cls._FMT_V1 if buf[:1] == b"\x01" else cls._FMT
+        n = struct.calcsize(fmt)
         if len(buf) < n:
             raise ValueError("HPTM report too short: %d bytes, needs %d" % (len(buf), n))
-        values = struct.unpack(cls._FMT, buf[:n])
+        values = struct.unpack(fmt, buf[:n])
         d = {}
-        for i in range(len(cls.FIELDS)):
+        for i in range(len(values)):
             d[cls.FIELDS[i]] = values[i]
         return cls(**d)
 

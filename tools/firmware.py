@@ -201,8 +201,7 @@ def build_unix(src=None):
     return _make(tree, out, "micropython", manifest_inputs(manifest), args)[0]
 
 
-def pyboard_heap(src=None):
-    """Bytes between _heap_start and _heap_end of the Pyboard firmware (its GC heap)."""
+def _pyboard_symbols(src=None):
     elf = build_pyboard(src) / "firmware.elf"
     out = subprocess.run(["arm-none-eabi-nm", str(elf)], capture_output=True, text=True).stdout
     sym = {}
@@ -210,7 +209,24 @@ def pyboard_heap(src=None):
         parts = line.split()
         if len(parts) == 3:
             sym[parts[2]] = int(parts[0], 16)
+    return sym
+
+
+def pyboard_heap(src=None):
+    """Bytes between _heap_start and _heap_end of the Pyboard firmware (its GC heap)."""
+    sym = _pyboard_symbols(src)
     return sym["_heap_end"] - sym["_heap_start"]
+
+
+# ports/stm32/mpconfigport.h: MICROPY_STACK_CHECK_MARGIN, what the stm32 port keeps back
+STM32_STACK_MARGIN = 1024
+
+
+def pyboard_stack_limit(src=None):
+    """The C stack a Pyboard's Python code may use before 'maximum recursion depth exceeded':
+    _estack - _sstack of its ELF less the stm32 port's check margin."""
+    sym = _pyboard_symbols(src)
+    return sym["_estack"] - sym["_sstack"] - STM32_STACK_MARGIN
 
 
 # a float constant the freezer cannot write for a single-precision image (beyond +-3.4e38, inf)
@@ -240,8 +256,9 @@ def stage_board_tests():
 
 
 def build_qemu(src=None, heap=None):
-    """boards/OBSW_QEMU (mps2-an385, Cortex-M3) with manifests/qemu.py frozen and a GC heap of
-    ``heap`` bytes (default: the Pyboard's). Returns firmware.elf."""
+    """boards/OBSW_QEMU (mps2-an385, Cortex-M3) with manifests/qemu.py frozen, a GC heap of
+    ``heap`` bytes (default: the Pyboard's) and the Pyboard's C stack limit. Returns
+    firmware.elf."""
     need("arm-none-eabi-gcc", "gcc-arm-none-eabi")
     tree = source(src)
     build_mpy_cross(src)
@@ -253,6 +270,7 @@ def build_qemu(src=None, heap=None):
     args += [
         "BUILD=" + str(out),
         "MICROPY_HEAP_SIZE=%d" % heap,
+        "OBSW_STACK_LIMIT=%d" % pyboard_stack_limit(src),
         "FROZEN_MANIFEST=" + str(manifest),
     ]
     inputs = _files_under(QEMU_BOARD) + manifest_inputs(manifest)

@@ -128,8 +128,7 @@ def stage_upy_frozen():
     r = subprocess.run([str(exe), "-c", probe], env=env, capture_output=True, text=True)
     print(r.stdout.strip() or r.stderr.strip())
     entry_ok = r.returncode == 0
-    # one interpreter per test file, as a board boots afresh for each: a single process running
-    # every file takes minutes longer on this build (its cause is not known yet)
+    # one interpreter per test file, as a board boots afresh for each
     totals = [0, 0, 0]
     for path in CORE_TESTS:
         cmd = [str(exe), "-X", "heapsize=64M", str(ROOT / "tools" / "upy" / "run.py")]

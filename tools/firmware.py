@@ -37,7 +37,18 @@ GET_SOURCE = (
 )
 PYBOARD = ROOT / "boards" / "OBSW_RECONFIG"
 QEMU_BOARD = ROOT / "boards" / "OBSW_QEMU"
-UNIX_OPTIONS = ("VARIANT=standard", "MICROPY_PY_BTREE=0", "MICROPY_PY_FFI=0", "MICROPY_PY_SSL=0")
+# The frozen modules are compiled for this port's 63-bit small ints: mpy-cross assumes 31 bits
+# (a 32-bit board's) unless told, and the freezer then writes every integer constant beyond
+# 2**30 (a 0xFFFFFFFF mask) as a constant long int, so each operation with it allocates a
+# long-int result: 3.4x slower, and with a 64 MB heap, where every collection sweeps it all,
+# minutes for a test file that takes seconds from source.
+UNIX_OPTIONS = (
+    "VARIANT=standard",
+    "MICROPY_PY_BTREE=0",
+    "MICROPY_PY_FFI=0",
+    "MICROPY_PY_SSL=0",
+    "MPY_CROSS_FLAGS=-msmall-int-bits=63",
+)
 # STM32F405RG: 1 MiB flash; sectors 1-4 (112 KiB at 0x08004000) hold the filesystem, the
 # firmware has sector 0 (16 KiB, vectors) and sectors 5-11 (896 KiB from 0x08020000).
 F405_FLASH = 1024 * 1024
@@ -157,6 +168,8 @@ def _make(tree, out, artifact, inputs, args):
         say("cached %s" % (out / artifact))
         return out / artifact, 0.0
     t0 = time.monotonic()
+    # make recompiles a frozen module when its source changes, not when the options do
+    shutil.rmtree(out / "frozen_mpy", ignore_errors=True)
     cmd = ["make", "-j" + JOBS] + list(args)
     say("$ " + " ".join(cmd))
     log = out.parent / (out.name + ".log")
@@ -201,8 +214,7 @@ def build_unix(src=None):
     return _make(tree, out, "micropython", manifest_inputs(manifest), args)[0]
 
 
-def pyboard_heap(src=None):
-    """Bytes between _heap_start and _heap_end of the Pyboard firmware (its GC heap)."""
+def _pyboard_symbols(src=None):
     elf = build_pyboard(src) / "firmware.elf"
     out = subprocess.run(["arm-none-eabi-nm", str(elf)], capture_output=True, text=True).stdout
     sym = {}
@@ -210,7 +222,24 @@ def pyboard_heap(src=None):
         parts = line.split()
         if len(parts) == 3:
             sym[parts[2]] = int(parts[0], 16)
+    return sym
+
+
+def pyboard_heap(src=None):
+    """Bytes between _heap_start and _heap_end of the Pyboard firmware (its GC heap)."""
+    sym = _pyboard_symbols(src)
     return sym["_heap_end"] - sym["_heap_start"]
+
+
+# ports/stm32/mpconfigport.h: MICROPY_STACK_CHECK_MARGIN, what the stm32 port keeps back
+STM32_STACK_MARGIN = 1024
+
+
+def pyboard_stack_limit(src=None):
+    """The C stack a Pyboard's Python code may use before 'maximum recursion depth exceeded':
+    _estack - _sstack of its ELF less the stm32 port's check margin."""
+    sym = _pyboard_symbols(src)
+    return sym["_estack"] - sym["_sstack"] - STM32_STACK_MARGIN
 
 
 # a float constant the freezer cannot write for a single-precision image (beyond +-3.4e38, inf)
@@ -240,8 +269,9 @@ def stage_board_tests():
 
 
 def build_qemu(src=None, heap=None):
-    """boards/OBSW_QEMU (mps2-an385, Cortex-M3) with manifests/qemu.py frozen and a GC heap of
-    ``heap`` bytes (default: the Pyboard's). Returns firmware.elf."""
+    """boards/OBSW_QEMU (mps2-an385, Cortex-M3) with manifests/qemu.py frozen, a GC heap of
+    ``heap`` bytes (default: the Pyboard's) and the Pyboard's C stack limit. Returns
+    firmware.elf."""
     need("arm-none-eabi-gcc", "gcc-arm-none-eabi")
     tree = source(src)
     build_mpy_cross(src)
@@ -253,6 +283,7 @@ def build_qemu(src=None, heap=None):
     args += [
         "BUILD=" + str(out),
         "MICROPY_HEAP_SIZE=%d" % heap,
+        "OBSW_STACK_LIMIT=%d" % pyboard_stack_limit(src),
         "FROZEN_MANIFEST=" + str(manifest),
     ]
     inputs = _files_under(QEMU_BOARD) + manifest_inputs(manifest)

@@ -118,8 +118,13 @@ class Link:
 
 
 def payload(n, seed=7):
+    """``n`` pseudo-random bytes, filled in place (a list of ``n`` ints would take 4n bytes of a
+    board's heap)."""
     r = Rng(seed)
-    return bytes([r.next() & 0xFF for _ in range(n)])
+    b = bytearray(n)
+    for i in range(n):
+        b[i] = r.next() & 0xFF
+    return bytes(b)
 
 
 def directive(pdu):

@@ -442,14 +442,18 @@ class TestEssentialCommands(unittest.TestCase):
 
     def test_security_from_file(self):
         self.assertIsNone(self.E.security_from_file("/nonexistent/tc.keys"))
-        path = "/tmp/obsw_test_frames_sdls_bad.keys"
+        import os
+
+        try:  # a host's temporary folder, else (a board) the root of its filesystem
+            os.stat("/tmp")
+            path = "/tmp/obsw_test_frames_sdls_bad.keys"
+        except OSError:
+            path = "/obsw_test_frames_sdls_bad.keys"
         with open(path, "w") as f:
             f.write("{not a key file")
         try:
             broken = self.E.security_from_file(path)
         finally:
-            import os
-
             os.remove(path)
         self.assertEqual(broken.sas, {})  # fail secure, keep running
         unit = self.E.Essential(SCID, security=broken)

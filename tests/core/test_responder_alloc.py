@@ -23,7 +23,7 @@ HAS_MEM_ALLOC = hasattr(gc, "mem_alloc")
 
 class Rig:
     def __init__(self):
-        self.hal = ModelHal(rtc_seconds=20089 * 86400)
+        self.hal = ModelHal(rtc_seconds=20089 * 86400, eeprom_size=2048)  # a board heap holds it
         self.app = ReconfigApp(self.hal)
         self.ctrl = Controller(heartbeat_period=0.5)
         self.ctrl.add_node(NODE_NOMINAL, definition(NODE_NOMINAL))

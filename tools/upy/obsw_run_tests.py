@@ -1,10 +1,14 @@
 """Run core unittest files on MicroPython (which ships no unittest): the unix port through
 run.py, a board through ``import obsw_run_tests; obsw_run_tests.main([...])``.
 
-main(files, skips): prints a line per failure and 'N passed, N failed[, N skipped]'; ``skips``
-maps a file name or 'file::Class::test' to the reason it cannot run here (counted as skipped).
+main(files, skips, threshold): prints a line per failure and 'N passed, N failed[, N skipped]';
+``skips`` maps a file name or 'file::Class::test' to the reason it cannot run here (counted as
+skipped); ``threshold`` (a board's) makes the GC collect after that many bytes allocated rather
+than only when the heap is exhausted, which keeps a small heap from fragmenting
+(``gc.threshold``).
 """
 
+import gc
 import sys
 import unittest
 
@@ -87,8 +91,11 @@ def run_file(path, counts, verbose, skips=None):
                     print("ok   %s" % label)
 
 
-def main(argv, skips=None):
+def main(argv, skips=None, threshold=None):
     verbose = "-v" in argv
+    if threshold:
+        gc.collect()
+        gc.threshold(threshold)
     files = [a for a in argv if not a.startswith("-")]
     counts = [0, 0, 0]
     for path in files:

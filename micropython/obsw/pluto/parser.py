@@ -21,7 +21,13 @@ _PROC_ONLY = (
 
 def parse(src):
     """Parse procedure text into its definition node; raises PlutoSyntaxError."""
-    tree = Parser(tokenize(src, True)).procedure()
+    parser = Parser(tokenize(src, True))
+    try:
+        tree = parser.procedure()
+    except RuntimeError:
+        # the C stack ran out before MAX_NESTING did (a Pyboard's 16 KiB stack holds about
+        # five levels of parentheses, fewer under a deep caller): a load error all the same
+        raise PlutoSyntaxError("nesting too deep for the stack", *line_col(parser.pos())) from None
     check_depth(tree)
     return tree
 

@@ -1,6 +1,8 @@
 // obsw_qemu: the board support of the QEMU board. disk() is a bytearray over a static buffer
 // (outside the GC heap, like a Pyboard's internal flash) that frozen _boot.py mounts as a
-// littlefs at "/"; obsw_qemu_boot() runs _boot.py at every (soft) reset.
+// littlefs at "/"; obsw_qemu_boot() gives Python the Pyboard's C stack limit and runs _boot.py
+// at every (soft) reset.
+#include "py/cstack.h"
 #include "py/runtime.h"
 #include "shared/runtime/pyexec.h"
 
@@ -27,6 +29,9 @@ const mp_obj_module_t obsw_qemu_module = {
 MP_REGISTER_MODULE(MP_QSTR_obsw_qemu, obsw_qemu_module);
 
 void obsw_qemu_boot(void) {
+    // the port's main() allows 10 KiB from its own frame; a Pyboard allows OBSW_STACK_LIMIT
+    // (the emulated board's RAM has room: the stack grows down from the top of its 4 MiB)
+    mp_cstack_init_with_top(MP_STATE_THREAD(stack_top), OBSW_STACK_LIMIT);
     pyexec_frozen_module("_boot.py", false);
 }
 

@@ -38,6 +38,8 @@ GET_SOURCE = (
 PYBOARD = ROOT / "boards" / "OBSW_RECONFIG"
 QEMU_BOARD = ROOT / "boards" / "OBSW_QEMU"
 UNIX_OPTIONS = ("VARIANT=standard", "MICROPY_PY_BTREE=0", "MICROPY_PY_FFI=0", "MICROPY_PY_SSL=0")
+# the core's @micropython.native hot paths freeze as machine code of the host (x86-64)
+UNIX_OPTIONS += ("MPY_CROSS_FLAGS=-march=x64",)
 # STM32F405RG: 1 MiB flash; sectors 1-4 (112 KiB at 0x08004000) hold the filesystem, the
 # firmware has sector 0 (16 KiB, vectors) and sectors 5-11 (896 KiB from 0x08020000).
 F405_FLASH = 1024 * 1024

@@ -99,6 +99,8 @@ class Rig:
 
     def frames(self, make):
         """The frames the controller sends for ``make(ctrl, now)``."""
+        if make is other_node:
+            return make(self.ctrl, self.now)
         make(self.ctrl, self.now)
         out = [(bus, can_id, bytes(data)) for bus, can_id, data in self.ctrl.take_frames()]
         if not out:
@@ -124,6 +126,11 @@ def ping(ctrl, now):
     from obsw.reconfig.node import NODE_NOMINAL
 
     ctrl.request(NODE_NOMINAL, 17, 1, b"", now)
+
+
+def other_node(ctrl, now):
+    # a ping to node 11 (another responder): this node only has to see that it is not its own
+    return [(0, 0x280 + 11, b"\x00\x00\x11\x01")]
 
 
 def _frame_op(rig, make):
@@ -319,10 +326,12 @@ OPS = {
     "frame_sync": lambda rig: _frame_op(rig, sync),
     "frame_tc_20_1": lambda rig: _frame_op(rig, telecommand),
     "frame_ping_17_1": lambda rig: _frame_op(rig, ping),
+    "frame_other": lambda rig: _frame_op(rig, other_node),
     "batch_heartbeat": lambda rig: _frames_op(rig, heartbeat, BATCH),
     "batch_sync": lambda rig: _frames_op(rig, sync, BATCH),
     "batch_tc_20_1": lambda rig: _frames_op(rig, telecommand, BATCH),
     "batch_ping_17_1": lambda rig: _frames_op(rig, ping, BATCH),
+    "batch_other": lambda rig: _frames_op(rig, other_node, BATCH),
     "can_idle": _can_idle,
     "loop_idle": _loop_idle,
     "loop_busy": _loop_busy,

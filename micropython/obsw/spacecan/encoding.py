@@ -22,15 +22,17 @@ _TABLE = {
 NAMES = tuple(_TABLE)
 
 # name -> (">" + code, lowest, highest), made once: encoding a value builds no format string
-_PACK = {}
+# (for f32 and f64 the range is of no use: a caller packing an int in range packs it as struct
+# would; bool has no entry)
+PACK = {}
 for _name in _TABLE:
     _code, _width, _signed = _TABLE[_name]
     if _code is not None:
         _bits = _width * 8
         if _signed:
-            _PACK[_name] = (">" + _code, -(1 << (_bits - 1)), (1 << (_bits - 1)) - 1)
+            PACK[_name] = (">" + _code, -(1 << (_bits - 1)), (1 << (_bits - 1)) - 1)
         else:
-            _PACK[_name] = (">" + _code, 0, (1 << _bits) - 1)
+            PACK[_name] = (">" + _code, 0, (1 << _bits) - 1)
 del _name, _code, _width, _signed, _bits
 _PARTS = {}  # encoding -> its names, for the encodings met (bounded: _PARTS_MAX)
 _PARTS_MAX = 64
@@ -99,7 +101,7 @@ def size(encoding):
 
 @micropython.native
 def _encode_one(name, value):
-    packing = _PACK.get(name)
+    packing = PACK.get(name)
     if packing is None:
         if value is True or value is False or value in (0, 1):
             return b"\x01" if value else b"\x00"
@@ -135,7 +137,7 @@ def _decode_one(name, buf, offset):
     width = _TABLE[name][1]
     if len(buf) - offset < width:
         raise DecodeError(name, width, len(buf) - offset)
-    packing = _PACK.get(name)
+    packing = PACK.get(name)
     if packing is None:
         return buf[offset] != 0, offset + 1
     return struct.unpack_from(packing[0], buf, offset)[0], offset + width

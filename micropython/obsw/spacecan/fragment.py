@@ -83,7 +83,8 @@ class Reassembler:
         c["frames"] += 1
         if not self._partial and len(data) >= 2 and data[0] == 0 and data[1] == 0:
             c["packets"] += 1  # a packet of one frame, nothing pending: the usual request
-            return bytes(data[2:])
+            packet = data[2:]
+            return packet if type(packet) is bytes else bytes(packet)
         if len(data) < 2:
             c["short"] += 1
             return None

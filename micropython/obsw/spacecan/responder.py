@@ -5,6 +5,8 @@ Sans-I/O, the same interface as the controller: `receive(bus, can_id, data, now)
 replies go out on the bus the request came in on, periodic reports on the active bus.
 """
 
+import struct
+
 from obsw.compat import const, micropython
 from obsw.spacecan import encoding as enc
 from obsw.spacecan import events as ev
@@ -27,6 +29,7 @@ from obsw.spacecan.timeframes import FrameLengthError, ScetTime, UtcTime
 _CANNED_MAX = const(64)  # verification report frames kept ready
 _PING_REPORT_FRAME = split(bytes((pk.SERVICE_TEST, pk.PING_REPORT)))[0]
 _PING_KEY = const((17 << 8) | 1)  # (pk.SERVICE_TEST << 8) | pk.PING
+_PARAM_REQUEST_KEY = const((20 << 8) | 1)  # (pk.SERVICE_PARAMETER << 8) | pk.PARAM_REQUEST
 
 _MIN_HK_INTERVAL = 0.01
 
@@ -195,12 +198,27 @@ class Responder:
         if not self._started:
             self.start(now)
         if can_id == self._req_id:
-            self._count_rx(bus, now)
+            self.counters["rx"] += 1
+            h = self.health[bus]  # BusHealth.received, inline
+            h.rx_frames += 1
+            h.last_rx = now
+            h.errors_since_rx = 0
             if not self.use_packets:
                 if self.on_raw is not None:
                     self.on_raw(bytes(data), bus)
                 return
-            packet = self.reassembler.push(can_id | (bus << 11), data, now)
+            ra = self.reassembler
+            if not ra._partial and len(data) >= 2 and data[0] == 0 and data[1] == 0:
+                # Reassembler.push's packet of one frame with nothing pending, inline
+                c = ra.counters
+                c["frames"] += 1
+                c["packets"] += 1
+                if type(data) is bytes:  # served in place: the packet starts at data[2]
+                    self._serve(data, bus, now, 2)
+                    return
+                packet = bytes(data[2:])
+            else:
+                packet = ra.push(can_id | (bus << 11), data, now)
             if packet is not None:
                 self._serve(packet, bus, now)
         elif can_id == ID_HEARTBEAT:
@@ -338,6 +356,9 @@ class Responder:
 
     @micropython.native
     def _reply(self, bus, service, subtype, data=b""):
+        if len(data) <= 4:  # one frame, [0][0][service][subtype][data], as split makes it
+            self._tx(bus, bytes((0, 0, service, subtype)) + data)
+            return
         for frame in split(bytes((service, subtype)) + data):
             self._tx(bus, frame)
 
@@ -356,21 +377,25 @@ class Responder:
 
     @micropython.native
     def _verify(self, bus, subtype, service, req_subtype):
-        self._frames.append(self._verification(bus, subtype, service, req_subtype))
+        frame = self._canned.get((bus << 24) | (subtype << 16) | (service << 8) | req_subtype)
+        if frame is None:
+            frame = self._verification(bus, subtype, service, req_subtype)
+        self._frames.append(frame)
         self.health[bus].tx_frames += 1  # BusHealth.sent
         self.counters["tx"] += 1
 
     @micropython.native
-    def _serve(self, packet, bus, now):
+    def _serve(self, packet, bus, now, start=0):
+        # the packet is packet[start:] (a one-frame request is served in its frame's bytes)
         self.counters["requests"] += 1
-        if len(packet) < 2:
+        if len(packet) - start < 2:
             self.counters["rejected"] += 1
             self._emit(
                 ev.REQUEST_REJECTED, now, service=None, subtype=None, reason="packet under 2 bytes"
             )
             return
-        service = packet[0]
-        subtype = packet[1]
+        service = packet[start]
+        subtype = packet[start + 1]
         key = (service << 8) | subtype
         if key == _PING_KEY:  # no data, nothing to decode: the replies are ready-made
             self._ping(bus, service, subtype, packet, now)
@@ -379,7 +404,10 @@ class Responder:
         try:
             if handler is None:
                 raise _Reject("service (%d,%d) not supported" % (service, subtype))
-            handler(bus, service, subtype, packet[2:], now)
+            if key == _PARAM_REQUEST_KEY:  # reads its ids in place
+                self._param_request(bus, service, subtype, packet, now, start + 2)
+            else:
+                handler(bus, service, subtype, packet[start + 2 :], now)
         except _Reject as e:
             self.counters["rejected"] += 1
             self._verify(bus, pk.ACCEPT_FAIL, service, subtype)
@@ -408,27 +436,64 @@ class Responder:
         self.counters["tx"] += 3
 
     @micropython.native
-    def _param_request(self, bus, service, subtype, data, now):
-        ids = pk.unpack_ids(data)
+    def _param_request(self, bus, service, subtype, data, now, start=0):
+        # the request's data is data[start:]: [N][id x N]
+        n = len(data)
+        if n - start < 1 or data[start] != n - start - 1:
+            pk.unpack_ids(data[start:])  # raises the error that says what is wrong
+        first = start + 1  # the ids, read in place (no list of them)
         size = 3
         params = self.nodedef.parameters
-        for pid in ids:
-            p = params.get(pid)
+        for i in range(first, n):
+            p = params.get(data[i])
             if p is None:
-                raise _Reject("unknown parameter %d" % pid)
+                raise _Reject("unknown parameter %d" % data[i])
             size += 1 + p.size
         if size > MAX_PACKET_SIZE:
             raise _Reject("report of %d bytes exceeds %d" % (size, MAX_PACKET_SIZE))
-        # pk.pack_values of the current values, without the pairs it would take
-        report = bytearray((len(ids),))
-        encode = enc.encode
-        for pid in ids:
+        # the (20,2) packet, [20][2] and pk.pack_values of the current values, written in place
+        # behind a frame's [0][0] (an integer in range packed as enc.encode packs it, anything
+        # else by enc.encode, which also raises for a value that does not fit: rejected)
+        buf = bytearray(size + 2)
+        buf[2] = pk.SERVICE_PARAMETER
+        buf[3] = pk.PARAM_REPORT
+        buf[4] = n - first
+        off = 5
+        packs = enc.PACK
+        for i in range(first, n):
+            pid = data[i]
             p = params[pid]
-            report.append(pid)
-            report += encode(p.encoding, p.value)
-        self._verify(bus, pk.ACCEPT_OK, service, subtype)
-        self._reply(bus, pk.SERVICE_PARAMETER, pk.PARAM_REPORT, report)
-        self._verify(bus, pk.COMPLETE_OK, service, subtype)
+            buf[off] = pid
+            off += 1
+            v = p.value
+            packing = packs.get(p.encoding)
+            if packing is not None and type(v) is int and packing[1] <= v <= packing[2]:
+                struct.pack_into(packing[0], buf, off, v)
+            else:
+                b = enc.encode(p.encoding, v)
+                buf[off : off + len(b)] = b
+            off += p.size
+        if size > 6:
+            self._verify(bus, pk.ACCEPT_OK, service, subtype)
+            self._reply(bus, pk.SERVICE_PARAMETER, pk.PARAM_REPORT, bytes(buf[4:]))
+            self._verify(bus, pk.COMPLETE_OK, service, subtype)
+            return
+        # one frame, [0][0][20][2][report] as split makes it, between the two verification
+        # reports from the table: three frames sent at once
+        canned = self._canned
+        key = (bus << 24) | (service << 8) | subtype
+        accept = canned.get(key | (pk.ACCEPT_OK << 16))
+        if accept is None:
+            accept = self._verification(bus, pk.ACCEPT_OK, service, subtype)
+        done = canned.get(key | (pk.COMPLETE_OK << 16))
+        if done is None:
+            done = self._verification(bus, pk.COMPLETE_OK, service, subtype)
+        out = self._frames
+        out.append(accept)
+        out.append((bus, self._rep_id, bytes(buf)))
+        out.append(done)
+        self.health[bus].tx_frames += 3  # BusHealth.sent
+        self.counters["tx"] += 3
 
     def _param_set(self, bus, service, subtype, data, now):
         values = dict(pk.unpack_values(self.nodedef, data))

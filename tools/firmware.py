@@ -47,7 +47,8 @@ UNIX_OPTIONS = (
     "MICROPY_PY_BTREE=0",
     "MICROPY_PY_FFI=0",
     "MICROPY_PY_SSL=0",
-    "MPY_CROSS_FLAGS=-msmall-int-bits=63",
+    # the core's @micropython.native hot paths freeze as machine code of the host (x86-64)
+    "MPY_CROSS_FLAGS=-march=x64 -msmall-int-bits=63",
 )
 # STM32F405RG: 1 MiB flash; sectors 1-4 (112 KiB at 0x08004000) hold the filesystem, the
 # firmware has sector 0 (16 KiB, vectors) and sectors 5-11 (896 KiB from 0x08020000).

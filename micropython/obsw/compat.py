@@ -14,6 +14,26 @@ except ImportError:
 
 MICROPYTHON = sys.implementation.name == "micropython"
 
+if MICROPYTHON:
+    import micropython  # the hot paths say @micropython.native: compiled to machine code
+else:
+
+    def _as_is(f):
+        return f
+
+    class micropython:  # noqa: N801 - stands in for the module of that name
+        """MicroPython's code emitter decorators, as no-ops where there is no such compiler.
+
+        A core module imports this name (``from obsw.compat import micropython``) and marks a
+        hot function ``@micropython.native``: MicroPython's compiler (mpy-cross with
+        ``-march``, as every image and deploy of this project gives it) emits machine code;
+        CPython runs the function as it is. Only functions that behave the same either way
+        carry it (no generators, no ``super()`` without arguments)."""
+
+        native = staticmethod(_as_is)
+        viper = staticmethod(_as_is)
+
+
 _TICKS_PERIOD = const(1 << 30)
 _TICKS_MAX = const((1 << 30) - 1)
 _TICKS_HALF = const(1 << 29)

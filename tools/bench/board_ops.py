@@ -1,41 +1,92 @@
-"""The operations tools/bench/board.py counts, run by the MicroPython interpreter under test.
+"""The operations tools/bench/board.py counts, run on the QEMU Cortex-M board (frozen core).
 
-    micropython board_ops.py OP N      set up, then run operation OP N times; prints a check line
-    micropython board_ops.py --list    the operation names
+    import board_ops; board_ops.run("frame_heartbeat", 16)   # prints the case's figures
 
-Everything before the timed loop (imports, the application's boot, the inputs) is the same
-whatever N is (every case imports every module, so every collection marks the same heap), so
-the instructions of one operation are the difference between two runs with
-different N divided by the difference of N. Every counted operation starts on a freshly
-collected heap (the collection is counted by the `gc_collect` case and subtracted), so its count
-includes sweeping its own garbage, and the same operation costs the same whatever N is. `alloc`
-after the check line is the heap allocated per operation: gc.mem_alloc() around a few
-operations with the collector off, so nothing is freed meanwhile (the same few whatever N is).
+Each operation is timed on its own: the heap is collected first (outside the count), then the
+CMSDK APB timer 0 of the MPS2 board (25 MHz, free-running down from 2**30 - 1, so its reading
+is a small int and reading it allocates nothing) is read before and after the operation, with
+the SysTick interrupt masked so that nothing else runs in between. Under QEMU's
+`-icount shift=7` every guest instruction advances the virtual clock by 128 ns, 3.2 timer
+ticks, so the tick difference fixes the instruction count exactly (board.py converts it and
+subtracts the empty case, the timer reads themselves).
+
+Printed, after all counting (printing meanwhile would wait on the UART):
+    ticks NAME t1 t2 ...      the timer ticks of each operation
+    alloc NAME BYTES          bytes allocated per operation (gc.mem_alloc around each of a few,
+                              the collector off; the board's GC allocates in 16-byte blocks)
+    heap NAME FREE            gc.mem_free() after a collection, with the case set up
+    ok NAME ...               a check line (steps, errors, HPCs, CPDU bits of the application)
+
+Frames reach the application through a hardware layer whose CAN side hands over a prepared
+frame and counts what is sent (``Feed``): it allocates nothing, so a frame's figure is the
+core's (a Pyboard's pyb.CAN recv and send come on top).
 """
 
 import gc
-import sys
 
-from obsw.frames import cltu, tc
-from obsw.pluto.interp import Procedure, load
-from obsw.pluto.system import SimulatedSystem
-from obsw.pus.tc import PusTc
-from obsw.pus.tm import PusTm
-from obsw.reconfig.app import RECORD_CONTEXT, ReconfigApp
-from obsw.reconfig.essential import HPC_LINES, TARGET_BOTH, Hpc
-from obsw.reconfig.models import ModelHal
-from obsw.reconfig.node import NODE_NOMINAL, definition
-from obsw.spacecan.controller import Controller
+import machine
+
+import micropython
+
+# Each case imports what it needs (a case runs after a soft reset): the whole core imported
+# at once would not leave a Pyboard's heap room for the application.
 
 SCID = 0x42
 RTC_2025 = 20089 * 86400  # 2025-01-01 in seconds since 1970
+EEPROM = 2048  # bytes per modelled EEPROM: room for the records, within a Pyboard's heap
+
+_mem = machine.mem32
+_TIMER = 0x40000000  # CMSDK APB timer 0 (mps2-an385): CTRL, VALUE, RELOAD
+_VALUE = 0x40000004
+_TOP = 0x3FFFFFFF  # a small int on a 32-bit port: reading it allocates nothing
+_SYST_CSR = 0xE000E010
+_TICKINT = 2
+
+
+class Feed:
+    """A hardware layer's CAN side that hands over queued frames and allocates nothing."""
+
+    def __init__(self, hal):
+        self.rx = [[], []]
+        self.pos = [0, 0]
+        self.sent = 0
+        hal.can_recv = self.recv
+        hal.can_send = self.send
+
+    def load(self, frames):
+        """``frames``: (bus, can_id, data); each bus gets its own in order."""
+        for bus, can_id, data in frames:
+            self.rx[bus].append((can_id, data))
+
+    def rewind(self):
+        self.pos[0] = 0
+        self.pos[1] = 0
+
+    @micropython.native  # a stand-in for the CAN driver, which is C on a board
+    def recv(self, bus):
+        i = self.pos[bus]
+        q = self.rx[bus]
+        if i >= len(q):
+            return None
+        self.pos[bus] = i + 1
+        return q[i]
+
+    @micropython.native
+    def send(self, bus, can_id, data):
+        self.sent += 1
+        return True
 
 
 class Rig:
     """The reconfiguration application after its boot, and a SpaceCAN controller for frames."""
 
     def __init__(self):
-        self.hal = ModelHal(rtc_seconds=RTC_2025)  # its clock moves 5 us per reading
+        from obsw.reconfig.app import ReconfigApp
+        from obsw.reconfig.models import ModelHal
+        from obsw.reconfig.node import NODE_NOMINAL, definition
+        from obsw.spacecan.controller import Controller
+
+        self.hal = ModelHal(rtc_seconds=RTC_2025, eeprom_size=EEPROM)
         self.app = ReconfigApp(self.hal)
         self.ctrl = Controller(heartbeat_period=0.5)
         self.ctrl.add_node(NODE_NOMINAL, definition(NODE_NOMINAL))
@@ -48,27 +99,13 @@ class Rig:
 
     def frames(self, make):
         """The frames the controller sends for ``make(ctrl, now)``."""
+        if make is other_node:
+            return make(self.ctrl, self.now)
         make(self.ctrl, self.now)
         out = [(bus, can_id, bytes(data)) for bus, can_id, data in self.ctrl.take_frames()]
         if not out:
             raise RuntimeError("the controller sent nothing")
         return out
-
-
-def _frame_op(rig, make):
-    frames = rig.frames(make)
-    hal = rig.hal
-    rx = hal.can_rx
-    can = rig.app._can
-    now = rig.now
-
-    def op():
-        for bus, can_id, data in frames:
-            rx[bus].append((can_id, data))
-        can(now)
-        hal.can_tx = []
-
-    return op
 
 
 def heartbeat(ctrl, now):
@@ -80,14 +117,56 @@ def sync(ctrl, now):
 
 
 def telecommand(ctrl, now):
+    from obsw.reconfig.node import NODE_NOMINAL
+
     ctrl.request_parameters(NODE_NOMINAL, [1], now)  # TC[20,1]: report the CPDU state bits
 
 
 def ping(ctrl, now):
+    from obsw.reconfig.node import NODE_NOMINAL
+
     ctrl.request(NODE_NOMINAL, 17, 1, b"", now)
 
 
+def other_node(ctrl, now):
+    # a ping to node 11 (another responder): this node only has to see that it is not its own
+    return [(0, 0x280 + 11, b"\x00\x00\x11\x01")]
+
+
+def _frame_op(rig, make):
+    # one SpaceCAN poll of the application that receives this frame (every fragment of a
+    # request) and sends the replies
+    feed = Feed(rig.hal)
+    feed.load(rig.frames(make))
+    can = rig.app._can
+    now = rig.now
+    rewind = feed.rewind
+
+    def op():
+        rewind()
+        can(now)
+
+    return op
+
+
+def _frames_op(rig, make, k):
+    # a poll that receives k frames of a kind back to back (a bus at full load)
+    feed = Feed(rig.hal)
+    frames = rig.frames(make)
+    feed.load(frames * k)
+    can = rig.app._can
+    now = rig.now
+    rewind = feed.rewind
+
+    def op():
+        rewind()
+        can(now)
+
+    return op
+
+
 def _can_idle(rig):
+    Feed(rig.hal)
     can = rig.app._can
     now = rig.now
 
@@ -98,6 +177,7 @@ def _can_idle(rig):
 
 
 def _loop_idle(rig):
+    Feed(rig.hal)
     step = rig.app.step
 
     def op():
@@ -111,28 +191,30 @@ def _loop_busy(rig):
     # report, state save, and one of each SpaceCAN frame kind on the bus
     app = rig.app
     hal = rig.hal
-    frames = []
+    feed = Feed(hal)
     for make in (heartbeat, sync, telecommand, ping):
-        frames += rig.frames(make)
-    rx = hal.can_rx
+        feed.load(rig.frames(make))
+    rewind = feed.rewind
 
     def op():
-        for bus, can_id, data in frames:
-            rx[bus].append((can_id, data))
+        rewind()
         app._next_status = 0
         app._next_report = 0
         app._next_save = 0
         app._dirty = True
         app.step()
-        hal.can_tx = []
         hal.uart_tx[0] = bytearray()
 
     return op
 
 
 def _essential(rig):
+    from obsw.frames import cltu, tc
+    from obsw.reconfig.essential import HPC_LINES, TARGET_BOTH, Hpc
+
     app = rig.app
     hal = rig.hal
+    Feed(hal)
     values = []
     for i, value in enumerate((0x0A0, 0x050)):
         hpc = Hpc(HPC_LINES, (0x0F0, value), TARGET_BOTH)
@@ -146,12 +228,13 @@ def _essential(rig):
         hal.uart_rx[0].extend(values[k])  # alternate, so every HPC changes the lines
         app.step()
         hal.uart_tx[0] = bytearray()
-        hal.can_tx = []
 
     return op
 
 
 def _sgm_write(rig):
+    from obsw.reconfig.app import RECORD_CONTEXT
+
     sgm = rig.app.sgm
     payload = b"\x00\x01\x02\x03"
 
@@ -162,6 +245,8 @@ def _sgm_write(rig):
 
 
 def _sgm_read(rig):
+    from obsw.reconfig.app import RECORD_CONTEXT
+
     sgm = rig.app.sgm
     sgm.write(RECORD_CONTEXT, b"\x00\x01\x02\x03")
 
@@ -172,6 +257,8 @@ def _sgm_read(rig):
 
 
 def _pus_tc_decode(rig):
+    from obsw.pus.tc import PusTc
+
     raw = PusTc(0x65, 17, 1, b"", 7).pack()
     unpack = PusTc.unpack
 
@@ -182,6 +269,8 @@ def _pus_tc_decode(rig):
 
 
 def _pus_tm_encode(rig):
+    from obsw.pus.tm import PusTm
+
     data = bytes(range(16))
 
     def op():
@@ -205,6 +294,9 @@ end procedure
 
 
 def _pluto(rig):
+    from obsw.pluto.interp import Procedure, load
+    from obsw.pluto.system import SimulatedSystem
+
     # one statement per operation (Procedure.step: the loop's `i := i + 1;` or its test)
     p = Procedure(load(PLUTO), SimulatedSystem({}))
     p.start(0)
@@ -216,28 +308,30 @@ def _pluto(rig):
     return op
 
 
-def _gc_collect(rig):
-    # the collections alone: run() collects before every operation
+def _nothing(rig):
     def op():
         pass
 
     return op
 
 
-def _empty(rig):
-    def op():
-        pass
+BATCH = 16  # frames per poll in the "at full load" cases
 
-    return op
-
+NO_RIG = ("pus_tc_decode", "pus_tm_encode", "pluto_statement")
 
 OPS = {
-    "empty": _empty,
-    "gc_collect": _gc_collect,
+    "empty": _nothing,
+    "gc_collect": _nothing,
     "frame_heartbeat": lambda rig: _frame_op(rig, heartbeat),
     "frame_sync": lambda rig: _frame_op(rig, sync),
     "frame_tc_20_1": lambda rig: _frame_op(rig, telecommand),
     "frame_ping_17_1": lambda rig: _frame_op(rig, ping),
+    "frame_other": lambda rig: _frame_op(rig, other_node),
+    "batch_heartbeat": lambda rig: _frames_op(rig, heartbeat, BATCH),
+    "batch_sync": lambda rig: _frames_op(rig, sync, BATCH),
+    "batch_tc_20_1": lambda rig: _frames_op(rig, telecommand, BATCH),
+    "batch_ping_17_1": lambda rig: _frames_op(rig, ping, BATCH),
+    "batch_other": lambda rig: _frames_op(rig, other_node, BATCH),
     "can_idle": _can_idle,
     "loop_idle": _loop_idle,
     "loop_busy": _loop_busy,
@@ -249,38 +343,69 @@ OPS = {
     "pluto_statement": _pluto,
 }
 
+ALLOC_OPS = 4  # operations measured for their allocations, each with the collector off
 
-ALLOC_OPS = 8  # operations measured for their allocations, gc off (the same for any N)
+
+def _timer_start():
+    _mem[_TIMER] = 0
+    _mem[_TIMER + 8] = _TOP
+    _mem[_VALUE] = _TOP
+    _mem[_TIMER] = 1  # enable, no interrupt
 
 
 def run(name, n):
-    rig = Rig()
+    rig = None if name in NO_RIG else Rig()
     op = OPS[name](rig)
     op()  # first use: anything created lazily exists before counting starts
     gc.collect()
-    gc.disable()
-    before = gc.mem_alloc() if hasattr(gc, "mem_alloc") else 0
+    free = gc.mem_free()
+    allocated = 0
     for _ in range(ALLOC_OPS):
+        gc.collect()
+        gc.disable()
+        before = gc.mem_alloc()
         op()
-    after = gc.mem_alloc() if hasattr(gc, "mem_alloc") else 0
-    gc.enable()
+        allocated += gc.mem_alloc() - before
+        gc.enable()
+    ticks = [0] * n
     collect = gc.collect
-    if name == "gc_collect":
-        for _ in range(n):
-            collect()
-    elif name == "empty":
-        for _ in range(n):
-            op()
-    else:
-        for _ in range(n):
-            collect()  # the same heap before every operation: counted apart (gc_collect)
-            op()
-    gc.enable()
+    mem = _mem
+    _timer_start()
+    csr = mem[_SYST_CSR]
+    mem[_SYST_CSR] = csr & ~_TICKINT  # nothing but the operation between the two readings
+    try:
+        if name == "gc_collect":
+            for i in range(n):
+                collect()
+                a = mem[_VALUE]
+                collect()
+                b = mem[_VALUE]
+                ticks[i] = (a - b) & _TOP
+        else:
+            for i in range(n):
+                collect()
+                a = mem[_VALUE]
+                op()
+                b = mem[_VALUE]
+                ticks[i] = (a - b) & _TOP
+        collect()
+        a = mem[_VALUE]
+        collect()
+        b = mem[_VALUE]
+        gc_ticks = (a - b) & _TOP
+    finally:
+        mem[_SYST_CSR] = csr
+    print("ticks", name, " ".join(str(t) for t in ticks))
+    print("alloc", name, allocated // ALLOC_OPS)
+    print("heap", name, free)
+    print("gc", name, gc_ticks)
+    if rig is None:
+        print("ok", name)
+        return
     app = rig.app
     print(
         "ok",
         name,
-        n,
         "steps",
         app.counters["steps"],
         "errors",
@@ -290,11 +415,3 @@ def run(name, n):
         "bits",
         app.bits,
     )
-    print("alloc", (after - before) // ALLOC_OPS)
-
-
-if __name__ == "__main__":
-    if sys.argv[1:] == ["--list"]:
-        print(" ".join(OPS))
-    else:
-        run(sys.argv[1], int(sys.argv[2]))

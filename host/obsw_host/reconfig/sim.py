@@ -8,6 +8,7 @@ controller, and CPDU line ``obc_line`` powers the OBC process (off kills it, on 
 """
 
 import os
+import platform
 import shutil
 import signal
 import subprocess
@@ -67,6 +68,10 @@ _HOST_MODULES = ("obsw_host/__init__.py", "obsw_host/reconfig/__init__.py")
 _HOST_MODULES += ("obsw_host/reconfig/simhal.py",)
 
 
+# the unix port's machine code, for the core's @micropython.native hot paths
+_MARCH = "x64" if platform.machine().lower() in ("x86_64", "amd64") else "host"
+
+
 def compile_controller(out):
     """Compile the controller's modules with mpy-cross into ``out``; False if unavailable."""
     import glob
@@ -82,7 +87,9 @@ def compile_controller(out):
                 dst = os.path.join(out, rel[:-3] + ".mpy")
                 os.makedirs(os.path.dirname(dst), exist_ok=True)
                 r = subprocess.run(
-                    [tool, "-o", dst, "-s", rel, src], capture_output=True, text=True
+                    [tool, "-march=" + _MARCH, "-o", dst, "-s", rel, src],
+                    capture_output=True,
+                    text=True,
                 )
                 if r.returncode:
                     raise RuntimeError("mpy-cross failed on %s: %s" % (rel, r.stderr.strip()))

@@ -8,7 +8,7 @@ for a while, and an unhealthy application stops kicking the watchdog.
 
 import struct
 
-from obsw.compat import const
+from obsw.compat import const, micropython
 from obsw.reconfig.cpdu import Cpdu
 from obsw.reconfig.ds3231 import DS3231, TimeSync
 from obsw.reconfig.eeprom import M24512
@@ -39,6 +39,7 @@ H_LOOP = const(0x10)
 H_IN_CHARGE = const(0x20)
 
 _STATE_FMT = ">HBBBBH"
+FRAMES_PER_BUS = const(32)  # SpaceCAN frames taken from each bus per loop pass
 
 
 def _sdls_record(security):
@@ -79,6 +80,9 @@ class ReconfigApp:
         if node_id is None:
             node_id = NODE_NOMINAL if self.role == NOMINAL else NODE_REDUNDANT
         self.node = CpduNode(self, node_id, heartbeat_period)
+        # the events _can acts on; the others (SYNC above all, a frame kind a loaded bus may
+        # carry thousands of times a second) are not built
+        self.node.responder.event_kinds = (ev.UTC, ev.SCET, ev.FUNCTION_CALL)
         self.essential = Essential(
             scid,
             self.role,
@@ -266,15 +270,22 @@ class ReconfigApp:
         self.watchdog.poll(now_us // 1000, self.healthy(now))
         return self._idle_ms(now)
 
+    @micropython.native
     def _can(self, now):
+        """One SpaceCAN pass: at most FRAMES_PER_BUS frames from each bus, then the node's
+        deadlines, the replies and the events. The bound keeps a pass short whatever the bus
+        carries (a flood waits in the controller's receive FIFO, which drops what overflows),
+        so a flood of frames cannot starve the rest of the loop and the watchdog kick."""
         hal = self.hal
         r = self.node.responder
         for bus in (0, 1):
-            for _ in range(32):
+            n = FRAMES_PER_BUS
+            while n:
                 f = hal.can_recv(bus)
                 if f is None:
                     break
                 r.receive(bus, f[0], f[1], now)
+                n -= 1
         r.poll(now)
         frames = r.take_frames()
         while frames:
@@ -296,8 +307,9 @@ class ReconfigApp:
                 self.sync.on_scet(e.value, now)
             elif k == ev.FUNCTION_CALL:
                 self._note("function %d %r -> %s" % (e.function_id, e.args, e.ok))
-        if r.health[r.active].last_heartbeat is not None:
-            self._last_heartbeat = r.health[r.active].last_heartbeat
+        last = r.health[r.monitor.active].last_heartbeat
+        if last is not None:
+            self._last_heartbeat = last
 
     def _status(self, now):
         self._next_status = now + self.status_period

@@ -2,6 +2,8 @@
 
 import struct
 
+from obsw.compat import micropython
+
 # name -> (struct code, size, signed); bool is handled by hand (MicroPython's struct has no '?')
 _TABLE = {
     "bool": (None, 1, False),
@@ -18,6 +20,22 @@ _TABLE = {
 }
 
 NAMES = tuple(_TABLE)
+
+# name -> (">" + code, lowest, highest), made once: encoding a value builds no format string
+# (for f32 and f64 the range is of no use: a caller packing an int in range packs it as struct
+# would; bool has no entry)
+PACK = {}
+for _name in _TABLE:
+    _code, _width, _signed = _TABLE[_name]
+    if _code is not None:
+        _bits = _width * 8
+        if _signed:
+            PACK[_name] = (">" + _code, -(1 << (_bits - 1)), (1 << (_bits - 1)) - 1)
+        else:
+            PACK[_name] = (">" + _code, 0, (1 << _bits) - 1)
+del _name, _code, _width, _signed, _bits
+_PARTS = {}  # encoding -> its names, for the encodings met (bounded: _PARTS_MAX)
+_PARTS_MAX = 64
 
 
 class EncodingError(ValueError):
@@ -40,7 +58,17 @@ class DecodeError(ValueError):
 
 
 def parts(encoding):
-    """Split a (possibly comma separated) encoding into its known names."""
+    """Split a (possibly comma separated) encoding into its known names (a list of the
+    caller's; see ``_names`` for the shared one)."""
+    return list(_names(encoding))
+
+
+@micropython.native
+def _names(encoding):
+    # the names of an encoding, split once per encoding met (a tuple shared by the callers)
+    got = _PARTS.get(encoding)
+    if got is not None:
+        return got
     out = []
     for name in encoding.split(","):
         name = name.strip()
@@ -49,6 +77,9 @@ def parts(encoding):
                 "unknown encoding %r, expected one of %s" % (name, ", ".join(NAMES)), name
             )
         out.append(name)
+    out = tuple(out)
+    if len(_PARTS) < _PARTS_MAX:
+        _PARTS[encoding] = out
     return out
 
 
@@ -56,42 +87,43 @@ def check(encoding):
     """Return encoding if every part is known, else raise EncodingError."""
     if not isinstance(encoding, str):
         raise EncodingError("encoding must be a string, got %r" % (encoding,), encoding)
-    parts(encoding)
+    _names(encoding)
     return encoding
 
 
 def size(encoding):
     """Encoded size in bytes."""
     n = 0
-    for name in parts(encoding):
+    for name in _names(encoding):
         n += _TABLE[name][1]
     return n
 
 
+@micropython.native
 def _encode_one(name, value):
-    code, width, signed = _TABLE[name]
-    if code is None:
+    packing = PACK.get(name)
+    if packing is None:
         if value is True or value is False or value in (0, 1):
             return b"\x01" if value else b"\x00"
         raise EncodingError("bool value must be True/False/0/1, got %r" % (value,), name, value)
-    if code in ("f", "d"):
+    fmt, lo, hi = packing
+    if name == "f32" or name == "f64":
         if not isinstance(value, (int, float)) or isinstance(value, bool):
             raise EncodingError("%s value must be a number, got %r" % (name, value), name, value)
-        return struct.pack(">" + code, value)
+        return struct.pack(fmt, value)
     if not isinstance(value, int) or isinstance(value, bool):
         raise EncodingError("%s value must be an integer, got %r" % (name, value), name, value)
-    bits = width * 8
-    lo, hi = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
     if value < lo or value > hi:
         raise EncodingError(
             "%s value out of range %d..%d: %d" % (name, lo, hi, value), name, value
         )
-    return struct.pack(">" + code, value)
+    return struct.pack(fmt, value)
 
 
+@micropython.native
 def encode(encoding, value):
     """Encode value; for a comma separated encoding value is a list or tuple of the same length."""
-    names = parts(encoding)
+    names = _names(encoding)
     if len(names) == 1:
         return _encode_one(names[0], value)
     if not isinstance(value, (list, tuple)) or len(value) != len(names):
@@ -102,17 +134,18 @@ def encode(encoding, value):
 
 
 def _decode_one(name, buf, offset):
-    code, width, _ = _TABLE[name]
+    width = _TABLE[name][1]
     if len(buf) - offset < width:
         raise DecodeError(name, width, len(buf) - offset)
-    if code is None:
+    packing = PACK.get(name)
+    if packing is None:
         return buf[offset] != 0, offset + 1
-    return struct.unpack_from(">" + code, buf, offset)[0], offset + width
+    return struct.unpack_from(packing[0], buf, offset)[0], offset + width
 
 
 def decode(encoding, buf, offset=0):
     """Decode one value at offset; return (value, next offset). Lists give a tuple value."""
-    names = parts(encoding)
+    names = _names(encoding)
     if len(names) == 1:
         return _decode_one(names[0], buf, offset)
     values = []

@@ -5,7 +5,7 @@ index 0, the same total in every frame, contiguous indices, duplicates dropped, 
 counters for every frame thrown away.
 """
 
-from obsw.compat import const
+from obsw.compat import const, micropython
 
 CHUNK = const(6)
 MAX_FRAMES = const(256)
@@ -22,6 +22,7 @@ class PacketTooLongError(ValueError):
         self.length = length
 
 
+@micropython.native
 def split(payload):
     """Return the frames' data (list of bytes) that carry payload; an empty one still gives one."""
     payload = bytes(payload)
@@ -76,9 +77,14 @@ class Reassembler:
     def _count(self, name):
         self.counters[name] += 1
 
+    @micropython.native
     def push(self, key, data, now):
         c = self.counters
         c["frames"] += 1
+        if not self._partial and len(data) >= 2 and data[0] == 0 and data[1] == 0:
+            c["packets"] += 1  # a packet of one frame, nothing pending: the usual request
+            packet = data[2:]
+            return packet if type(packet) is bytes else bytes(packet)
         if len(data) < 2:
             c["short"] += 1
             return None

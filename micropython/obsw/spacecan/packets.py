@@ -1,5 +1,6 @@
 """SpaceCAN service packets ([service][subtype][data]) and the data layouts of services 1-20."""
 
+from obsw.compat import micropython
 from obsw.spacecan import encoding as enc
 
 # Services and subtypes, named once.
@@ -100,6 +101,7 @@ def pack_ids(ids):
     return bytes([len(ids)] + ids)
 
 
+@micropython.native
 def unpack_ids(data):
     if len(data) < 1:
         raise ServicePacketError("id list needs a count byte, got no data")

@@ -85,7 +85,8 @@ class HeartbeatMonitor:
     spacecan. Since both buses are received, a heartbeat on the standby bus after the active one
     missed more than half a period more is followed at once (`follow`), and when the deadline
     passes with heartbeats present on the other bus the switch goes there, not blindly.
-    `max_switches` bounds switching without any heartbeat (None = unbounded).
+    `max_switches` bounds switching without any heartbeat (None = unbounded). The period and
+    max_miss are settings of the construction: the window they give is computed once.
     """
 
     def __init__(self, period=0.5, max_miss=3, max_switches=None, follow=True, bus=BUS_A):
@@ -93,6 +94,7 @@ class HeartbeatMonitor:
         if not isinstance(max_miss, int) or isinstance(max_miss, bool) or max_miss < 0:
             raise ConfigError("max_miss_heartbeat", "an integer >= 0", max_miss)
         self.max_miss = max_miss
+        self.window_s = (max_miss + 1) * self.period  # seconds without a heartbeat
         self.max_switches = check_max_switches(max_switches)
         self.follow = follow
         self.active = bus
@@ -102,7 +104,7 @@ class HeartbeatMonitor:
         self.switch_count = 0
 
     def window(self):
-        return (self.max_miss + 1) * self.period
+        return self.window_s
 
     def start(self, now):
         if self.period:

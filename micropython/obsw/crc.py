@@ -137,8 +137,8 @@ def _make_t2():
         base = (a << 8) & 0xFFFF
         k = a >> 8
         t2.extend([base ^ t1[k ^ lo] for lo in range(256)])  # two message bytes in one step
+    _WORDS = [struct.Struct(">%dH" % k) for k in range(_NWORDS)]  # set before _T2 says ready
     _T2 = array("H", t2)
-    _WORDS = [struct.Struct(">%dH" % k) for k in range(_NWORDS)]
     return _T2
 
 

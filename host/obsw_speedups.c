@@ -1030,6 +1030,52 @@ cbor_loads(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     return v;
 }
 
+/* cbor_frame_loads(data, declined, max_frame) -> the value of the one length-prefixed frame
+ * data holds exactly (4-byte big-endian length, then one CBOR item), or declined: for anything
+ * else (several frames, a part of one, a length above max_frame, a value cbor_loads declines)
+ * the Python reader takes over and decides. */
+static PyObject *
+cbor_frame_loads(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    Py_buffer view;
+    Py_ssize_t pos = 4;
+    PyObject *v = NULL;
+    const unsigned char *p;
+    unsigned long long length;
+    long long limit;
+    int rc;
+    (void)self;
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "cbor_frame_loads takes 3 arguments");
+        return NULL;
+    }
+    limit = PyLong_AsLongLong(args[2]);
+    if (limit == -1 && PyErr_Occurred())
+        return NULL;
+    if (octets_of(args[0], &view))
+        return Py_NewRef(args[1]);
+    p = (const unsigned char *)view.buf;
+    if (view.len < 5) {
+        PyBuffer_Release(&view);
+        return Py_NewRef(args[1]);
+    }
+    length = ((unsigned long long)p[0] << 24) | ((unsigned long long)p[1] << 16) |
+             ((unsigned long long)p[2] << 8) | (unsigned long long)p[3];
+    if (length + 4 != (unsigned long long)view.len || (long long)length > limit) {
+        PyBuffer_Release(&view);
+        return Py_NewRef(args[1]);
+    }
+    rc = cd_item(p, view.len, &pos, CBOR_MAX_DEPTH, &v);
+    PyBuffer_Release(&view);
+    if (rc < 0)
+        return NULL;
+    if (rc == 0 || pos != view.len) {
+        Py_XDECREF(v);
+        return Py_NewRef(args[1]);
+    }
+    return v;
+}
+
 #define FASTCALL(f) (PyCFunction)(void (*)(void))(f), METH_FASTCALL
 
 static PyMethodDef methods[] = {
@@ -1041,6 +1087,8 @@ static PyMethodDef methods[] = {
     {"tm_unpack", FASTCALL(tm_unpack), "Decode a well-formed TM into cls, or None."},
     {"cbor_frame", cbor_frame, METH_O, "Length-prefixed deterministic CBOR, or None."},
     {"cbor_loads", FASTCALL(cbor_loads), "Decode one CBOR item, or return the second arg."},
+    {"cbor_frame_loads", FASTCALL(cbor_frame_loads),
+     "Decode the one whole length-prefixed frame data holds, or return the second arg."},
     {"crc16_ccitt", crc16_ccitt, METH_VARARGS, "CRC-16/CCITT-FALSE continuing a register."},
     {NULL, NULL, 0, NULL},
 };

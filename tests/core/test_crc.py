@@ -83,6 +83,31 @@ class TestRunningValues(unittest.TestCase):
                 self.assertEqual(fast(s), pure(s))
                 self.assertEqual(fast(s[3:], fast(s[:3])), pure(s[3:], pure(s[:3])))
 
+    def test_crc16_every_length_and_buffer_kind(self):
+        # the pure CRC-16 takes one byte, two bytes or (CPython) bit planes per step depending
+        # on the length and its parity; every way must equal the shift register, for any start
+        # register and for bytes, bytearray and memoryview alike
+        data = bytes((i * 89 + 7) & 0xFF for i in range(300))
+        fns = [crc.crc16_ccitt_update, crc._crc16_bytes]
+        if not crc.MICROPYTHON:
+            fns += [crc._crc16_words]
+        for n in list(range(0, 70)) + [127, 128, 255, 300]:
+            s = data[:n]
+            for reg in (0xFFFF, 0, 0x1D0F):
+                want = _bitwise_msb(s, 16, 0x1021, reg)
+                for f in fns:
+                    self.assertEqual(f(s, reg), want)
+                    self.assertEqual(f(bytearray(s), reg), want)
+                    self.assertEqual(f(memoryview(b"x" + s)[1:], reg), want)
+
+    def test_crc16_long_input(self):
+        # longer than the bit planes cover at once (4 KiB): taken in chunks
+        data = bytes((i * 31 + 5) & 0xFF for i in range(9001))
+        want = _bitwise_msb(data, 16, 0x1021, 0xFFFF)
+        self.assertEqual(crc.crc16_ccitt_update(data, 0xFFFF), want)
+        self.assertEqual(crc.crc16_ccitt(data), want)
+        self.assertEqual(crc.crc16_ccitt(data[5000:], crc.crc16_ccitt(data[:5000])), want)
+
 
 class TestCfdpChecksums(unittest.TestCase):
     def test_modular_sums_aligned_words(self):

@@ -218,3 +218,34 @@ def test_c_path_declines_what_only_python_knows():
     assert C.cbor_loads(b"\x01\x02", DECLINED) is DECLINED  # trailing data
     with pytest.raises(cbor.CborDecodeError):
         wire.loads(b"\x62\xff\xfe")
+
+
+@needs_c
+@SETTINGS
+@given(values, st.booleans())
+def test_c_whole_frame_decodes_like_the_reader_or_declines(v, canonical):
+    body = cbor2.dumps(v, canonical=canonical)
+    data = len(body).to_bytes(4, "big") + body
+    got = C.cbor_frame_loads(data, DECLINED, wire.MAX_FRAME)
+    assert got is DECLINED or same(got, cbor2.loads(body))
+    assert [same(m, cbor2.loads(body)) for m in wire.FrameReader().feed(data)] == [True]
+
+
+@needs_c
+@SETTINGS
+@given(st.binary(max_size=64))
+def test_c_whole_frame_on_random_bytes_agrees_or_declines(data):
+    got = C.cbor_frame_loads(data, DECLINED, wire.MAX_FRAME)
+    if got is not DECLINED:
+        assert len(data) >= 5 and int.from_bytes(data[:4], "big") == len(data) - 4
+        assert same(got, cbor2.loads(data[4:]))
+
+
+@needs_c
+def test_c_whole_frame_declines_anything_but_one_whole_frame():
+    one = wire.frame([1, "a"])
+    for data in (one + one, one[:-1], one[:4], b"", bytearray(one[:3])):
+        assert C.cbor_frame_loads(data, DECLINED, wire.MAX_FRAME) is DECLINED
+    assert C.cbor_frame_loads(one, DECLINED, 1) is DECLINED  # above the frame limit
+    assert C.cbor_frame_loads(bytearray(one), DECLINED, wire.MAX_FRAME) == [1, "a"]
+    assert C.cbor_frame_loads(memoryview(one), DECLINED, wire.MAX_FRAME) == [1, "a"]

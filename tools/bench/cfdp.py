@@ -389,17 +389,18 @@ def main():
                 extra = []
                 # short transfers are noisy: more runs for the median
                 nruns = (3 if args.quick else 7) if mib == 1 else runs
+                peer = []
+                prun = 1 if mib >= 10 else nruns
+                # interleaved, so that both see the same machine load
                 for r in range(nruns):
                     dt, ok, retx, dropped = obsw_transfer(data, mode, loss, 10 + r)
                     if not ok:
                         raise SystemExit("obsw transfer failed: " + case)
                     ours.append(len(data) / dt / 1e6)
                     extra.append(retx / dropped if dropped else 1.0)
-                peer = []
-                prun = 1 if mib >= 10 else nruns
-                for r in range(prun):
-                    dt, ok, _, _ = peer_transfer(data, mode, loss, 10 + r)
-                    peer.append(len(data) / dt / 1e6 if ok else 0.0)
+                    if r < prun:
+                        dt, ok, _, _ = peer_transfer(data, mode, loss, 10 + r)
+                        peer.append(len(data) / dt / 1e6 if ok else 0.0)
                 o = statistics.median(ours)
                 p = statistics.median(peer)
                 add(case, "obsw", o, "MB/s")
@@ -425,8 +426,9 @@ def main():
                     table.append((case + ": vs own lossless", o / own_lossless[mode], None, ""))
     n = 2000 if args.quick else 10000
     for case, ours, peer in codec_rates(n):
-        o = statistics.median([_rate(ours, n) for _ in range(runs)])
-        p = statistics.median([_rate(peer, n) for _ in range(runs)])
+        pairs = [(_rate(ours, n), _rate(peer, n)) for _ in range(max(runs, 3))]
+        o = statistics.median([a for a, _ in pairs])
+        p = statistics.median([b for _, b in pairs])
         add(case, "obsw", o, "PDU/s")
         add(case, PEER, p, "PDU/s")
         table.append((case, o, p, "PDU/s"))

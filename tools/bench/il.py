@@ -1,6 +1,6 @@
 """Benchmark of the interaction layer next to the thesis design (pyzmq REQ/REP, PUB/SUB + JSON).
 
-Cases, each measured for obsw and for pyzmq+JSON in the same run (medians of several runs):
+Cases, each measured for obsw and for pyzmq+JSON in the same run, in short interleaved runs:
   round trips, 1 process     a synchronous call and its reply (ZeroMQ: REP served by a thread)
   round trips, 2 processes   the same, the provider in a child process (Unix socket / ipc://)
   fan-out, 1 process         publications delivered per second to N subscribers
@@ -395,23 +395,36 @@ class ZmqRemote:
 
 
 def paired(ours, theirs, runs):
-    """Medians of ``runs`` alternating runs, so both see the same machine load."""
-    a, b = [], []
-    for _ in range(runs):
-        a.append(ours())
-        b.append(theirs())
-    return statistics.median(a), statistics.median(b)
+    """Interleaved short runs of both implementations, so both see the same machine load.
+
+    Each pair runs the two back to back, the order alternating from pair to pair; the result
+    is the median rate of each and the median of the per-pair ratios (the ratio of two runs a
+    moment apart, which a change of load between pairs does not skew)."""
+    a, b, r = [], [], []
+    for i in range(runs):
+        if i & 1:
+            y = theirs()
+            x = ours()
+        else:
+            x = ours()
+            y = theirs()
+        a.append(x)
+        b.append(y)
+        r.append(x / y)
+    return statistics.median(a), statistics.median(b), statistics.median(r)
 
 
 def measure(quick, subs):
-    runs = 3 if quick else 7
-    n_rt = 5000 if quick else 20000
-    n_rt_local = 20000 if quick else 200000
-    n_pub = 2000 if quick else 10000
+    # many short interleaved runs rather than a few long ones: on a shared machine the load
+    # changes within seconds
+    runs = 9 if quick else 21
+    n_rt = 1500 if quick else 4000
+    n_rt_local = 20000 if quick else 50000
+    n_pub = 1000 if quick else 3000
     rows = []
 
     def add(case, unit, values):
-        rows.append((case, unit, values[0], values[1]))
+        rows.append((case, unit) + tuple(values))
 
     # the cross-process cases first, in a fresh interpreter: the garbage of the in-process
     # runs would otherwise slow the socket loops of both implementations
@@ -465,7 +478,7 @@ def main(argv=None):
     rows = measure(args.quick, args.subscribers)
     if args.json:
         out = []
-        for case, unit, ours, theirs in rows:
+        for case, unit, ours, theirs, ratio in rows:
             out.append(
                 {
                     "case": case,
@@ -473,6 +486,7 @@ def main(argv=None):
                     "value": ours,
                     "unit": unit,
                     "higher_is_better": True,
+                    "ratio": round(ratio, 2),
                 }
             )
             out.append(
@@ -488,8 +502,9 @@ def main(argv=None):
         return 0
     print("interaction layer (codec %s); pyzmq+JSON = the thesis design" % CODEC)
     print("%-36s %14s %14s %7s  %s" % ("case", "obsw", "pyzmq+JSON", "ratio", "unit"))
-    for case, unit, ours, theirs in rows:
-        print("%-36s %14.0f %14.0f %6.1fx  %s" % (case, ours, theirs, ours / theirs, unit))
+    for case, unit, ours, theirs, ratio in rows:
+        print("%-36s %14.0f %14.0f %6.1fx  %s" % (case, ours, theirs, ratio, unit))
+    print("(ratio: median of the ratios of interleaved pairs of runs)")
     return 0
 
 

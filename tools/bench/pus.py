@@ -2,9 +2,11 @@
 
 Each round trip builds a packet object from field values, packs it, unpacks the bytes and reads
 the fields back. The reference is hand-written `struct` code doing the same with the same CRC
-function obsw uses (obsw.crc.crc16_ccitt_update, binascii.crc_hqx on CPython). TM[3,25]
-carries a 16-bit structure ID and 16 uint32
-parameters, encoded once up front and the same bytes for every implementation.
+function obsw uses (obsw.crc.crc16_ccitt_update, binascii.crc_hqx on CPython, pure Python with
+OBSW_PURE=1). "spacepackets, same CRC" is spacepackets with its compiled CRC (fastcrc, Rust)
+replaced by that same function too, so that with OBSW_PURE=1 both pay a pure-Python CRC and
+without it both a C one. TM[3,25] carries a 16-bit structure ID and 16 uint32 parameters,
+encoded once up front and the same bytes for every implementation.
 
 Usage: python tools/bench/pus.py [--quick] [--json]
 """
@@ -156,6 +158,35 @@ def spacepackets_tm(service, subtype, data):
     return run
 
 
+class _SameCrc16:
+    """Stands in for fastcrc's ``crc16`` module in spacepackets: its ibm_3740 (that is
+    CRC-16/CCITT-FALSE) computed by the function obsw uses, so that both pay the same CRC."""
+
+    @staticmethod
+    def ibm_3740(data, initial=None):
+        return crc16_ccitt_update(data, 0xFFFF if initial is None else initial)
+
+
+def _same_crc(make):
+    def factory(service, subtype, data):
+        import spacepackets.ecss.tc as sp_tc
+        import spacepackets.ecss.tm as sp_tm
+
+        inner = make(service, subtype, data)
+
+        def run(n):
+            saved = sp_tc.crc16, sp_tm.crc16
+            sp_tc.crc16 = sp_tm.crc16 = _SameCrc16
+            try:
+                inner(n)
+            finally:
+                sp_tc.crc16, sp_tm.crc16 = saved
+
+        return run
+
+    return factory
+
+
 # --- puslib ------------------------------------------------------------------------------------
 def puslib_tc(service, subtype, data):
     from puslib.packet import AckFlag, PusTcPacket
@@ -210,6 +241,7 @@ IMPLS = (
     ("obsw", obsw_tc, obsw_tm),
     ("reference", reference_tc, reference_tm),
     ("spacepackets", spacepackets_tc, spacepackets_tm),
+    ("spacepackets, same CRC", _same_crc(spacepackets_tc), _same_crc(spacepackets_tm)),
     ("puslib", puslib_tc, puslib_tm),
 )
 
@@ -271,13 +303,13 @@ def main(argv=None):
     if args.json:
         print(json.dumps({"bench": "pus", "rows": rows}))
         return 0
-    print("%-22s %-13s %14s %12s" % ("case", "impl", "round trips/s", "obsw ratio"))
+    print("%-22s %-23s %14s %12s" % ("case", "impl", "round trips/s", "obsw ratio"))
     for case, *_ in CASES:
         mine = [r for r in rows if r["case"] == case]
         ours = next(r["value"] for r in mine if r["impl"] == "obsw")
         for r in mine:
             ratio = "" if r["impl"] == "obsw" else "%.2fx" % (ours / r["value"])
-            print("%-22s %-13s %14.0f %12s" % (case, r["impl"], r["value"], ratio))
+            print("%-22s %-23s %14.0f %12s" % (case, r["impl"], r["value"], ratio))
     return 0
 
 

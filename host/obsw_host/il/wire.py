@@ -73,6 +73,8 @@ CODEC = "cbor2" if cbor2 is not None and os.environ.get("OBSW_IL_CODEC") != "cor
 _C = speedups() if CODEC == "cbor2" else None
 _c_frame = _C.cbor_frame if _C is not None else None
 _c_loads = _C.cbor_loads if _C is not None else None
+# a reader's usual case in one C call: one whole frame, decoded (older builds lack it)
+_c_frame_loads = getattr(_C, "cbor_frame_loads", None)
 _DECLINED = object()
 
 
@@ -118,6 +120,10 @@ class FrameReader:
     def feed(self, data):
         """Add ``data``; return the list of messages completed by it."""
         buf = self._buf
+        if not buf and _c_frame_loads is not None:
+            v = _c_frame_loads(data, _DECLINED, MAX_FRAME)
+            if v is not _DECLINED:
+                return [v]
         if not buf and len(data) >= 4:
             # the usual case: one read holds exactly one frame, decoded without buffering
             (length,) = _LEN.unpack_from(data, 0)

@@ -37,15 +37,18 @@ def _classes():
 
 
 _DIRECTIVES = {}
+_FILE_DATA = []  # FileDataPdu.from_body, once imported
 
 
 def decode_pdu(buf):
     """Decode any CFDP PDU; raises a ``CfdpError`` subclass for malformed input."""
     header, body = split_pdu(buf)
     if header.pdu_type == FILE_DATA:
-        from obsw.cfdp.pdu.filedata import FileDataPdu
+        if not _FILE_DATA:
+            from obsw.cfdp.pdu.filedata import FileDataPdu
 
-        return FileDataPdu.from_body(header, body)
+            _FILE_DATA.append(FileDataPdu.from_body)
+        return _FILE_DATA[0](header, body)
     if not body:
         raise PduTooShortError("file directive PDU data field", 1, 0)
     if not _DIRECTIVES:

@@ -2,6 +2,10 @@
 
 from obsw.cfdp.defs import FILE_DATA, PduFormatError, PduTooShortError
 from obsw.cfdp.pdu.header import Pdu, fss_pack, fss_unpack
+from obsw.compat import Struct
+
+_OFFSET = Struct(">I")
+_new = object.__new__
 
 
 class FileDataPdu(Pdu):
@@ -31,6 +35,15 @@ class FileDataPdu(Pdu):
     def from_body(cls, header, body):
         if header.pdu_type != FILE_DATA:
             raise PduFormatError("File Data PDU needs PDU type 1, got a file directive")
+        if not (header.seg_meta or header.large) and len(body) >= 4:
+            # the usual segment: a 32-bit offset and the data, built without __init__
+            pdu = _new(cls)
+            pdu.header = header
+            pdu.offset = _OFFSET.unpack_from(body, 0)[0]
+            pdu.data = bytes(body[4:])
+            pdu.rcs = 0
+            pdu.segment_metadata = b""
+            return pdu
         pos = 0
         rcs = 0
         meta = b""

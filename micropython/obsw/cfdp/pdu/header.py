@@ -11,7 +11,11 @@ from obsw.cfdp.defs import (
     PduFormatError,
     PduTooShortError,
 )
+from obsw.compat import Struct
 from obsw.crc import crc16_ccitt
+
+_HEAD = Struct(">BHB")
+_new = object.__new__
 
 
 def int_len(value):
@@ -141,30 +145,37 @@ class PduHeader:
 
     @classmethod
     def unpack(cls, buf):
-        if len(buf) < 4:
-            raise PduTooShortError("PDU header", 4, len(buf))
-        b0, data_len, b3 = struct.unpack_from(">BHB", buf, 0)
+        n = len(buf)
+        if n < 4:
+            raise PduTooShortError("PDU header", 4, n)
+        b0, data_len, b3 = _HEAD.unpack_from(buf, 0)
         if b0 >> 5 != VERSION:
             raise PduFormatError("PDU version %d, expected %d" % (b0 >> 5, VERSION))
         e = ((b3 >> 4) & 7) + 1
         s = (b3 & 7) + 1
         size = 4 + 2 * e + s
-        if len(buf) < size:
-            raise PduTooShortError("PDU header", size, len(buf))
-        h = cls(
-            uint_from(buf, 4, e),
-            uint_from(buf, 4 + e + s, e),
-            uint_from(buf, 4 + e, s),
-            pdu_type=(b0 >> 4) & 1,
-            direction=(b0 >> 3) & 1,
-            mode=(b0 >> 2) & 1,
-            crc=(b0 >> 1) & 1,
-            large=b0 & 1,
-            seg_ctrl=b3 >> 7,
-            seg_meta=(b3 >> 3) & 1,
-            eid_len=e,
-            seq_len=s,
-        )
+        if n < size:
+            raise PduTooShortError("PDU header", size, n)
+        # the fields straight into a new object (no keyword call, no range checks: every
+        # value a header can carry is a valid one)
+        h = _new(cls)
+        if e == 1 and s == 1:
+            h.source = buf[4]
+            h.seq = buf[5]
+            h.dest = buf[6]
+        else:
+            h.source = uint_from(buf, 4, e)
+            h.seq = uint_from(buf, 4 + e, s)
+            h.dest = uint_from(buf, 4 + e + s, e)
+        h.pdu_type = (b0 >> 4) & 1
+        h.direction = (b0 >> 3) & 1
+        h.mode = (b0 >> 2) & 1
+        h.crc = bool(b0 & 2)
+        h.large = bool(b0 & 1)
+        h.seg_ctrl = bool(b3 & 0x80)
+        h.seg_meta = bool(b3 & 8)
+        h.eid_len = e
+        h.seq_len = s
         h.data_len = data_len
         return h
 
@@ -188,7 +199,7 @@ class PduHeader:
 def split_pdu(buf):
     """Header and data field (a memoryview without the CRC) of one PDU; checks lengths and CRC."""
     h = PduHeader.unpack(buf)
-    hl = h.length
+    hl = 4 + 2 * h.eid_len + h.seq_len
     end = hl + h.data_len
     if len(buf) < end:
         raise PduTooShortError("PDU", end, len(buf))

@@ -153,6 +153,40 @@ def _stage_dir(name):
     return d
 
 
+BATCH = 12  # test files per mpremote session (each after a soft reset): a session costs ~1 s
+MARK = "== obsw test file "
+
+
+def _board_code(name):
+    skips = {k: v for k, v in CORTEX_M_SKIPS.items() if k.split("::")[0] == name}
+    return (
+        "import time; print(%r); t = time.ticks_ms(); import obsw_run_tests as r; "
+        "r.main([%r], %r, %d); print('board time', time.ticks_diff(time.ticks_ms(), t))"
+        % (MARK + name, name, skips, GC_THRESHOLD)
+    )
+
+
+def _run_batch(q, paths, from_source):
+    """One mpremote session: per file a soft reset (a fresh heap), the file copied when it is
+    not frozen, and the board's runner. Returns {name: output}."""
+    args = []
+    for path in paths:
+        args += ["soft-reset", "+"]
+        if path.name in from_source:
+            args += ["cp", str(path), ":" + path.name, "+"]
+        args += ["exec", _board_code(path.name), "+"]
+    rc, out = firmware.mpremote(q.pty, *args[:-1], timeout=60 + 90 * len(paths))
+    found = {}
+    name = None
+    for line in out.splitlines():
+        if line.startswith(MARK):
+            name = line[len(MARK) :].strip()
+            found[name] = []
+        elif name is not None:
+            found[name].append(line)
+    return rc, {k: "\n".join(v) for k, v in found.items()}, out
+
+
 def stage_cortex_m():
     t0 = time.monotonic()
     try:
@@ -162,33 +196,43 @@ def stage_cortex_m():
         return _close("cortex-m", t0, 0, 1)
     from_source = firmware.stage_board_tests()  # tests that cannot be frozen: copied, compiled
     passed = failed = skipped = 0
+    reasons = {}  # skip reason -> tests skipped for it
     q = firmware.Qemu(elf)
     try:
-        for path in CORE_TESTS:
-            name = path.name
-            skips = {k: v for k, v in CORTEX_M_SKIPS.items() if k.split("::")[0] == name}
-            code = "import obsw_run_tests as r; r.main([%r], %r, %d)" % (name, skips, GC_THRESHOLD)
-            t1 = time.monotonic()
-            pre = ["cp", str(path), ":" + name, "+"] if name in from_source else []
-            rc, out = firmware.mpremote(q.pty, *pre, "exec", code, timeout=90)
-            c = _counts(out)
-            if c is None:
-                failed += 1
-                print("FAIL %s (no result, status %d):\n%s" % (name, rc, out[-1500:]))
-                q.close()
-                q = firmware.Qemu(elf)
-                continue
-            passed, failed, skipped = passed + c[0], failed + c[1], skipped + c[2]
-            for line in out.splitlines():
-                if (
-                    line.startswith(("FAIL", "skip", "Traceback", "MemoryError"))
-                    or "Error" in line
-                ):
-                    print("  " + line)
-            print(
-                "%-40s %3d passed %3d failed %3d skipped %5.1f s"
-                % (name, *c, time.monotonic() - t1)
-            )
+        for i in range(0, len(CORE_TESTS), BATCH):
+            batch = CORE_TESTS[i : i + BATCH]
+            rc, outs, raw = _run_batch(q, batch, from_source)
+            for path in batch:
+                name = path.name
+                out = outs.get(name, "")
+                c = _counts(out)
+                if c is None or not out.rstrip().splitlines()[-1].startswith("board time"):
+                    # no result (a crash, a hang): alone on a fresh board, once
+                    q.close()
+                    q = firmware.Qemu(elf)
+                    rc, again, raw = _run_batch(q, [path], from_source)
+                    out = again.get(name, "")
+                    c = _counts(out)
+                    if c is None:
+                        failed += 1
+                        print("FAIL %s (no result, status %d):\n%s" % (name, rc, raw[-1500:]))
+                        q.close()
+                        q = firmware.Qemu(elf)
+                        continue
+                passed, failed, skipped = passed + c[0], failed + c[1], skipped + c[2]
+                ms = 0
+                for line in out.splitlines():
+                    if line.startswith("board time"):
+                        ms = int(line.split()[-1])
+                    elif line.startswith("skip "):
+                        reason = line.split(": ", 1)[-1]
+                        reasons[reason] = reasons.get(reason, 0) + 1
+                    elif line.startswith(("FAIL", "Traceback", "MemoryError")) or "Error" in line:
+                        print("  " + line)
+                print("%-40s %3d passed %3d failed %3d skipped %5.1f s" % (name, *c, ms / 1000))
+        print("skipped on the board (a file counts once):")
+        for reason, n in sorted(reasons.items(), key=lambda kv: -kv[1]):
+            print("  %3d  %s" % (n, reason))
         p, f = board_tools(q.pty)
         passed, failed = passed + p, failed + f
     finally:

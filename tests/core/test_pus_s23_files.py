@@ -24,22 +24,11 @@ from pus_loop import APID
 from store_sim import SimFs
 
 DATA = payload(3000)
-_BIG = []
+BIG = payload(40000, seed=9)
 
 
-def big():
-    """A 40,000-byte file, made once, by the tests that copy it (not at import: a board's heap
-    holds the other tests without it)."""
-    if not _BIG:
-        _BIG.append(payload(40000, seed=9))
-    return _BIG[0]
-
-
-def make(with_big=False, **kw):
-    files = {"data/a.bin": DATA}
-    if with_big:
-        files["big.bin"] = big()
-    fl = FilesLoop(sat_files=files, **kw)
+def make(**kw):
+    fl = FilesLoop(sat_files={"data/a.bin": DATA, "big.bin": BIG}, **kw)
     fl.sat_ent.fs.dirs.add("data")
     fl.ground_ent.fs.dirs.add("down")
     return fl
@@ -191,12 +180,12 @@ class TestRemoteCopies(unittest.TestCase):
         self.assertEqual(fl.event_ids(2), [EVENT_COPY_FAILED])
 
     def test_suspend_resume_and_status_reports(self):
-        fl = make(with_big=True, max_segment=64)
+        fl = make(max_segment=64)
         u = fl.user
         fl.run(lambda: u.enable_reports(APID, 3))
         fl.run(
             lambda: u.copy(APID, 1, "SAT:/big.bin", "GROUND:/big.bin"),
-            until=lambda: 0 < fl.files.ops.get(1, {}).get("bytes", 0) < len(big()),
+            until=lambda: 0 < fl.files.ops.get(1, {}).get("bytes", 0) < len(BIG),
         )
         tx = fl.run(lambda: u.suspend(APID, [1]))
         self.assertTrue(tx.ok)
@@ -210,7 +199,7 @@ class TestRemoteCopies(unittest.TestCase):
         self.assertEqual(tx.failure["code"], 13)  # the component: not active
         tx = fl.run(lambda: u.resume(APID, [1]), until=lambda: status(fl, 1) == COPY_COMPLETED)
         self.assertTrue(tx.ok)
-        self.assertEqual(bytes(fl.ground_ent.fs.files["big.bin"]), big())
+        self.assertEqual(bytes(fl.ground_ent.fs.files["big.bin"]), BIG)
         seen = [o["status"] for d in fl.loop.unsolicited(23, 23) for o in d["operations"]]
         self.assertIn(COPY_IN_PROGRESS, seen)
         self.assertIn(COPY_SUSPENDED, seen)
@@ -223,7 +212,7 @@ class TestRemoteCopies(unittest.TestCase):
         self.assertEqual(tx.failure["code"], FAILURE_UNKNOWN_ID)
 
     def test_abort_in_path_and_move(self):
-        fl = make(with_big=True, max_segment=64)
+        fl = make(max_segment=64)
         u = fl.user
         fl.run(
             lambda: u.copy(APID, 1, "SAT:/big.bin", "GROUND:/big.bin"),
@@ -250,7 +239,7 @@ class TestRemoteCopies(unittest.TestCase):
 
 class TestRestarts(unittest.TestCase):
     def test_cfdp_entity_restarts_during_a_copy(self):
-        fl = make(with_big=True, max_segment=64, loss=0.05, seed=2)
+        fl = make(max_segment=64, loss=0.05, seed=2)
         u = fl.user
         fl.run(
             lambda: u.copy(APID, 1, "SAT:/big.bin", "GROUND:/big.bin"),
@@ -259,12 +248,12 @@ class TestRestarts(unittest.TestCase):
         fl.restart_cfdp()
         self.assertEqual(fl.copy.status("2:1")["state"], "active")
         fl.run(until=lambda: status(fl, 1) == COPY_COMPLETED)
-        self.assertEqual(bytes(fl.ground_ent.fs.files["big.bin"]), big())
+        self.assertEqual(bytes(fl.ground_ent.fs.files["big.bin"]), BIG)
 
     def test_pus_process_restarts_during_a_get(self):
         fs = SimFs()
         fl = make(max_segment=64, store=Store("/ctx", fs))
-        fl.ground_ent.fs.files["up.bin"] = bytearray(big())
+        fl.ground_ent.fs.files["up.bin"] = bytearray(BIG)
         u = fl.user
         fl.run(
             lambda: u.copy(APID, 5, "GROUND:/up.bin", "SAT:/up.bin"),
@@ -274,8 +263,8 @@ class TestRestarts(unittest.TestCase):
         op = fl.files.ops[5]
         self.assertEqual((op["kind"], op["transfer"]), ("get", "2:1"))
         fl.run(until=lambda: status(fl, 5) == COPY_COMPLETED)
-        self.assertEqual(bytes(fl.sat_ent.fs.files["up.bin"]), big())
-        self.assertEqual(fl.files.ops[5]["bytes"], len(big()))
+        self.assertEqual(bytes(fl.sat_ent.fs.files["up.bin"]), BIG)
+        self.assertEqual(fl.files.ops[5]["bytes"], len(BIG))
 
 
 if __name__ == "__main__":

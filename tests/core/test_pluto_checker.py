@@ -3,8 +3,8 @@
 import unittest
 
 from obsw.pluto.checker import PlutoReferenceError, PlutoTypeError
-from obsw.pluto.interp import load
-from obsw.pluto.system import SimulatedSystem
+from obsw.pluto.interp import Procedure, load
+from obsw.pluto.system import SimulatedSystem, run_virtual
 
 SYSTEM = SimulatedSystem(
     {
@@ -23,6 +23,55 @@ def step(main, decl=""):
         "procedure\ninitiate and confirm step S\n%s\nmain\n%s\nend main\nend step;\nend procedure"
         % ("declare %s end declare" % decl if decl else "", main)
     )
+
+
+V = "variable x of type signed integer"
+
+
+def deepest(make):
+    """The deepest nesting of ``make(n)`` the loader takes (its MAX_NESTING)."""
+    from obsw.pluto.lexer import PlutoSyntaxError
+
+    n = 1
+    while True:
+        try:
+            load(make(n + 1))
+        except PlutoSyntaxError as e:
+            if "nesting" not in e.msg:
+                raise
+            return n
+        n += 1
+
+
+def parens(n):
+    return "(" * n + "x" + ")" * n
+
+
+def ifs(n, body):
+    return "if x > 0 then " * n + body + " end if;" * n
+
+
+class TestNestingLimit(unittest.TestCase):
+    """Whatever nesting the loader takes, the parser, the checker and the interpreter walk on
+    a board's C stack (the Cortex-M stage runs this with the Pyboard's 15,360 bytes)."""
+
+    def check(self, make):
+        n = deepest(make)
+        sim = SimulatedSystem()  # its clock starts at 0: exact on single-precision boards too
+        p = Procedure(load(make(n)), sim)
+        p.start(sim.now)
+        run_virtual(p, sim)
+        self.assertEqual((p.outcome, sim.logs), ("confirmed", ["7"]))
+        return n
+
+    def test_parentheses(self):
+        self.assertTrue(self.check(lambda n: step("x := 7; log %s;" % parens(n), V)) >= 8)
+
+    def test_blocks(self):
+        self.assertTrue(self.check(lambda n: step("x := 7; " + ifs(n, "log x;"), V)) >= 8)
+
+    def test_blocks_and_parentheses(self):
+        self.check(lambda n: step("x := 7; " + ifs(n // 2, "log %s;" % parens(n - n // 2)), V))
 
 
 class TestRejections(unittest.TestCase):

@@ -14,6 +14,8 @@ RESERVED = set(
 )
 OBJECT_TYPES = ("variable", "parameter", "argument", "activity", "event", "step")
 RELOPS = ("=", "!=", "<", ">", "<=", ">=")
+_LOGIC = {"OR": 1, "XOR": 2, "AND": 3}
+_ARITH = {"+": 1, "-": 1, "*": 2, "/": 2, "**": 3}
 _TIME_ORDER = ("d", "h", "min", "s")
 SUBJECT = ("subj", 0)  # the value a case statement tests, in its case tags
 # Deepest nesting of blocks, parentheses and operators the parser takes: the parser, the
@@ -107,29 +109,26 @@ class ExprParser:
         return ["r", p, tuple(names), otype, None, None]
 
     # expressions: OR < XOR < AND < relational < + - < * / < ** < unary, left associative
-    def expr(self):
-        return self._binary(0)
-
-    _LEVELS = (("OR",), ("XOR",), ("AND",))
-
-    def _binary(self, level):
-        if level == 3:
-            return self.relational()
-        left = self._binary(level + 1)
-        ops = self._LEVELS[level]
-        while self.toks[self.i][0] == WORD and self.toks[self.i][1] in ops:
-            p, op = self.pos(), self.toks[self.i][1]
+    # but **. Precedence climbing keeps the Python calls per parenthesis to four (expr,
+    # relational, _arith, _simple): each costs C stack on MicroPython, and a Pyboard has 15 KiB.
+    def expr(self, min_prec=1, operand=None):
+        """A logical expression over relations, or over ``operand()`` (a case tag's)."""
+        left = operand() if operand else self.relational()
+        while True:
+            t = self.toks[self.i]
+            prec = _LOGIC.get(t[1], 0) if t[0] == WORD else 0
+            if prec < min_prec:
+                return left
             self.i += 1
-            left = ("l", p, op, left, self._binary(level + 1))
-        return left
+            left = ("l", t[2], t[1], left, self.expr(prec + 1, operand))
 
     def relational(self, subject=None):
-        left = subject or self.term()
+        left = subject or self._arith(1)
         t = self.toks[self.i]
         p = t[2]
         if t[0] == OP and t[1] in RELOPS:
             self.i += 1
-            return ("cmp", p, t[1], left, self.term())
+            return ("cmp", p, t[1], left, self._arith(1))
         if self.take("between"):
             lo = self.term()
             self.expect("and", after="in between")
@@ -155,32 +154,29 @@ class ExprParser:
         return left
 
     def term(self):
-        left = self.product()
-        while self.isop("+") or self.isop("-"):
-            p, op = self.pos(), self.toks[self.i][1]
-            self.i += 1
-            left = ("b", p, op, left, self.product())
-        return left
+        return self._arith(1)
 
-    def product(self):
-        left = self.factor()
-        while self.isop("*") or self.isop("/"):
-            p, op = self.pos(), self.toks[self.i][1]
+    def _arith(self, min_prec):
+        self.enter()  # simple(), inline: one Python call less per parenthesis
+        try:
+            left = self._simple()
+        finally:
+            self.depth -= 1
+        while True:
+            t = self.toks[self.i]
+            prec = _ARITH.get(t[1], 0) if t[0] == OP else 0
+            if prec < min_prec:
+                return left
             self.i += 1
-            left = ("b", p, op, left, self.factor())
-        return left
-
-    def factor(self):
-        base = self.simple()
-        if self.isop("**"):
-            p = self.pos()
-            self.i += 1
-            self.enter()
-            try:
-                return ("b", p, "**", base, self.factor())
-            finally:
-                self.depth -= 1
-        return base
+            if prec == 3:  # "**" binds to the right, one level deeper each
+                self.enter()
+                try:
+                    right = self._arith(3)
+                finally:
+                    self.depth -= 1
+            else:
+                right = self._arith(prec + 1)
+            left = ("b", t[2], t[1], left, right)
 
     def simple(self):
         self.enter()

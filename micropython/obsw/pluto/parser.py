@@ -268,19 +268,14 @@ class Parser(ExprParser):
         self.expect("end", "case")
         return ("case", p, subject, branches, other)
 
-    def case_tag(self, level=0):
-        if level == 3:
-            t = self.tok()
-            if t[1] in ("=", "!=", "<", ">", "<=", ">=", "between", "within", "in"):
-                return self.relational(SUBJECT)
-            return ("cmp", t[2], "=", SUBJECT, self.term())  # a bare value means '= value'
-        ops = self._LEVELS[level]
-        left = self.case_tag(level + 1)
-        while self.tok()[0] == WORD and self.tok()[1] in ops:
-            p, op = self.pos(), self.tok()[1]
-            self.i += 1
-            left = ("l", p, op, left, self.case_tag(level + 1))
-        return left
+    def case_tag(self):
+        return self.expr(1, self._case_relation)
+
+    def _case_relation(self):
+        t = self.tok()
+        if t[1] in ("=", "!=", "<", ">", "<=", ">=", "between", "within", "in"):
+            return self.relational(SUBJECT)
+        return ("cmp", t[2], "=", SUBJECT, self.term())  # a bare value means '= value'
 
     def activity_call(self):
         r = self.ref("an activity")

@@ -25,6 +25,7 @@ Usage: python tools/bench/board.py [--quick] [--json] [--check]
 """
 
 import argparse
+import contextlib
 import json
 import os
 import subprocess
@@ -218,7 +219,11 @@ def rows_of(cases, res, b):
         row(what, r["alloc"], "bytes allocated")
         if "per_frame_instructions" in r:
             kind = name[len("batch_") :]
-            row(what + ", per request", round(r["per_frame_with_gc"]), "instructions with gc")
+            row(
+                what + ", per frame received",
+                round(r["per_frame_with_gc"]),
+                "instructions with gc",
+            )
             row(
                 what + ", a bus of them at %d frames/s" % BUS_FRAMES,
                 round(100 * b["share"][kind], 1),
@@ -241,11 +246,12 @@ def main(argv=None):
     ap.add_argument("--heap", type=int, help="the board's heap (default: the Pyboard's)")
     args = ap.parse_args(argv)
     cases = [c for c in CASES if not args.quick or c[0] in QUICK]
-    elf = firmware.build_qemu(heap=args.heap)
-    with tempfile.TemporaryDirectory(prefix="obsw-board-") as tmp:
-        mpy = os.path.join(tmp, "board_ops.mpy")
-        compile_ops(mpy)
-        res, same = measure(str(elf), mpy, cases, args.check)
+    with contextlib.redirect_stdout(sys.stderr):  # the build's progress; stdout is the result
+        elf = firmware.build_qemu(heap=args.heap)
+        with tempfile.TemporaryDirectory(prefix="obsw-board-") as tmp:
+            mpy = os.path.join(tmp, "board_ops.mpy")
+            compile_ops(mpy)
+            res, same = measure(str(elf), mpy, cases, args.check)
     b = budget(res)
     if args.json:
         print(

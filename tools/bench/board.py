@@ -12,9 +12,10 @@ per instruction is 3.2 ticks, so a tick difference t fixes the instruction count
 M3's DWT cycle counter is not emulated.) Each operation starts on a freshly collected heap (not
 counted), so its figure holds its own allocation but no collection; "with gc" adds a whole
 collection of the case's heap, counted on the board, for every free heap's worth of bytes it
-allocates. The empty operation (the timer reads and a call) is subtracted. Each case runs after
-a soft reset of the board, so the figures do not depend on which cases ran before; `--check`
-boots the board twice and compares every count.
+allocates. The empty operation (the timer reads and a call) is subtracted. Each case runs on a
+freshly booted board (between soft resets the REPL keeps a few bytes of line history, which
+shifts the heap and the counts with it), so no figure depends on which cases ran before;
+`--check` measures every case twice and compares every count.
 
 The counts are Thumb-2 instructions of the Cortex-M3 build; a Pyboard's Cortex-M4 runs the same
 interpreter code (its build adds the FPU, which the core's few float operations use). The CPU
@@ -96,15 +97,14 @@ def compile_ops(out):
 
 
 def run_board(elf, mpy, cases):
-    """One boot of the board: {case: {"ticks": [...], "alloc": n, "heap": n, "ok": line}}."""
+    """Every case on a fresh board: {case: {"ticks": [...], "alloc", "heap", "gc", "ok"}}."""
     out = {}
-    with firmware.Qemu(elf, ["-icount", "shift=%d" % SHIFT]) as q:
-        rc, text = firmware.mpremote(q.pty, "cp", mpy, ":board_ops.mpy")
-        if rc:
-            raise SystemExit("board: copying board_ops.mpy failed:\n" + text)
-        for name, _, n in cases:
+    for name, _, n in cases:
+        # a fresh board for every case: what the REPL keeps between soft resets (its line
+        # history) would otherwise shift the heap by a few bytes, and with it the counts
+        with firmware.Qemu(elf, ["-icount", "shift=%d" % SHIFT]) as q:
             code = "import board_ops\nboard_ops.run(%r, %d)\n" % (name, n)
-            rc, text = firmware.mpremote(q.pty, "soft-reset", "exec", code)
+            rc, text = firmware.mpremote(q.pty, "cp", mpy, ":board_ops.mpy", "+", "exec", code)
             r = {}
             for line in text.splitlines():
                 parts = line.split()
@@ -122,10 +122,7 @@ def run_board(elf, mpy, cases):
 
 
 def _collection(ticks):
-    # The collector scans the C stack conservatively, and what earlier code (the REPL reading
-    # the UART at the host's pace) left there varies between boots by a few words: a
-    # collection's count varies by a few instructions in 700,000, so it is kept in thousands.
-    return round(instructions(ticks), -3)
+    return instructions(ticks)
 
 
 def _counts(r):
@@ -158,7 +155,7 @@ def measure(elf, mpy, cases, check):
             "max": max(counts),
             "alloc": r["alloc"],
             "heap": r["heap"],
-            "collect": _collection(r["gc"]),
+            "collect": _collection(r["gc"]) - base,
             "ok": r["ok"],
         }
     for r in res.values():

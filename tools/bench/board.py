@@ -145,7 +145,11 @@ def measure(elf, mpy, cases, check):
     same = None
     if check:
         second = run_board(elf, mpy, cases)
-        same = all(_counts(first[k]) == _counts(second[k]) for k in first)
+        differ = [k for k in first if _counts(first[k]) != _counts(second[k])]
+        for k in differ:
+            print("board: %s counted differently:" % k, file=sys.stderr)
+            print("  %r\n  %r" % (_counts(first[k]), _counts(second[k])), file=sys.stderr)
+        same = not differ
     empty = [instructions(t) for t in first["empty"]["ticks"]]
     base = min(empty)
     res = {}

@@ -12,7 +12,7 @@ per instruction is 3.2 ticks, so a tick difference t fixes the instruction count
 M3's DWT cycle counter is not emulated.) Each operation starts on a freshly collected heap (not
 counted), so its figure holds its own allocation but no collection; "with gc" adds a whole
 collection of the case's heap, counted on the board (to 10,000 instructions: the collector's
-conservative stack scan reads a few words the REPL left at the host's pace), for every 40,416
+conservative stack scan reads a few words the REPL left at the host's pace), for every 38,880
 bytes it allocates (what the application leaves free on a Pyboard's heap, its low-water mark
 in the `heap` stage). The empty operation (the timer reads and a call) is
 subtracted. Each case runs on a freshly booted board (between soft resets the REPL keeps a
@@ -53,7 +53,7 @@ RESPONDER_SHARE = 0.5  # the responder's budget at full bus load
 # what the reconfiguration application leaves free on a Pyboard's heap (the heap stage's
 # low-water mark): a collection comes every so many bytes allocated. (The free heap of a case
 # itself is not used: a stale word in the C stack can keep a garbage block alive in one boot.)
-FREE_HEAP = 40416
+FREE_HEAP = 38880
 WATCHDOG_TARGET_MS = 330  # obsw.reconfig.watchdog: kick aimed at 330 ms after the last one
 WATCHDOG_TIMEOUT_MS = 1000  # the TPS3813 resets after 1000 ms without a kick
 WATCHDOG_MARGIN_MS = 10

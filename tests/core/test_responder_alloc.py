@@ -16,14 +16,22 @@ from obsw.reconfig.node import NODE_NOMINAL, definition
 from obsw.spacecan.controller import Controller
 
 # bytes per frame, the README's table "Reconfiguration module CPU budget"
-LIMITS = {"idle poll": 64, "heartbeat": 160, "sync": 384, "ping 17,1": 576, "TC 20,1": 1792}
+LIMITS = {
+    "idle poll": 0,
+    "heartbeat": 64,
+    "sync": 32,
+    "another node's request": 32,
+    "ping 17,1": 96,
+    "TC 20,1": 288,
+}
 FRAMES = 8
 HAS_MEM_ALLOC = hasattr(gc, "mem_alloc")
 
 
 class Rig:
     def __init__(self):
-        self.hal = ModelHal(rtc_seconds=20089 * 86400, eeprom_size=2048)  # a board heap holds it
+        # EEPROMs of 2 KiB: room for the records, and the test fits a Pyboard's heap
+        self.hal = ModelHal(rtc_seconds=20089 * 86400, eeprom_size=2048)
         self.app = ReconfigApp(self.hal)
         self.ctrl = Controller(heartbeat_period=0.5)
         self.ctrl.add_node(NODE_NOMINAL, definition(NODE_NOMINAL))
@@ -43,6 +51,8 @@ class Rig:
             c.request(NODE_NOMINAL, 17, 1, b"", self.now)
         elif kind == "TC 20,1":
             c.request_parameters(NODE_NOMINAL, [1], self.now)
+        elif kind == "another node's request":
+            return [(0, 0x280 + NODE_NOMINAL + 1, b"\x00\x00\x11\x01")]  # a ping to node 11
         return [(bus, can_id, bytes(data)) for bus, can_id, data in c.take_frames()]
 
     def allocated_per_frame(self, kind):

@@ -11,10 +11,13 @@ per instruction is 3.2 ticks, so a tick difference t fixes the instruction count
 40 instructions a tick; QEMU 7.2 as Debian ships it has no TCG plugins to count with, and the
 M3's DWT cycle counter is not emulated.) Each operation starts on a freshly collected heap (not
 counted), so its figure holds its own allocation but no collection; "with gc" adds a whole
-collection of the case's heap, counted on the board, for every free heap's worth of bytes it
-allocates. The empty operation (the timer reads and a call) is subtracted. Each case runs after
-a soft reset of the board, so the figures do not depend on which cases ran before; `--check`
-boots the board twice and compares every count.
+collection of the case's heap, counted on the board (to 10,000 instructions: the collector's
+conservative stack scan reads a few words the REPL left at the host's pace), for every 38,880
+bytes it allocates (what the application leaves free on a Pyboard's heap, its low-water mark
+in the `heap` stage). The empty operation (the timer reads and a call) is
+subtracted. Each case runs on a freshly booted board (between soft resets the REPL keeps a
+few bytes of line history, which shifts the heap and the counts with it), so no figure depends
+on which cases ran before; `--check` measures every case twice and compares every count.
 
 The counts are Thumb-2 instructions of the Cortex-M3 build; a Pyboard's Cortex-M4 runs the same
 interpreter code (its build adds the FPU, which the core's few float operations use). The CPU
@@ -25,6 +28,7 @@ Usage: python tools/bench/board.py [--quick] [--json] [--check]
 """
 
 import argparse
+import contextlib
 import json
 import os
 import subprocess
@@ -46,6 +50,10 @@ BUS_FRAMES = 8000  # SpaceCAN at 1 Mbit/s: about 8,000 frames per second
 BATCH = 16  # frames per poll in the batch cases (board_ops.BATCH)
 FRAMES_PER_PASS = 64  # the application's bound: 32 frames a bus per loop pass
 RESPONDER_SHARE = 0.5  # the responder's budget at full bus load
+# what the reconfiguration application leaves free on a Pyboard's heap (the heap stage's
+# low-water mark): a collection comes every so many bytes allocated. (The free heap of a case
+# itself is not used: a stale word in the C stack can keep a garbage block alive in one boot.)
+FREE_HEAP = 38880
 WATCHDOG_TARGET_MS = 330  # obsw.reconfig.watchdog: kick aimed at 330 ms after the last one
 WATCHDOG_TIMEOUT_MS = 1000  # the TPS3813 resets after 1000 ms without a kick
 WATCHDOG_MARGIN_MS = 10
@@ -95,15 +103,14 @@ def compile_ops(out):
 
 
 def run_board(elf, mpy, cases):
-    """One boot of the board: {case: {"ticks": [...], "alloc": n, "heap": n, "ok": line}}."""
+    """Every case on a fresh board: {case: {"ticks": [...], "alloc", "heap", "gc", "ok"}}."""
     out = {}
-    with firmware.Qemu(elf, ["-icount", "shift=%d" % SHIFT]) as q:
-        rc, text = firmware.mpremote(q.pty, "cp", mpy, ":board_ops.mpy")
-        if rc:
-            raise SystemExit("board: copying board_ops.mpy failed:\n" + text)
-        for name, _, n in cases:
+    for name, _, n in cases:
+        # a fresh board for every case: what the REPL keeps between soft resets (its line
+        # history) would otherwise shift the heap by a few bytes, and with it the counts
+        with firmware.Qemu(elf, ["-icount", "shift=%d" % SHIFT]) as q:
             code = "import board_ops\nboard_ops.run(%r, %d)\n" % (name, n)
-            rc, text = firmware.mpremote(q.pty, "soft-reset", "exec", code)
+            rc, text = firmware.mpremote(q.pty, "cp", mpy, ":board_ops.mpy", "+", "exec", code)
             r = {}
             for line in text.splitlines():
                 parts = line.split()
@@ -121,10 +128,10 @@ def run_board(elf, mpy, cases):
 
 
 def _collection(ticks):
-    # The collector scans the C stack conservatively, and what earlier code (the REPL reading
-    # the UART at the host's pace) left there varies between boots by a few words: a
-    # collection's count varies by a few instructions in 700,000, so it is kept in thousands.
-    return round(instructions(ticks), -3)
+    # A collection scans the C stack conservatively, and a few words there are left by code
+    # that ran at the host's pace (the REPL polling the UART for the code to run): its count
+    # moves by a few instructions from one boot to the next, so it is kept to 10,000.
+    return round(instructions(ticks), -4)
 
 
 def _counts(r):
@@ -132,7 +139,6 @@ def _counts(r):
     return (
         [instructions(t) for t in r["ticks"]],
         r["alloc"],
-        r["heap"],
         _collection(r["gc"]),
         r["ok"],
     )
@@ -143,7 +149,11 @@ def measure(elf, mpy, cases, check):
     same = None
     if check:
         second = run_board(elf, mpy, cases)
-        same = all(_counts(first[k]) == _counts(second[k]) for k in first)
+        differ = [k for k in first if _counts(first[k]) != _counts(second[k])]
+        for k in differ:
+            print("board: %s counted differently:" % k, file=sys.stderr)
+            print("  %r\n  %r" % (_counts(first[k]), _counts(second[k])), file=sys.stderr)
+        same = not differ
     empty = [instructions(t) for t in first["empty"]["ticks"]]
     base = min(empty)
     res = {}
@@ -160,9 +170,13 @@ def measure(elf, mpy, cases, check):
             "collect": _collection(r["gc"]),
             "ok": r["ok"],
         }
+    gc_case = res.get("gc_collect")
+    if gc_case is not None:  # a collection's count, kept to 10,000 like the others
+        for key in ("instructions", "min", "max"):
+            gc_case[key] = round(gc_case[key], -4)
     for r in res.values():
-        # the collections its garbage costs: one of its heap for every free heap's worth
-        r["with_gc"] = r["instructions"] + r["alloc"] * r["collect"] / r["heap"]
+        # the collections its garbage costs: one of its heap for every FREE_HEAP bytes
+        r["with_gc"] = r["instructions"] + r["alloc"] * r["collect"] / FREE_HEAP
     for kind in KINDS:
         b = res.get("batch_" + kind)
         if b is not None and "can_idle" in res:
@@ -218,7 +232,11 @@ def rows_of(cases, res, b):
         row(what, r["alloc"], "bytes allocated")
         if "per_frame_instructions" in r:
             kind = name[len("batch_") :]
-            row(what + ", per request", round(r["per_frame_with_gc"]), "instructions with gc")
+            row(
+                what + ", per frame received",
+                round(r["per_frame_with_gc"]),
+                "instructions with gc",
+            )
             row(
                 what + ", a bus of them at %d frames/s" % BUS_FRAMES,
                 round(100 * b["share"][kind], 1),
@@ -241,11 +259,12 @@ def main(argv=None):
     ap.add_argument("--heap", type=int, help="the board's heap (default: the Pyboard's)")
     args = ap.parse_args(argv)
     cases = [c for c in CASES if not args.quick or c[0] in QUICK]
-    elf = firmware.build_qemu(heap=args.heap)
-    with tempfile.TemporaryDirectory(prefix="obsw-board-") as tmp:
-        mpy = os.path.join(tmp, "board_ops.mpy")
-        compile_ops(mpy)
-        res, same = measure(str(elf), mpy, cases, args.check)
+    with contextlib.redirect_stdout(sys.stderr):  # the build's progress; stdout is the result
+        elf = firmware.build_qemu(heap=args.heap)
+        with tempfile.TemporaryDirectory(prefix="obsw-board-") as tmp:
+            mpy = os.path.join(tmp, "board_ops.mpy")
+            compile_ops(mpy)
+            res, same = measure(str(elf), mpy, cases, args.check)
     b = budget(res)
     if args.json:
         print(

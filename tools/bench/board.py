@@ -9,15 +9,15 @@ timer (25 MHz, 40 ns a tick) around each operation with the SysTick interrupt ma
 per instruction is 3.2 ticks, so a tick difference t fixes the instruction count I exactly
 (3.2 I - 1 < t < 3.2 I + 1 holds one integer). (`shift=0`, 1 ns an instruction, would give
 40 instructions a tick; QEMU 7.2 as Debian ships it has no TCG plugins to count with, and the
-M3's DWT cycle counter is not emulated.) Each operation starts on a freshly collected heap (not
+M3's DWT cycle counter reads 0.) Each operation starts on a freshly collected heap (not
 counted), so its figure holds its own allocation but no collection; "with gc" adds a whole
 collection of the case's heap, counted on the board (to 10,000 instructions: the collector's
 conservative stack scan reads a few words the REPL left at the host's pace), for every 38,880
 bytes it allocates (what the application leaves free on a Pyboard's heap, its low-water mark
-in the `heap` stage). The empty operation (the timer reads and a call) is
-subtracted. Each case runs on a freshly booted board (between soft resets the REPL keeps a
-few bytes of line history, which shifts the heap and the counts with it), so no figure depends
-on which cases ran before; `--check` measures every case twice and compares every count.
+in the `heap` stage). The empty operation (the timer reads and a call) is subtracted. Each case
+runs on a freshly booted board (after a soft reset the heap was found a few bytes apart from
+one run to the next, and the counts with it), so no figure depends on which cases ran before;
+`--check` measures every case twice and compares every count.
 
 The counts are Thumb-2 instructions of the Cortex-M3 build; a Pyboard's Cortex-M4 runs the same
 interpreter code (its build adds the FPU, which the core's few float operations use). The CPU
@@ -106,8 +106,8 @@ def run_board(elf, mpy, cases):
     """Every case on a fresh board: {case: {"ticks": [...], "alloc", "heap", "gc", "ok"}}."""
     out = {}
     for name, _, n in cases:
-        # a fresh board for every case: what the REPL keeps between soft resets (its line
-        # history) would otherwise shift the heap by a few bytes, and with it the counts
+        # a fresh board for every case: after a soft reset the heap was found a few bytes apart
+        # from one run to the next, and the counts with it
         with firmware.Qemu(elf, ["-icount", "shift=%d" % SHIFT]) as q:
             code = "import board_ops\nboard_ops.run(%r, %d)\n" % (name, n)
             rc, text = firmware.mpremote(q.pty, "cp", mpy, ":board_ops.mpy", "+", "exec", code)

@@ -110,17 +110,8 @@ class Connection:
             self.close("bad frame: %s" % e)
             return
         inbound = self._inbound
-        node = self.transport.node
-        if not inbound and len(msgs) == 1:
-            # the usual case: one message and nothing queued before it, delivered straight
-            msg = msgs[0]
-            self.received += 1
-            if type(msg) is not list or len(msg) < 4:
-                self.transport.bad_frames += 1
-                return
-            node.deliver(msg, self)
-            return
         inbound.extend(msgs)
+        node = self.transport.node
         # a handler may wait for another reply and read this connection again (nested):
         # one queue per connection keeps the messages in the order they came
         while inbound and self.alive:
@@ -269,7 +260,8 @@ class SocketTransport:
         if self._server is None and len(self._fds) == 1 and (timeout is None or timeout >= _SLICE):
             # a user with one connection: one blocking recv (bounded by SO_RCVTIMEO) instead
             # of poll() then recv(), one system call less per reply
-            next(iter(self._fds.values())).on_readable()
+            for conn in list(self._fds.values()):
+                conn.on_readable()
             if self.node._remote_topics:
                 self._renew()
             return

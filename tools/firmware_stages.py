@@ -315,8 +315,16 @@ def stage_heap():
     return _close("heap", t0, passed, failed)
 
 
+def stage_board():
+    t0 = time.monotonic()
+    with firmware.Qemu(firmware.build_qemu()) as q:
+        passed, failed = board_tools(q.pty)
+    return _close("board", t0, passed, failed)
+
+
 def main(argv):
     stages = {
+        "board": stage_board,
         "firmware": firmware.stage_sizes,
         "upy-frozen": stage_upy_frozen,
         "cortex-m": stage_cortex_m,

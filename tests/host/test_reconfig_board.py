@@ -70,7 +70,7 @@ def test_deploy_compiles_for_the_pyboard_and_copies(fakes, tmp_path, monkeypatch
     scratch = tmp_path / "scratch"
     scratch.mkdir()
     monkeypatch.setattr(tempfile, "tempdir", str(scratch))
-    assert run(["board", "deploy", "--port", "/dev/ttyACM0"]) == 0
+    assert run(["board", "deploy", "--port", "/dev/ttyACM0", "--march", "armv7emsp"]) == 0
     assert os.listdir(scratch) == []  # the compiled files' folder is gone again
     c = calls()
     assert len(c) == 1 and c[0].startswith("mpremote connect /dev/ttyACM0")
@@ -79,6 +79,40 @@ def test_deploy_compiles_for_the_pyboard_and_copies(fakes, tmp_path, monkeypatch
     names = [n for _, n in board.frozen_modules()]
     assert "obsw/reconfig/app.py" in names and "hal_pyb.py" in names
     assert not [n for n in names if n.startswith(("obsw/cfdp", "obsw/pluto", "obsw/il"))]
+
+
+BOARD_SAYS = """#!/bin/sh
+echo "$(basename "$0") $*" >> "{log}"
+case "$*" in *_mpy*) echo {mpy} ;; esac
+exit 0
+"""
+
+
+@pytest.mark.parametrize(
+    "mpy, march", [(6 | 5 << 10, "armv7m"), (6 | 7 << 10, "armv7emsp"), (6, "armv7emsp")]
+)
+def test_deploy_compiles_for_the_boards_own_architecture(fakes, mpy, march):
+    tmp, calls = fakes
+    log = tmp / "calls.log"
+    for name in ("mpremote", "mpy-cross"):
+        p = tmp / "bin" / name
+        p.write_text(BOARD_SAYS.format(log=log, mpy=mpy))
+        p.chmod(p.stat().st_mode | stat.S_IEXEC)
+    os.environ["MPY_CROSS"] = str(tmp / "bin" / "mpy-cross")
+    try:
+        assert run(["board", "deploy", "--port", "/dev/pts/7"]) == 0
+    finally:
+        del os.environ["MPY_CROSS"]
+    c = calls()
+    assert c[0].startswith("mpremote connect /dev/pts/7 exec") and "_mpy" in c[0]
+    compiled = [line for line in c if line.startswith("mpy-cross")]
+    assert compiled and all(line.split()[1] == "-march=" + march for line in compiled)
+
+
+def test_arch_codes():
+    assert board.arch_of(6 | 2 << 10) == "x64"
+    assert board.arch_of(6 | 4 << 10) == "armv6m"
+    assert board.arch_of(6) is None and board.arch_of(6 | 63 << 10) is None
 
 
 def test_flash_repl_and_test(fakes, tmp_path):

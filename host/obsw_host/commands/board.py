@@ -38,6 +38,11 @@ def add_parser(sub):
         )
         if name == "flash":
             q.add_argument("firmware", help="firmware.dfu from `obsw board build`")
+        if name == "deploy":
+            q.add_argument(
+                "--march",
+                help="mpy-cross architecture (default: the board's own, else armv7emsp)",
+            )
         if name == "test":
             q.add_argument(
                 "files", nargs="*", help="test files (default: the reconfiguration core tests)"
@@ -89,7 +94,9 @@ def _qemu(args):
 def _deploy(args):
     from obsw_host import board
 
-    return _guard(lambda: print("%d modules deployed" % len(board.deploy(args.port))))
+    return _guard(
+        lambda: print("%d modules deployed" % len(board.deploy(args.port, march=args.march)))
+    )
 
 
 def _flash(args):

@@ -90,7 +90,6 @@ def peer_transfer(data, mode, loss, seed):
 
     import spacepackets.countdown as countdown
     from cfdppy import (
-        CfdpUserBase,
         IndicationConfig,
         LocalEntityConfig,
         PacketDestination,
@@ -102,10 +101,8 @@ def peer_transfer(data, mode, loss, seed):
     from cfdppy.filestore import NativeFilestore
     from cfdppy.handler.dest import DestHandler
     from cfdppy.handler.source import SourceHandler
-    from cfdppy.mib import CheckTimerProvider, DefaultFaultHandlerBase
     from spacepackets.cfdp import ChecksumType, TransmissionMode
     from spacepackets.cfdp.pdu import PduFactory
-    from spacepackets.countdown import Countdown
     from spacepackets.seqcount import SeqCountProvider
     from spacepackets.util import ByteFieldU8
 
@@ -147,60 +144,9 @@ def peer_transfer(data, mode, loss, seed):
             crc = zlib.crc32(memoryview(self.files[file_path])[:size_to_verify])
             return crc.to_bytes(4, "big")
 
-    class User(CfdpUserBase):
-        def __init__(self, vfs):
-            super().__init__(vfs)
-            self.done = False
+    from cfdppy_parts import peer_classes
 
-        def transaction_finished_indication(self, params):
-            self.done = True
-
-        def transaction_indication(self, *a):
-            pass
-
-        def eof_sent_indication(self, *a):
-            pass
-
-        def metadata_recv_indication(self, *a):
-            pass
-
-        def file_segment_recv_indication(self, *a):
-            pass
-
-        def report_indication(self, *a):
-            pass
-
-        def suspended_indication(self, *a):
-            pass
-
-        def resumed_indication(self, *a):
-            pass
-
-        def fault_indication(self, *a):
-            pass
-
-        def abandoned_indication(self, *a):
-            pass
-
-        def eof_recv_indication(self, *a):
-            pass
-
-    class Faults(DefaultFaultHandlerBase):
-        def notice_of_suspension_cb(self, *a):
-            pass
-
-        def notice_of_cancellation_cb(self, *a):
-            pass
-
-        def abandoned_cb(self, *a):
-            pass
-
-        def ignore_cb(self, *a):
-            pass
-
-    class Timers(CheckTimerProvider):
-        def provide_check_timer(self, *a, **kw):
-            return Countdown.from_seconds(0.05)
+    User, Faults, Timers = peer_classes(0.05)
 
     clock = Clock()
     saved = countdown.time_ms

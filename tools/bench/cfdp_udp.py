@@ -142,50 +142,16 @@ def _same(path, data):
 def _peer_parts(local, remote):
     """cfdp-py's configuration objects for entity ``local`` talking to ``remote``."""
     from cfdppy import (
-        CfdpUserBase,
         IndicationConfig,
         LocalEntityConfig,
         RemoteEntityConfig,
         RemoteEntityConfigTable,
     )
-    from cfdppy.mib import CheckTimerProvider, DefaultFaultHandlerBase
+    from cfdppy_parts import peer_classes
     from spacepackets.cfdp import ChecksumType, TransmissionMode
-    from spacepackets.countdown import Countdown
     from spacepackets.util import ByteFieldU8
 
-    class User(CfdpUserBase):
-        done = False
-        condition = None
-
-        def transaction_finished_indication(self, params):
-            self.done = True
-            self.condition = params.finished_params.condition_code
-
-        def _ignore(self, *a, **kw):
-            pass
-
-        transaction_indication = eof_sent_indication = metadata_recv_indication = _ignore
-        file_segment_recv_indication = report_indication = suspended_indication = _ignore
-        resumed_indication = fault_indication = abandoned_indication = _ignore
-        eof_recv_indication = _ignore
-
-    class Faults(DefaultFaultHandlerBase):
-        def notice_of_suspension_cb(self, *a):
-            pass
-
-        def notice_of_cancellation_cb(self, *a):
-            pass
-
-        def abandoned_cb(self, *a):
-            pass
-
-        def ignore_cb(self, *a):
-            pass
-
-    class Timers(CheckTimerProvider):
-        def provide_check_timer(self, *a, **kw):
-            return Countdown.from_seconds(TIMER)
-
+    User, Faults, Timers = peer_classes(TIMER)
     cfg = LocalEntityConfig(ByteFieldU8(local), IndicationConfig(), Faults())
     rcfg = RemoteEntityConfig(
         entity_id=ByteFieldU8(remote),

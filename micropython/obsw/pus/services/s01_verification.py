@@ -108,6 +108,17 @@ class Verification(Service):
     """The service 1 provider: builds and sends the reports the application process asks."""
 
     SERVICE = SERVICE_VERIFICATION
+    REPORTS = (
+        TM_VERIFY_ACCEPTANCE_SUCCESS,
+        TM_VERIFY_ACCEPTANCE_FAILURE,
+        TM_VERIFY_START_SUCCESS,
+        TM_VERIFY_START_FAILURE,
+        TM_VERIFY_PROGRESS_SUCCESS,
+        TM_VERIFY_PROGRESS_FAILURE,
+        TM_VERIFY_COMPLETION_SUCCESS,
+        TM_VERIFY_COMPLETION_FAILURE,
+        TM_VERIFY_ROUTING_FAILURE,
+    )
 
     def success(self, request_id, stage, destination=0, step=None):
         data = request_id.pack()

@@ -68,6 +68,7 @@ class DeviceAccess(Service):
     """The service 2 provider, calling ``component`` on the interaction-layer ``node``."""
 
     SERVICE = SERVICE_DEVICE_ACCESS
+    REPORTS = (TM_DEVICE_PHYSICAL_DATA_REPORT, TM_DEVICE_LOGICAL_DATA_REPORT)
     HANDLERS = (
         (TC_DEVICE_PHYSICAL_COMMAND, "physical_command"),
         (TC_DEVICE_PHYSICAL_ACQUIRE, "physical_acquire"),

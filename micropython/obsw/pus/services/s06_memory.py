@@ -114,6 +114,7 @@ class MemoryManagement(Service):
     """The service 6 provider over ``areas`` (memory ID -> area)."""
 
     SERVICE = SERVICE_MEMORY_MANAGEMENT
+    REPORTS = (TM_MEM_DUMP_RAW_REPORT, TM_MEM_CHECK_RAW_REPORT)
     HANDLERS = (
         (TC_MEM_LOAD_RAW, "load"),
         (TC_MEM_DUMP_RAW, "dump"),

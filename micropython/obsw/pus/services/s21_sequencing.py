@@ -94,6 +94,12 @@ class RequestSequencing(Service):
     ``route(raw)`` takes requests for APIDs this process does not serve."""
 
     SERVICE = SERVICE_REQUEST_SEQUENCING
+    REPORTS = (
+        TM_SEQUENCE_STATUS_REPORT,
+        TM_SEQUENCE_CHECKSUM_REPORT,
+        TM_SEQUENCE_CONTENT_REPORT,
+        TM_SEQUENCE_ABORTED_REPORT,
+    )
     NAME = "s21"
     HANDLERS = (
         (TC_SEQUENCE_LOAD_DIRECT, "load"),

@@ -50,6 +50,12 @@ class PositionScheduling(Schedule):
     """The service 22 provider on ``pool``; ``parameter`` (ID or name) is the position."""
 
     SERVICE = SERVICE_POSITION_BASED_SCHEDULING
+    REPORTS = (
+        TM_POS_SCHED_DETAIL_REPORT,
+        TM_POS_SCHED_SUMMARY_REPORT,
+        TM_POS_SCHED_SUBSCHEDULE_STATUS_REPORT,
+        TM_POS_SCHED_GROUP_STATUS_REPORT,
+    )
     NAME = "s22"
     TAG = POSITION
     OFFSET = POSITION_OFFSET

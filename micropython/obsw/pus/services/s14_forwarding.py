@@ -79,6 +79,7 @@ class ForwardingControl(Service):
     REPORTS = (
         TM_FWD_REPORT_TYPES_REPORT,
         TM_FWD_HK_STRUCTURES_REPORT,
+        TM_FWD_DIAG_STRUCTURES_REPORT,
         TM_FWD_BLOCKED_EVENTS_REPORT,
     )
     NAME = "s14"

@@ -44,9 +44,7 @@ def test_the_table_has_the_standards_318_types_once_each():
 def test_every_message_type_named_in_messages_is_in_the_table():
     table = {(m.service, m.subtype) for m in MESSAGE_TYPES}
     named = {
-        v
-        for k, v in vars(messages).items()
-        if re.match(r"^T[CM]_", k) and isinstance(v, tuple)
+        v for k, v in vars(messages).items() if re.match(r"^T[CM]_", k) and isinstance(v, tuple)
     }
     assert named - PROJECT_DEFINED <= table, sorted(named - PROJECT_DEFINED - table)
 

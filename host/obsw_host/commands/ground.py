@@ -67,6 +67,9 @@ def add_parser(sub):
 
     obcp.add_to_ground(s)
     cfdp.add_parser(s)  # obsw ground cfdp put|get|status|serve
+    from obsw_host.commands import ground_services
+
+    ground_services.add_to_ground(s)  # obsw ground device|diag|functional|forward (2, 3, 14)
 
     _add_operator(s)
     s.add_parser("ping", help="TC[17,1] are-you-alive").set_defaults(func=_ping)
@@ -101,6 +104,7 @@ def add_parser(sub):
     x = hk.add_parser("listen", help="print periodic reports")
     x.add_argument("--seconds", type=float, default=3.0)
     x.set_defaults(func=_listen, listen=(3, 25))
+    ground_services.add_to_hk(hk)  # obsw ground hk append
 
     pa = s.add_parser("params", help="service 20 parameters").add_subparsers(dest="params")
     pa.required = True
@@ -129,9 +133,9 @@ def add_parser(sub):
     x = ti.add_parser("rate", help="TC[9,1] report every 2**EXPONENT s")
     x.add_argument("exponent", type=int)
     x.set_defaults(func=_time_rate)
-    x = ti.add_parser("listen", help="print time reports")
+    x = ti.add_parser("listen", help="print time reports (CUC TM[9,2] or CDS TM[9,3])")
     x.add_argument("--seconds", type=float, default=3.0)
-    x.set_defaults(func=_listen, listen=(9, 2))
+    x.set_defaults(func=_listen, listen=(9, None))
 
 
 def _add_automation(s):

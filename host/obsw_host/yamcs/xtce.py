@@ -631,7 +631,119 @@ class Generator:
         self.parameter_commands()
         self.monitor_commands()
         self.function_commands()
+        self.services_2_3_9_14()
         return self.root.element()
+
+    # ------------------------------------------------------------------ services 2, 3, 9, 14
+    def services_2_3_9_14(self):
+        """Reports and commands of device access, diagnostics, functional reporting, time and
+        diagnostic forwarding: one item per command (N = 1), the first item of a report."""
+        r = self.root
+        exponent = self.header_param("time_rate_exponent", 8)
+        status = self.header_param("time_reference_status", 8)
+        cuc = [self.header_param("cuc_coarse", 32), self.header_param("cuc_fine", 16)]
+        cds = [self.header_param("cds_day", 16), self.header_param("cds_ms_of_day", 32)]
+        self.report("cuc_time_report", M.TM_TIME_CUC_REPORT, [exponent] + cuc + [status])
+        self.report("cds_time_report", M.TM_TIME_CDS_REPORT, [exponent] + cds + [status])
+        diag_sid = self.header_param("diag_structure_id", 16)
+        self.report("diag_report", M.TM_HK_DIAG_REPORT, [diag_sid])
+        n = self.header_param("register_count", 8)
+        address = self.header_param("register_address", 32)
+        value = self.header_param("register_value", 32)
+        self.report("register_dump", M.TM_DEVICE_REGISTER_DUMP_REPORT, [n, address, value])
+        for name, msg_type in (
+            ("diag_structure_report", M.TM_HK_DIAG_STRUCTURE_REPORT),
+            ("diag_properties_report", M.TM_HK_DIAG_PERIODIC_PROPERTIES_REPORT),
+            ("functional_reporting_report", M.TM_HK_FUNCTIONAL_REPORTING_REPORT),
+            ("forward_diag_report", M.TM_FWD_DIAG_STRUCTURES_REPORT),
+        ):
+            self.report(name, msg_type)
+
+        pus = r.child("PUS")
+        one8, one16 = ("fixed", "n", 1, 8), ("fixed", "n", 1, 16)
+        none16 = ("fixed", "nfa", 0, 16)
+        pids = {pid: _label(p.qualified) for pid, p in self.sc.params.items()}
+
+        def arg(name, pair, valid=None, labels=None):
+            return ("arg", name, argument_type("", pair, valid=valid, labels=labels))
+
+        self.command(
+            pus,
+            "time_rate",
+            M.TC_TIME_SET_REPORT_RATE,
+            [arg("exponent", U8, (0, 16))],
+            "TC[9,1] a report every 2**exponent s",
+        )
+        self.command(
+            pus,
+            "device_on_off",
+            M.TC_DEVICE_ON_OFF,
+            [one8, arg("address", U16)],
+            "TC[2,1] on/off device command",
+        )
+        self.command(
+            pus,
+            "device_register_load",
+            M.TC_DEVICE_REGISTER_LOAD,
+            [one8, arg("address", U32), arg("value", U32)],
+            "TC[2,2] register load",
+        )
+        self.command(
+            pus,
+            "device_register_dump",
+            M.TC_DEVICE_REGISTER_DUMP,
+            [one8, arg("address", U32)],
+            "TC[2,5] register dump",
+        )
+        self.command(
+            pus,
+            "device_cpdu",
+            M.TC_DEVICE_CPDU,
+            [one8, arg("line", U16), arg("duration_ms", U16)],
+            "TC[2,4] CPDU command",
+        )
+        for name, msg_type in (
+            ("diag_enable", M.TC_HK_ENABLE_DIAG_REPORTS),
+            ("diag_disable", M.TC_HK_DISABLE_DIAG_REPORTS),
+            ("diag_one_shot", M.TC_HK_ONE_SHOT_DIAG),
+            ("diag_delete", M.TC_HK_DELETE_DIAG_STRUCTURES),
+            ("diag_structures", M.TC_HK_REPORT_DIAG_STRUCTURES),
+            ("diag_properties", M.TC_HK_REPORT_DIAG_PERIODIC_PROPERTIES),
+        ):
+            self.command(pus, name, msg_type, [one16, arg("sid", U16)])
+        self.command(
+            pus,
+            "diag_interval",
+            M.TC_HK_MODIFY_DIAG_INTERVAL,
+            [one16, arg("sid", U16), arg("interval", U16, (1, 65535))],
+        )
+        for name, msg_type in (
+            ("hk_append", M.TC_HK_APPEND_HK_PARAMETERS),
+            ("diag_append", M.TC_HK_APPEND_DIAG_PARAMETERS),
+        ):
+            self.command(
+                pus,
+                name,
+                msg_type,
+                [arg("sid", U16), one16, arg("parameter", U16, labels=pids), none16],
+            )
+        for name, msg_type in (
+            ("functional_apply", M.TC_HK_APPLY_FUNCTIONAL_REPORTING),
+            ("functional_delete", M.TC_HK_DELETE_FUNCTIONAL_REPORTING),
+            ("functional_report", M.TC_HK_REPORT_FUNCTIONAL_REPORTING),
+        ):
+            self.command(pus, name, msg_type, [one16, arg("definition", U16)])
+        for name, msg_type in (
+            ("forward_diag_add", M.TC_FWD_ADD_DIAG_STRUCTURES),
+            ("forward_diag_delete", M.TC_FWD_DELETE_DIAG_STRUCTURES),
+        ):
+            self.command(
+                pus,
+                name,
+                msg_type,
+                [one8, arg("apid", U16, (0, 2047)), ("fixed", "n2", 1, 8), arg("sid", U16)],
+            )
+        self.command(pus, "forward_diag_report", M.TC_FWD_REPORT_DIAG_STRUCTURES)
 
 
 def _drop_condition(container, ref):

@@ -5,7 +5,12 @@ SpaceCAN node with CPDU functions; unknown addresses, refusals and silent device
 import unittest
 
 from obsw.il.node import Node
-from obsw.pus.messages import FAILURE_COMPONENT, FAILURE_TIMEOUT, FAILURE_UNKNOWN_ID
+from obsw.pus.messages import (
+    FAILURE_COMPONENT,
+    FAILURE_TIMEOUT,
+    FAILURE_UNAVAILABLE,
+    FAILURE_UNKNOWN_ID,
+)
 from obsw.pus.services.s02_device_access import DeviceAccess, DeviceUser
 from obsw.spacecan.controller import Controller
 from obsw.spacecan.device_access import DEVICE_ACCESS, SpaceCanDeviceAccess
@@ -165,6 +170,16 @@ class TestDeviceCommands(unittest.TestCase):
         self.assertEqual(len(b.calls), 1)  # the first failed: the second never went out
         tx = b.run(lambda: b.user.cpdu(APID, [(SILENT << 8 | 1, 10)]))
         self.assertEqual((tx.failure["code"], tx.failure["data"]), (FAILURE_TIMEOUT, b"\x0c\x01"))
+
+    def test_no_device_access_component_fails_the_start(self):
+        loop = Loop()
+        loop.app.register(DeviceAccess(Node("alone", clock=loop.clock), timeout=0.05))
+        user = loop.ground.register(DeviceUser())
+        tx = loop.run_async(lambda: user.dump_registers(APID, [STATE]))
+        self.assertEqual(
+            (tx.failure["stage"], tx.failure["code"], tx.failure["data"]),
+            (2, FAILURE_UNAVAILABLE, b""),
+        )
 
 
 if __name__ == "__main__":

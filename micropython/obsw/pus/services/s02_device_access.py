@@ -82,7 +82,7 @@ TIMEOUT_REASON = "TIMEOUT"
 
 
 def _failure(error, device, ident=DEVICE_ID):
-    data = ident.pack(device)
+    data = ident.pack(device) if device is not None else b""
     if isinstance(error, CallTimeoutError):
         return PusFailure(FAILURE_TIMEOUT, error.message, data)
     if isinstance(error, ComponentError) and error.code == TIMEOUT_REASON:
@@ -141,7 +141,7 @@ class DeviceAccess(Service):
 
     async def _check(self, req, kind, addresses, ident):
         """Fail the start if one of ``addresses`` names no device of ``kind``."""
-        bad = await self._call("check", (kind, list(addresses)), 0, ident)
+        bad = await self._call("check", (kind, list(addresses)), None, ident)
         if bad is not None:
             raise PusFailure(
                 FAILURE_UNKNOWN_ID, "no %s address 0x%X" % (kind, bad), ident.pack(bad)

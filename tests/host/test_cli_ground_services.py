@@ -91,3 +91,13 @@ def test_diagnostic_structures_and_functional_reporting(obc):
     assert rc == 0, out
     rc, out = ground(obc, "diag", "delete", 7, 8)  # 8 unknown: nothing deleted
     assert rc == 1
+
+
+def test_any_tc_with_its_application_data_in_hex(obc):
+    rc, out = ground(obc, "tc", 3, 40, "0000")  # TC[3,40], N = 0: every definition
+    assert rc == 0, out
+    assert out["request"] == "TC[3,40]"
+    assert "definitions" in out["replies"][0]
+    rc, out = ground(obc, "tc", 3, 99)
+    assert rc == 1
+    assert out["failure"]["code"] == 4  # illegal subtype

@@ -11,6 +11,8 @@ diagnostic forwarding requests (services 2, 3 and 14).
     obsw ground functional create 1 --hk 1:on:2 --diag 5:off:1    TC[3,38]; apply, delete,
                                                 report, add, remove, modify
     obsw ground forward diag add 10:5           TC[14,9]; delete (TC[14,10]), report
+    obsw ground tc 3 40 0000                    any TC: service, subtype, application data
+                                                in hex; the replies decoded by the users
 
 On SpaceCAN, an on/off address is node << 8 | on << 7 | line, a register address
 node << 16 | parameter id, a CPDU line node << 8 | output line (obsw.spacecan.device_access).
@@ -171,6 +173,12 @@ def add_to_ground(s):
         func=_forward, what="report"
     )
 
+    x = s.add_parser("tc", help="any TC: service, subtype and application data in hex")
+    x.add_argument("service", type=int)
+    x.add_argument("subtype", type=int)
+    x.add_argument("data", nargs="?", default="", help="application data, hex (default none)")
+    x.set_defaults(func=_tc)
+
 
 # ------------------------------------------------------------------------------ actions
 
@@ -246,5 +254,28 @@ def _forward(args):
         if args.what == "add":
             return _issue(g, fwd.add_diag(g.apid, selection))
         return _issue(g, fwd.delete_diag(g.apid, selection))
+
+    return _run(args, go)
+
+
+def _tc(args):
+    try:
+        data = bytes.fromhex(args.data)
+    except ValueError:
+        raise UserError("application data %r" % args.data, expected="hex octets") from None
+    for what, value in (("service", args.service), ("subtype", args.subtype)):
+        if not 0 <= value <= 255:
+            raise UserError("%s %d" % (what, value), expected="0 to 255")
+
+    def go(g):
+        _storage(g)  # the users of services 2, 4, 6, 13, 14, 15, 23 decode their reports too
+        mark = len(g.received)
+        tx = g.wait(g.send(g.apid, args.service, args.subtype, data))
+        # no reply type is expected of a TC sent by numbers: the reports of its service sent
+        # to this ground while it ran are its replies
+        for tm, decoded in g.received[mark:]:
+            if tm.service == args.service and tm.destination_id == g.proc.source_id:
+                tx.replies.append(decoded)
+        return tx
 
     return _run(args, go)

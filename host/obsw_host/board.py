@@ -210,15 +210,14 @@ def deploy(port=None, runner=subprocess.call, out_dir=None, march=None):
 
 
 def flash(firmware, port=None, runner=subprocess.call):
-    """mpremote bootloader, then dfu-util with the firmware (a .dfu file)."""
+    """mpremote bootloader, then dfu-util with the firmware (a .dfu file). Every tool is
+    found before the board enters DFU mode, so a missing one leaves the board running."""
     if not os.path.isfile(firmware):
         raise BoardError("no firmware file %r: run `obsw board build` first" % firmware)
-    _run(_mpremote(port) + ["bootloader"], runner)
     dfu = _tool("DFU_UTIL", "dfu-util")
     if dfu is None:
-        raise BoardError(
-            "dfu-util not found (apt install dfu-util); the board now waits in DFU mode"
-        )
+        raise BoardError("dfu-util not found: apt install dfu-util (the board was left running)")
+    _run(_mpremote(port) + ["bootloader"], runner)
     _run([dfu, "-a", "0", "-d", "0483:df11", "-D", firmware], runner)
     _run(_mpremote(port) + ["cp", os.path.join(board_dir(), "main.py"), ":main.py"], runner)
 

@@ -173,7 +173,7 @@ def _run_lines(run):
         "- Load average (1, 5, 15 min) before: %s; after: %s. The machine is shared: other"
         " jobs ran at the same time, so absolute figures move from run to run; the ratios"
         " compare implementations measured in the same run." % tuple(
-            ", ".join(fmt(x) for x in v) if v else "unknown" for v in load
+            ", ".join("%.2f" % x for x in v) if v else "unknown" for v in load
         ),
         "- %s"
         % (
@@ -223,22 +223,25 @@ def page(name, result):
 
 
 def headline(result):
-    """The lowest and highest ratio of obsw to a peer in one result (reference rows aside)."""
+    """The range of obsw's ratios in one result: to its peers, and to the plain reference."""
     ours = _obsw_figures(result["rows"])
-    ratios = []
+    peers, reference = [], []
     for r in result["rows"]:
         mine = ours.get((r["case"], r["unit"]))
-        if mine is None or r["impl"] in ("obsw", "reference") or r["impl"].startswith("obsw"):
+        if mine is None or r["impl"] == "obsw":
             continue
         q = ratio(mine["value"], r["value"], r["higher_is_better"])
         if q is not None:
-            ratios.append((q, r["impl"]))
-    if not ratios:
-        return "obsw alone (see the page)"
-    peers = sorted({impl for _, impl in ratios})
-    lo, hi = min(q for q, _ in ratios), max(q for q, _ in ratios)
-    span = ("%.2fx" % lo) if abs(hi - lo) < 0.005 else "%.2fx to %.2fx" % (lo, hi)
-    return "%s against %s" % (span, ", ".join(peers))
+            (reference if r["impl"] == "reference" else peers).append((q, r["impl"]))
+    parts = []
+    for found, what in ((peers, None), (reference, "the plain reference")):
+        if not found:
+            continue
+        lo, hi = min(q for q, _ in found), max(q for q, _ in found)
+        span = ("%.2fx" % lo) if abs(hi - lo) < 0.005 else "%.2fx to %.2fx" % (lo, hi)
+        names = ", ".join("`%s`" % impl for impl in sorted({impl for _, impl in found}))
+        parts.append(span + " " + (what or names))
+    return "; ".join(parts) or "obsw alone (see the page)"
 
 
 def index(results):
@@ -252,7 +255,7 @@ def index(results):
         " medians. The figures below come from the saved `--json` output of the last run of"
         " each benchmark; [how they are made](../benchmarks.md) says how to run them again.",
         "",
-        "| benchmark | obsw against its peers (range over the cases) | run |",
+        "| benchmark | obsw's figure over the others' (range over the cases) | run |",
         "|---|---|---|",
     ]
     for name in RUNS:

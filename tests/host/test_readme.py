@@ -4,9 +4,11 @@ samples the examples use are shipped there).
 
 Each shell block is one terminal: a line ending in ``&`` starts a server, which must print its
 ready line (bound) before the next line runs, and stays up for the Python blocks that follow
-until the next shell block. A line's expected exit status is 0 unless its comment says
-``exit N``. Lines that need hardware, or that are whole suites run elsewhere, are listed in
-SKIP with the reason. Ports move with OBSW_PORT_BASE (PUS) and a substitution (CFDP).
+until the next shell block. A shell block whose first line is ``# from the top folder`` runs
+there (the copy of examples/ sits next to links to the rest of the tree). A line's expected
+exit status is 0 unless its comment says ``exit N``. Lines that need hardware or root, or that
+are whole suites run elsewhere, are listed in SKIP with the reason. Ports move with
+OBSW_PORT_BASE (PUS) and a substitution (CFDP).
 """
 
 import os
@@ -42,6 +44,7 @@ SKIP = {  # a piece of the line -> why it does not run here
     "tests/fuzz/run.py --inputs 1000000": "the long fuzz run takes hours",
     "mkdocs serve": "serves the site until Ctrl-C (tools/test builds it)",
 }
+TOP_FOLDER = "# from the top folder"  # a shell block that starts so runs from the top folder
 RAN_AT_LEAST = 60  # examples run over all pages
 SKIPPED_AT_MOST = 40  # every one names where it is covered or what it needs
 
@@ -138,6 +141,9 @@ def _command(line):
 def test_every_example_runs(page, tmp_path):
     work = tmp_path / "examples"
     shutil.copytree(ROOT / "examples", work, ignore=shutil.ignore_patterns("__pycache__"))
+    for entry in ROOT.iterdir():  # the rest of the tree, for blocks run from the top folder
+        if entry.name not in ("examples", ".git", "build"):
+            (tmp_path / entry.name).symlink_to(entry)
     base = free_base()
     venv_bin = os.path.dirname(sys.executable)
     env = dict(
@@ -174,6 +180,7 @@ def test_every_example_runs(page, tmp_path):
             for server in servers:
                 server.stop()
             servers = []
+            cwd = tmp_path if body.startswith(TOP_FOLDER) else work
             for command, expected, reason in shell_lines(body):
                 if reason:
                     skipped.append((command, reason))
@@ -181,7 +188,7 @@ def test_every_example_runs(page, tmp_path):
                 for old, new in ports.items():
                     command = command.replace(old, new)
                 if command.endswith("&"):
-                    server = Server(command[:-1].strip(), env, work)
+                    server = Server(command[:-1].strip(), env, cwd)
                     servers.append(server)
                     assert server.ready.wait(BOUND), "no ready line from %r" % command
                     assert server.proc.poll() is None, "%r ended: %s" % (command, server.output)
@@ -190,7 +197,7 @@ def test_every_example_runs(page, tmp_path):
                 res = subprocess.run(
                     ["bash", "-c", command],
                     env=env,
-                    cwd=work,
+                    cwd=cwd,
                     capture_output=True,
                     text=True,
                     timeout=BOUND,

@@ -126,7 +126,7 @@ def test_flash_repl_and_test(fakes, tmp_path):
     assert run(["board", "test", "--port", "u0"]) == 0
     c = calls()
     assert c[0] == "mpremote bootloader"
-    assert c[1] == "dfu-util -a 0 -d 0483:df11 -D %s" % fw
+    assert c[1] == "dfu-util -a 0 -d 0483:df11 -D %s -s :leave" % fw  # starts the firmware
     assert c[2].startswith("mpremote cp") and c[2].endswith(":main.py")
     assert c[3] == "mpremote repl"
     tests = c[4:]

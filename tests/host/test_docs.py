@@ -2,6 +2,7 @@
 benchmark pages say what their saved data says, and the conventions page lists the modules
 the imports check allows."""
 
+import json
 import pathlib
 import re
 import subprocess
@@ -13,6 +14,7 @@ sys.path.insert(0, str(ROOT / "tools" / "bench"))
 
 import check_imports  # noqa: E402
 import report  # noqa: E402
+from obsw_host.obc.config import MissionConfig  # noqa: E402
 
 README_MAX = 15_000  # bytes: a front page, the rest lives in docs/
 
@@ -94,3 +96,27 @@ def test_the_conventions_list_what_the_imports_check_allows():
     section = text.split("## The MicroPython subset")[1].split("No `typing`")[0]
     listed = set(re.findall(r"`(\w+)`", section))
     assert listed == check_imports.MICROPYTHON_MODULES
+
+
+def _json_blocks():
+    for page in sorted((ROOT / "docs").rglob("*.md")):
+        for body in re.findall(r"```json\n(.*?)```", page.read_text(), re.S):
+            yield page.relative_to(ROOT), body
+
+
+def test_every_json_example_parses():
+    blocks = list(_json_blocks())
+    assert len(blocks) >= 3
+    for page, body in blocks:
+        try:
+            json.loads(body)
+        except ValueError as e:
+            raise AssertionError("%s: %s\n%s" % (page, e, body)) from None
+
+
+def test_the_obc_configurations_shown_are_accepted(tmp_path):
+    configs = [(page, json.loads(b)) for page, b in _json_blocks() if '"processes"' in b]
+    assert {str(page) for page, _ in configs} == {"docs/obc.md", "docs/raspberry-pi.md"}
+    for page, doc in configs:
+        config = MissionConfig(doc, str(tmp_path / "mission.json"))
+        assert config.processes == doc["processes"], page

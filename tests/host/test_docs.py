@@ -101,7 +101,11 @@ def test_the_conventions_list_what_the_imports_check_allows():
 def _json_blocks():
     for page in sorted((ROOT / "docs").rglob("*.md")):
         for body in re.findall(r"```json\n(.*?)```", page.read_text(), re.S):
-            yield page.relative_to(ROOT), body
+            if body.startswith("--8<--"):  # a file of the repository, shown as it is
+                path = body.split('"')[1]
+                yield pathlib.Path(path), (ROOT / path).read_text()
+            else:
+                yield page.relative_to(ROOT), body
 
 
 def test_every_json_example_parses():
@@ -114,9 +118,20 @@ def test_every_json_example_parses():
             raise AssertionError("%s: %s\n%s" % (page, e, body)) from None
 
 
+def test_every_file_shown_exists():
+    shown = []
+    for page in sorted((ROOT / "docs").rglob("*.md")):
+        shown += re.findall(r'^--8<-- "([^"]+)"$', page.read_text(), re.M)
+    assert len(shown) >= 5
+    assert [path for path in shown if not (ROOT / path).is_file()] == []
+
+
 def test_the_obc_configurations_shown_are_accepted(tmp_path):
     configs = [(page, json.loads(b)) for page, b in _json_blocks() if '"processes"' in b]
-    assert {str(page) for page, _ in configs} == {"docs/obc.md", "docs/raspberry-pi.md"}
+    assert {str(page) for page, _ in configs} == {
+        "docs/obc.md",
+        "boards/raspberry-pi/mission.json",
+    }
     for page, doc in configs:
         config = MissionConfig(doc, str(tmp_path / "mission.json"))
         assert config.processes == doc["processes"], page

@@ -247,8 +247,10 @@ class Checker(ExprChecker):
                 self.fail(PlutoTypeError, "%scannot assign a real to %s variable"
                           % (who, _a(declared)), p)  # fmt: skip
             elif et[1] != vt[1] and et[1] != NONE:
-                self.fail(PlutoTypeError, "%sunits do not match: variable has %s"
-                          % (who, unit or "no units"), p)  # fmt: skip
+                self.fail(PlutoTypeError, "%scannot assign %s to %s variable with units %s: "
+                          "units %s and %s differ" % (who, self.operand(e, et), _a(declared),
+                          unit or "none", self.unit_name(e, et) or "none", unit or "none"),
+                          p)  # fmt: skip
             return
         if vt[0] != et[0]:
             self.fail(PlutoTypeError, "%scannot assign %s to %s variable"

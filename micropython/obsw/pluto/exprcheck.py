@@ -188,7 +188,8 @@ class ExprChecker:
         if a[0] == b[0] and (a[0] != "b" or op in ("=", "!=")):
             return
         self.fail(PlutoTypeError, "cannot compare %s with %s: types %s and %s differ"
-                  % (self.operand(x, a), self.operand(y, b), _show(a), _show(b)), e[1])  # fmt: skip
+                  % (self.operand(x, a), self.operand(y, b), _show(a), _show(b)),
+                  e[1])  # fmt: skip
 
     def arith(self, e, a, b):
         op, p = e[2], e[1]

@@ -4,6 +4,7 @@ from obsw.pluto.exprcheck import (
     ANY,
     NONE,
     STRING,
+    TIME,
     ExprChecker,
     PlutoReferenceError,
     PlutoTypeError,
@@ -12,6 +13,8 @@ from obsw.pluto.exprcheck import (
     type_of_code,
     type_of_value,
 )
+from obsw.pluto.names import norm
+from obsw.pluto.units import Quantity, dims
 
 
 class Checker(ExprChecker):
@@ -187,8 +190,83 @@ class Checker(ExprChecker):
             if d is None or d[0] != "activity":
                 self.fail(PlutoReferenceError, "unknown activity %s" % path, r[1])
         r[4], r[5] = "act", path
-        for _, v in tuple(call[1]) + tuple(call[2]):
+        for _, v in call[2]:
             self.argument(v, scopes)
+        sig = None
+        if self.resolver is not None and hasattr(self.resolver, "signature"):
+            sig = self.resolver.signature(path)
+        if sig is None or (call[1] and call[1][0][0] == "value set"):
+            for _, v in call[1]:
+                self.argument(v, scopes)
+            return
+        self.signature(path, sig, call[1], scopes, r[1])
+
+    def signature(self, path, sig, args, scopes, p):
+        """Arguments against the activity's declared signature: names, count, types, units."""
+        takes = ", ".join([a[0] for a in sig]) or "none"
+        given = {}
+        for i, (name, v) in enumerate(args):
+            q = v[1] if isinstance(v, tuple) else p
+            if name is None:
+                if i >= len(sig):
+                    self.fail(PlutoTypeError, "activity %s takes %d arguments (%s), got %d"
+                              % (path, len(sig), takes, len(args)), q)  # fmt: skip
+                    self.argument(v, scopes)
+                    continue
+                decl = sig[i]
+            else:
+                decl = None
+                for d in sig:
+                    if norm(d[0]) == norm(name):
+                        decl = d
+                if decl is None:
+                    self.fail(PlutoReferenceError, "activity %s has no argument %s (takes: %s)"
+                              % (path, name, takes), q)  # fmt: skip
+                    self.argument(v, scopes)
+                    continue
+            if decl[0] in given:
+                self.fail(PlutoTypeError, "activity %s: argument %s given twice"
+                          % (path, decl[0]), q)  # fmt: skip
+            given[decl[0]] = True
+            if v[0] in ("rec", "arr"):
+                self.argument(v, scopes)
+                if decl[1] != "?":
+                    self.fail(PlutoTypeError, "activity %s: argument %s takes %s, got a%s"
+                              % (path, decl[0], _a(_DECLARED[decl[1]]),
+                                 " record" if v[0] == "rec" else "n array"), q)  # fmt: skip
+                continue
+            self.argument_type(path, decl, v, self.expr(v, scopes), q)
+        for d in sig:
+            if d[0] not in given:
+                self.fail(PlutoTypeError, "activity %s needs argument %s (takes: %s)"
+                          % (path, d[0], takes), p)  # fmt: skip
+
+    def argument_type(self, path, decl, v, et, p):
+        name, code, unit = decl
+        if code == "?" or et[0] == "?":
+            return
+        want = _DECLARED[code] + (" in " + unit if unit and code != "rt" else "")
+        why = None
+        if code in ("i", "u", "r"):
+            if et[0] not in "ir":
+                why = "types %s and %s differ" % (_show(et), _DECLARED[code])
+            elif code != "r" and et[0] == "r":
+                why = "a real is no integer"
+            elif et[1] != NONE and et[1] != (dims(unit) if unit else NONE):
+                why = "units %s and %s differ" % (self.unit_name(v, et), unit or "none")
+            elif code == "u" and v[0] == "c" and _below_zero(v[2]):
+                why = "it is negative"
+        elif code == "rt":
+            if not (et[0] in "ir" and et[1] == TIME):
+                why = "it is no relative time"
+        elif code == "s":
+            if et[0] not in "se":
+                why = "types %s and string differ" % _show(et)
+        elif et[0] != code:
+            why = "types %s and %s differ" % (_show(et), _DECLARED[code])
+        if why:
+            self.fail(PlutoTypeError, "activity %s: argument %s takes %s, got %s: %s"
+                      % (path, name, _a(want), self.operand(v, et), why), p)  # fmt: skip
 
     def argument(self, v, scopes):
         if isinstance(v, tuple) and v[0] in ("rec", "arr"):
@@ -321,6 +399,11 @@ def _declared(code, vt):
     if isinstance(code, tuple):
         return "enumerated " + str(code[1])
     return _DECLARED.get(code) or _show(vt)
+
+
+def _below_zero(v):
+    n = v.value if isinstance(v, Quantity) else v
+    return type(n) is not bool and isinstance(n, (int, float)) and n < 0
 
 
 def _a(text):

@@ -45,6 +45,33 @@ def type_code(t):
 
 _PTC = {1: "b", 3: "i", 4: "i", 5: "r", 8: "s"}
 
+# PLUTO's predefined types as an argument declaration may name them
+_PLUTO_TYPES = {
+    "boolean": "b",
+    "signed integer": "i",
+    "integer": "i",
+    "unsigned integer": "u",
+    "real": "r",
+    "string": "s",
+    "absolute time": "a",
+    "relative time": "rt",
+}
+
+
+def argument_code(t):
+    """Checker type code of a declared activity argument: a PLUTO predefined type name
+    ("unsigned integer", "relative time"...) or a database type ("uint8", "float32", [3, 4]);
+    unsigned integers give "u", types PLUTO cannot check "?"."""
+    if isinstance(t, (list, tuple)) and len(t) == 2:
+        return "u" if t[0] == 3 else _PTC.get(t[0], "?")
+    name = str(t or "").lower()
+    code = _PLUTO_TYPES.get(name)
+    if code is not None:
+        return code
+    if name.startswith("uint") or name == "unsigned":
+        return "u"
+    return type_code(t)
+
 
 def _unit(u):
     """``u`` if PLUTO (Annex B) knows it, else None (the value then counts as unitless)."""
@@ -64,13 +91,15 @@ MEMBER = 2
 CODE = 3
 UNIT = 4
 PARAMS = 5
+SIGNATURE = 6
 
 
 class Catalog:
     """What is known about component members, by spelling-free (component, member) names.
 
-    An entry is ``[kind, component, member, type code, unit, params]``; ``kind`` is
-    "parameter", "activity" or "event"; ``params`` lists an operation's ``(name, unit)``.
+    An entry is ``[kind, component, member, type code, unit, params, signature]``; ``kind``
+    is "parameter", "activity" or "event"; ``params`` lists an operation's ``(name, unit)``;
+    ``signature`` the arguments the database declares, ``(name, type code, unit)``.
     """
 
     def __init__(self, sdb=None, interfaces=()):
@@ -82,11 +111,11 @@ class Catalog:
         for itf in interfaces or ():
             self.add_interface(itf)
 
-    def add(self, kind, comp, member, code=None, unit=None, params=None):
+    def add(self, kind, comp, member, code=None, unit=None, params=None, signature=None):
         key = (norm(comp), norm(member))
         e = self.entries.get(key)
         if e is None:
-            self.entries[key] = [kind, comp, member, code, _unit(unit), params]
+            self.entries[key] = [kind, comp, member, code, _unit(unit), params, signature]
         else:  # a second source fills in what the first left open
             if e[CODE] in (None, "?") and code:
                 e[CODE] = code
@@ -94,6 +123,8 @@ class Catalog:
                 e[UNIT] = _unit(unit)
             if e[PARAMS] is None and params is not None:
                 e[PARAMS] = params
+            if e[SIGNATURE] is None and signature is not None:
+                e[SIGNATURE] = signature
         self._paths = {}
 
     def add_interface(self, itf):
@@ -117,7 +148,8 @@ class Catalog:
             if p.component:
                 self.add("parameter", p.component, p.name, type_code(p.type_spec), p.unit)
         for op in sdb.operations.values():
-            self.add("activity", op.component, op.name, None, None, list(op.arguments))
+            sig = [(n, argument_code(t), _unit(u)) for n, t, u in op.signature or ()]
+            self.add("activity", op.component, op.name, None, None, list(op.arguments), sig)
         for e in sdb.events.values():
             if e.component:
                 self.add("event", e.component, e.name)

@@ -5,7 +5,7 @@ JSON-like description on a virtual clock (dry runs and tests); ``run_virtual`` d
 procedure to its end against it, advancing the clock straight to each deadline.
 """
 
-from obsw.pluto.names import type_code
+from obsw.pluto.names import argument_code
 from obsw.pluto.units import TIME, Quantity, UnitError, dims, parse_iso
 from obsw.pluto.units import parse as parse_unit
 
@@ -52,6 +52,11 @@ class System:
     def describe(self, path):
         """Load-time facts about a reference: ("parameter", type code, unit),
         ("activity", None, None), ("event", None, None), or None when unknown."""
+        return None
+
+    def signature(self, path):
+        """The arguments activity ``path`` declares, [(name, type code, unit)] (type codes
+        as ``describe`` gives, "u" unsigned, "rt" relative time), or None: any arguments."""
         return None
 
 
@@ -171,7 +176,7 @@ def _signature(path, a):
         u = x.get("unit")
         if u:
             _quantity(0, u, "activity %s, argument %s" % (path, x["name"]))
-        out.append((x["name"], type_code(x.get("type")), u))
+        out.append((x["name"], argument_code(x.get("type")), u))
     return out
 
 

@@ -29,6 +29,8 @@ class Checker(ExprChecker):
         self.subj = []
         self.var_types = {}  # variable key -> (type, unit, enumerated values or None, code)
         self.def_vars = {}  # id(definition node) -> keys of the variables it declares
+        self.defs = []  # definitions being checked, innermost last
+        self.saved = set()  # keys of values a save context statement holds (read only)
 
     def lookup(self, scopes, name, kinds):
         for s in reversed(scopes):
@@ -41,6 +43,7 @@ class Checker(ExprChecker):
         _, p, decls, pre, main, wd, conf = node
         scope = {}
         scopes = scopes + [scope]
+        self.defs.append(id(node))
         for d in decls:
             if d[2] in scope:
                 self.fail(PlutoTypeError, "%s declared twice" % d[2], d[1])
@@ -74,6 +77,7 @@ class Checker(ExprChecker):
             self.stmt(s, scopes)
         for c in conf or ():
             self.condition(c, scopes)
+        self.defs.pop()
 
     def condition(self, c, scopes):
         if c[0] == "if":
@@ -161,12 +165,32 @@ class Checker(ExprChecker):
         elif k in ("log", "inform"):
             for e in s[2]:
                 self.expr(e, scopes)
+        elif k == "save":
+            self.save_context(s, scopes)
         elif k == "ctx":
             r = s[2]
             r[4], r[5] = "ctx", " of ".join(r[2])
             self.ctx.append(r[2])
             self.block(s[3], scopes)
             self.ctx.pop()
+
+    def save_context(self, s, scopes):
+        """Each saved value becomes a read-only variable of the enclosing step."""
+        for item in s[2]:
+            r, name = item[0], item[1]
+            typ = self.ref(r, scopes)
+            unit = r[5][1] if r[4] == "p" else None
+            if r[4] == "v":
+                unit = self.var_types[r[5]][1]
+            if name in scopes[-1]:
+                self.fail(PlutoTypeError, "%s declared twice" % name, s[1])
+            self.n += 1
+            key = "%d.%s" % (self.n, name)
+            item[2] = key
+            self.var_types[key] = (typ, unit, None, "saved")
+            self.saved.add(key)
+            self.def_vars.setdefault(self.defs[-1], []).append(key)
+            scopes[-1][name] = ("v", key)
 
     def continuation(self, cont, scopes):
         for a in (cont or {}).values():
@@ -296,6 +320,10 @@ class Checker(ExprChecker):
 
     def var(self, r, scopes):
         self.ref(r, scopes)
+        if r[4] == "v" and r[5] in self.saved:
+            self.fail(PlutoTypeError, "%s holds a saved context value, it cannot be assigned"
+                      % " of ".join(r[2]), r[1])  # fmt: skip
+            return None
         if r[4] != "v":
             if r[4] is not None:
                 self.fail(PlutoTypeError, "only variables can be assigned, %s is not one"

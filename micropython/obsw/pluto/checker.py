@@ -157,6 +157,7 @@ class Checker(ExprChecker):
         elif k == "op":
             self.activity((s[2], s[3], ()), scopes)
         elif k == "step":
+            scopes[-1][s[2]] = ("step", s[2])
             self.definition(s[3], scopes)
             self.continuation(s[4], scopes)
         elif k == "par":
@@ -367,6 +368,11 @@ class Checker(ExprChecker):
         names = r[2]
         if names[0] == "value" and len(names) > 1:
             names = names[1:]
+        if len(names) == 2 and names[0] in _STATUS_PROPERTIES:
+            e = self.lookup(scopes, names[1], ("act", "step"))
+            if e is not None:
+                r[4], r[5] = "st", (names[0], names[1], e[0])
+                return STRING
         if len(names) == 1:
             n = names[0]
             e = self.lookup(scopes, n, ("v", "act"))
@@ -410,6 +416,9 @@ def check(proc, resolver=None, arguments=None):
         raise err
     return c.var_types, c.def_vars
 
+
+# properties of an activity statement (its refer by name) or a step, as strings
+_STATUS_PROPERTIES = ("confirmation status", "execution status")
 
 _DECLARED = {
     "b": "Boolean",

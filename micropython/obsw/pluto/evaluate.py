@@ -220,12 +220,31 @@ class Evaluator:
             return v
         if kind == "a":
             return self.args[r[5]]
+        if kind == "st":
+            return self.status_property(*r[5])
         if kind == "s":
             h = self.refer.get(r[5])
             if h is None:
                 return "not initiated"
             return self.system.status(h) or "executing"
         raise PlutoRuntimeError("unresolved reference %s (procedure not checked)" % r[2][0])
+
+    def status_property(self, prop, name, what):
+        """``confirmation status`` (confirmed, not confirmed, aborted; "not available" before
+        the end) or ``execution status`` (not initiated, executing, completed) of an activity
+        statement's refer by name or of a step."""
+        if what == "act":
+            h = self.refer.get(name)
+            st = None if h is None else self.system.status(h)
+            started = h is not None
+        else:
+            st = getattr(self, "step_status", {}).get(name)
+            started = st is not None
+            if st == "executing":
+                st = None
+        if prop == "execution status":
+            return "completed" if st else "executing" if started else "not initiated"
+        return st or "not available"
 
     def assign(self, r, v):
         key = r[5]

@@ -220,6 +220,10 @@ class ExprParser:
             f = self.function_name()
             if f is not None:
                 return self.call(f, p)
+            if self.take("confirmation", "status", "of"):  # 'confirmation' opens a body too
+                r = self.ref()
+                r[2] = ("confirmation status",) + r[2]
+                return r
             if v not in RESERVED:
                 if v == "get" and self.tok(1)[0] == WORD and self.tok(1)[1] not in RESERVED:
                     self.i += 1

@@ -81,6 +81,11 @@ def _math1(f):
     return g
 
 
+def _log10(x):
+    f = getattr(math, "log10", None)  # exact for powers of ten; a port may lack it
+    return f(x) if f else math.log(x) / math.log(10)
+
+
 def _sqrt(x):
     """Square root; a quantity's unit must be a square (4 m^2 gives 2 m)."""
     if not isinstance(x, Quantity):
@@ -209,7 +214,7 @@ FUNCTIONS = {
     "sqrt": (_sqrt, 1, 1, "N", "sqrt"),
     "exp": (_math1(math.exp), 1, 1, "D", "r"),
     "ln": (_math1(math.log), 1, 1, "D", "r"),
-    "log": (_math1(lambda x: math.log(x) / math.log(10)), 1, 1, "D", "r"),
+    "log": (_math1(_log10), 1, 1, "D", "r"),
     "sin": (_math1(math.sin), 1, 1, "D", "r"),
     "cos": (_math1(math.cos), 1, 1, "D", "r"),
     "tan": (_math1(math.tan), 1, 1, "D", "r"),

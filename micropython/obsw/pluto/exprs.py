@@ -248,7 +248,7 @@ class ExprParser:
             nt = self.tok(k + 1)
             if nt[0] == OP and nt[1] == "(":
                 name = " ".join(words)
-                if name in FUNCTIONS:
+                if name in FUNCTIONS or words[0] == "to":  # 'to ...(': a conversion, say so
                     best = (name, k + 1)
                 break
         if best is None:

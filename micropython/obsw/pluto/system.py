@@ -103,8 +103,7 @@ def value_of(v, where, unit=None):
                 return v.to(unit)
             except UnitError:
                 raise SystemSpecError("%s: %s is not in units of %s" % (where, v, unit)) from None
-        if _is_number(v):
-            return Quantity(v, unit)
+        return _quantity(v, unit, where)
     return v
 
 
@@ -136,6 +135,10 @@ def _parameter(path, p):
     if not isinstance(p, dict) or ("value" not in p and "timeline" not in p):
         v = value_of(p, where)
         return _code(v), v.unit if isinstance(v, Quantity) else None, [(0, v)]
+    extra = [k for k in p if k not in ("value", "timeline", "unit", "type")]
+    if extra:
+        raise SystemSpecError("%s: unknown key %s (value, timeline, unit, type)"
+                              % (where, ", ".join(extra)))  # fmt: skip
     unit = p.get("unit")
     if unit:
         _quantity(0, unit, where)
@@ -200,7 +203,7 @@ class SimulatedSystem(System):
     """
 
     def __init__(self, spec=None):
-        spec = spec or {}
+        spec = {} if spec is None else spec
         if not isinstance(spec, dict):
             raise SystemSpecError("a system description is a JSON object, got %r" % (spec,))
         cs = spec.get("clock_start")

@@ -36,9 +36,8 @@ class TestValuesWithUnits(unittest.TestCase):
         self.assertEqual(t["end_time_s"], 5)
 
     def test_values_converted_to_the_parameters_unit(self):
-        sim = SimulatedSystem(
-            {"parameters": {"t of Thermal": {"unit": "degC", "timeline": [[0, 20], [1, q(300, "K")]]}}}
-        )  # fmt: skip
+        line = [[0, 20], [1, q(300, "K")]]
+        sim = SimulatedSystem({"parameters": {"t of Thermal": {"unit": "degC", "timeline": line}}})
         self.assertEqual(sim.describe("t of Thermal"), ("parameter", "i", "degC"))
         self.assertEqual(sim.get("t of Thermal"), Quantity(20, "degC"))
         sim.now = 1
@@ -50,8 +49,10 @@ class TestValuesWithUnits(unittest.TestCase):
         sim = SimulatedSystem({"parameters": {"rate of Wheel": q(2.5, "deg/s")}})
         self.assertEqual(sim.describe("rate of Wheel"), ("parameter", "r", "deg/s"))
         self.assertEqual(sim.get("rate of Wheel"), Quantity(2.5, "deg/s"))
-        t = dry_run(step("log rate of Wheel > 1 deg/s;"), {"parameters": {"rate of Wheel":
-                                                                          q(2.5, "deg/s")}})
+        t = dry_run(
+            step("log rate of Wheel > 1 deg/s;"),
+            {"parameters": {"rate of Wheel": q(2.5, "deg/s")}},
+        )
         self.assertEqual(t["log"], ["TRUE"])
 
     def test_times_with_units(self):

@@ -146,13 +146,15 @@ class TestLoadTime(unittest.TestCase):
         self.rejected(
             "initiate and confirm set_state_bits of CpduN with arguments state := 1, mask := 1,"
             " gain := 2 end with;", PlutoReferenceError,
-            "activity set_state_bits of CpduN has no argument gain (takes: state, mask)")  # fmt: skip
+            "activity set_state_bits of CpduN has no argument gain (takes: state,"
+            " mask)")  # fmt: skip
 
     def test_missing_argument(self):
         self.rejected(
             "initiate set_state_bits of CpduN with arguments state := 1 end with;",
             PlutoTypeError,
-            "activity set_state_bits of CpduN needs argument mask (takes: state, mask)")  # fmt: skip
+            "activity set_state_bits of CpduN needs argument mask (takes: state,"
+            " mask)")  # fmt: skip
         self.rejected(
             "initiate and confirm reset of CpduN with arguments 1 end with;", PlutoTypeError,
             "activity reset of CpduN takes 0 arguments (none), got 1")  # fmt: skip

@@ -410,7 +410,10 @@ def check(proc, resolver=None, arguments=None):
     c = Checker(resolver, arguments)
     c.definition(proc, [], True)
     if c.errors:
-        c.errors.sort(key=lambda x: (x.line, x.col))
+        order = {}
+        for i, x in enumerate(c.errors):  # MicroPython's sort is not stable: ties by order
+            order[id(x)] = i
+        c.errors.sort(key=lambda x: (x.line, x.col, order[id(x)]))
         err = c.errors[0]
         err.errors = c.errors
         raise err

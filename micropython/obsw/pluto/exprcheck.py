@@ -123,8 +123,11 @@ class ExprChecker:
             return BOOL
         if k == "btw":
             t = self.expr(e[2], scopes)
-            self.comparable(e, t, self.expr(e[3], scopes), "<", e[2], e[3])
-            self.comparable(e, t, self.expr(e[4], scopes), "<", e[2], e[4])
+            lo, hi = self.expr(e[3], scopes), self.expr(e[4], scopes)
+            n = len(self.errors)  # one error per relation (the first bound that does not fit)
+            self.comparable(e, t, lo, "<", e[2], e[3])
+            if len(self.errors) == n:
+                self.comparable(e, t, hi, "<", e[2], e[4])
             return BOOL
         if k == "wi":
             t = self.expr(e[2], scopes)
@@ -140,8 +143,11 @@ class ExprChecker:
             return BOOL
         if k == "in":
             t = self.expr(e[2], scopes)
+            n = len(self.errors)
             for x in e[3]:
-                self.comparable(e, t, self.expr(x, scopes), "=", e[2], x)
+                tx = self.expr(x, scopes)
+                if len(self.errors) == n:
+                    self.comparable(e, t, tx, "=", e[2], x)
             return BOOL
         if k == "f":
             return self.function(e, [self.expr(a, scopes) for a in e[3]])

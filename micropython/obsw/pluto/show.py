@@ -19,7 +19,10 @@ def unit_text(dims):
 
 def source(e, depth=0):
     """Procedure text of expression node ``e`` (shortened; bounded recursion)."""
-    s = _source(e, depth)
+    try:
+        s = _source(e, depth)
+    except RuntimeError:  # called at the deepest nesting a board's C stack holds
+        return "the expression"
     return s if len(s) <= _MAX else s[: _MAX - 3] + "..."
 
 

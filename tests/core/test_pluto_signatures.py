@@ -31,7 +31,8 @@ SDB = {
                 {"name": "label", "arguments": [{"name": "text", "type": "string"},
                                                 {"name": "armed", "type": "bool"},
                                                 {"name": "anything"}]},
-                {"name": "reset"},
+                {"name": "reset", "arguments": []},
+                {"name": "flush"},
             ],
         }
     ]
@@ -88,12 +89,14 @@ class TestDeclared(unittest.TestCase):
                          [("line", "uint8", None), ("width", "float32", "ms")])  # fmt: skip
         self.assertEqual(ops["CpduN.pulse"].arguments, [("line", None), ("width", "ms")])
         self.assertEqual(ops["CpduN.reset"].signature, [])
+        self.assertIsNone(ops["CpduN.flush"].signature)  # arguments not declared: any
         s, _ = system()
         self.assertEqual(
             s.signature("pulse of CpduN"), [("line", "u", None), ("width", "r", "ms")]
         )
         self.assertEqual(s.signature("set state bits of Cpdu N")[0], ("state", "u", None))
         self.assertIsNone(s.signature("state of CpduN"))  # a parameter, no activity
+        self.assertIsNone(s.signature("flush of CpduN"))
         self.assertIsNone(Catalog(interfaces=[CPDU]).find("pulse of CpduN")[6])
 
     def test_type_names(self):

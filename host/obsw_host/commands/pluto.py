@@ -67,7 +67,8 @@ class SdbResolver:
         for op in sdb.operations.values():
             path = "%s of %s" % (op.name, op.component)
             self.known[path] = ("activity", "?", None)
-            self.signatures[path] = [(n, argument_code(t), u) for n, t, u in op.signature]
+            if op.signature is not None:
+                self.signatures[path] = [(n, argument_code(t), u) for n, t, u in op.signature]
         for e in sdb.events.values():
             if e.component:
                 self.known["%s of %s" % (e.name, e.component)] = ("event", "?", None)

@@ -148,7 +148,9 @@ class Catalog:
             if p.component:
                 self.add("parameter", p.component, p.name, type_code(p.type_spec), p.unit)
         for op in sdb.operations.values():
-            sig = [(n, argument_code(t), _unit(u)) for n, t, u in op.signature or ()]
+            sig = None
+            if op.signature is not None:
+                sig = [(n, argument_code(t), _unit(u)) for n, t, u in op.signature]
             self.add("activity", op.component, op.name, None, None, list(op.arguments), sig)
         for e in sdb.events.values():
             if e.component:

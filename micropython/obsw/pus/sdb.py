@@ -178,7 +178,8 @@ class FunctionDef:
 
 class OperationDef:
     """An operation of a component: ``arguments`` are (name, unit) pairs (None: not given);
-    ``signature`` is its declared arguments as (name, type, unit), type None when not given."""
+    ``signature`` is its declared arguments as (name, type, unit), type None when not given,
+    or None when the database lists no ``arguments`` (any arguments then)."""
 
     __slots__ = ("component", "name", "arguments", "signature")
 
@@ -198,7 +199,8 @@ class OperationDef:
 
 def _operation(cname, op):
     """An ``OperationDef`` from a component's ``operations`` entry: each argument is
-    ``{"name": n, "type": t, "unit": u}`` (type and unit optional; a type is checked here)."""
+    ``{"name": n, "type": t, "unit": u}`` (type and unit optional; a type is checked here);
+    ``"arguments": []`` declares an operation that takes none."""
     where = "operation %s.%s" % (cname, op["name"])
     args = []
     sig = []
@@ -213,7 +215,7 @@ def _operation(cname, op):
             field_type(t, "%s, argument %s" % (where, name))
         args.append((name, a.get("unit")))
         sig.append((name, t, a.get("unit")))
-    return OperationDef(cname, op["name"], args, sig)
+    return OperationDef(cname, op["name"], args, sig if "arguments" in op else None)
 
 
 class NodeDef:

@@ -279,3 +279,18 @@ class ExprChecker:
                     return ANY
             return ("r", tuple([d // 2 for d in first[1]]))
         return type_of_code(res)
+
+
+_DECLARED = {
+    "b": "Boolean",
+    "i": "signed integer",
+    "u": "unsigned integer",
+    "r": "real",
+    "s": "string",
+    "a": "absolute time",
+    "rt": "relative time",
+}
+
+
+def _a(text):
+    return ("an " if text[:1] in "aeiouAEIOU" else "a ") + text

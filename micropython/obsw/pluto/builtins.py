@@ -259,8 +259,12 @@ FUNCTIONS = {
     "to Boolean": (_to_boolean, 1, 1, "S", "b"),
 }
 
-# the most words any function name has (the parser looks no further ahead)
+# the most words any function name has (the parser looks no further ahead), and the words
+# function names start with ("to" too: 'to <anything>(' is a conversion the checker names)
 MAX_NAME_WORDS = 3
+FIRST_WORDS = set(["to"])
+for _name in FUNCTIONS:
+    FIRST_WORDS.add(_name.split(" ")[0])
 
 
 def call(name, args, now):

@@ -1,7 +1,7 @@
 """PLUTO expression parser: token helpers, names, references, constants with units, operators."""
 
 from obsw.pluto import units
-from obsw.pluto.builtins import FUNCTIONS, MAX_NAME_WORDS
+from obsw.pluto.builtins import FIRST_WORDS, FUNCTIONS, MAX_NAME_WORDS
 from obsw.pluto.lexer import ABST, EOF, NUM, OP, RELT, STR, WORD, PlutoSyntaxError, line_col
 
 # Words that end a multi-word name: every keyword that may follow a name or open a statement.
@@ -238,6 +238,8 @@ class ExprParser:
     def function_name(self):
         """The longest standard function name (Annex C, words such as 'to' or 'of' included)
         that starts here and is followed by '(', with its words taken; else None."""
+        if self.toks[self.i][1] not in FIRST_WORDS:
+            return None
         words = []
         best = None
         for k in range(MAX_NAME_WORDS):

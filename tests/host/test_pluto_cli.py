@@ -73,3 +73,15 @@ def test_run_the_procedure_written_from_the_grammar(capsys):
     trace = json.loads(capsys.readouterr().out)
     assert trace["status"] == "confirmed"
     assert trace["user_messages"][0] == "battery at 7.2 V"
+
+
+def test_run_argument_with_units(tmp_path, capsys):
+    f = tmp_path / "p.pluto"
+    f.write_text("procedure main log limit, limit > 2 V; end main end procedure")
+    ns = argparse.Namespace(file=str(f), system=None, quiet=True,
+                            arg=['limit={"value": 2500, "unit": "mV"}'])  # fmt: skip
+    assert cmd.run_cmd(ns) == 0
+    assert json.loads(capsys.readouterr().out)["log"] == ["2500 mVTRUE"]
+    ns.arg = ['limit={"value": 1, "unit": "parsec"}']
+    with pytest.raises(UserError):
+        cmd.run_cmd(ns)

@@ -7,7 +7,7 @@ from obsw.pluto.dryrun import dry_run
 from obsw.pluto.interp import load
 from obsw.pluto.lexer import PlutoError
 from obsw.pluto.names import argument_code
-from obsw.pluto.system import SimulatedSystem, SystemSpecError
+from obsw.pluto.system import SimulatedSystem, SystemSpecError, value_of
 from obsw.pluto.units import Quantity
 
 from obsw_host.errors import UserError, read_json
@@ -133,7 +133,13 @@ def run_cmd(args):
     spec = read_json(args.system, "system file") if args.system else {}
     if args.system:
         _system(args.system, spec)  # a description it cannot play is the user's, said at once
-    arguments = dict(_arg(a) for a in args.arg)
+    arguments = {}
+    for a in args.arg:  # a value with units as in the system file: {"value": 3, "unit": "V"}
+        name, value = _arg(a)
+        try:
+            arguments[name] = value_of(value, "--arg " + name)
+        except SystemSpecError as e:
+            raise UserError(str(e)) from None
 
     def show(t, line, what):
         print("t=%-8g line %-4d %s" % (t, line, what), file=sys.stderr)

@@ -10,8 +10,8 @@ from obsw.il.node import Node
 from obsw.pluto.checker import PlutoReferenceError, PlutoTypeError
 from obsw.pluto.il_system import IlSystem
 from obsw.pluto.interp import Procedure, load
-from obsw.pluto.names import Catalog, argument_code
-from obsw.pluto.system import SimulatedSystem, run_virtual
+from obsw.pluto.names import Catalog
+from obsw.pluto.system import SimulatedSystem, argument_code, run_virtual
 from obsw.pus.sdb import Sdb, SdbError
 
 T0 = 1735689600.0  # 2025-01-01T00:00:00Z

@@ -6,8 +6,7 @@ import sys
 from obsw.pluto.dryrun import dry_run
 from obsw.pluto.interp import load
 from obsw.pluto.lexer import PlutoError
-from obsw.pluto.names import argument_code
-from obsw.pluto.system import SimulatedSystem, SystemSpecError, value_of
+from obsw.pluto.system import SimulatedSystem, SystemSpecError, argument_code, value_of
 from obsw.pluto.units import Quantity
 
 from obsw_host.errors import UserError, read_json

@@ -34,51 +34,12 @@ def _num(x):
     return x
 
 
-def _keep(f):
-    # result keeps the unit of the argument (abs, round, floor...)
-    def g(x):
-        if isinstance(x, Quantity):
-            return Quantity(f(x.value), x.unit)
-        return f(x)
-
-    return g
-
-
 def _round(x):
     return int(math.floor(x + 0.5)) if x >= 0 else -int(math.floor(-x + 0.5))
 
 
 def _sign(x):
     return (x > 0) - (x < 0)
-
-
-def _minmax(pick):
-    def f(*xs):
-        best = xs[0]
-        for x in xs[1:]:
-            a = best.value if isinstance(best, Quantity) else best
-            b = (
-                x.to(best.unit).value
-                if isinstance(x, Quantity) and isinstance(best, Quantity)
-                else x
-            )
-            if isinstance(b, Quantity):
-                b = b.value
-            if pick(b, a):
-                best = x
-        return best
-
-    return f
-
-
-def _math1(f):
-    def g(x):
-        try:
-            return f(_num(x))
-        except (ValueError, ZeroDivisionError, OverflowError):
-            raise FunctionError("argument %s outside the function's domain" % text(x)) from None
-
-    return g
 
 
 def _log10(x):
@@ -88,14 +49,14 @@ def _log10(x):
 
 def _sqrt(x):
     """Square root; a quantity's unit must be a square (4 m^2 gives 2 m)."""
+    if (x.value if isinstance(x, Quantity) else x) < 0:
+        raise FunctionError("argument %s outside the function's domain" % text(x))
     if not isinstance(x, Quantity):
-        return _math1(math.sqrt)(x)
+        return math.sqrt(x)
     d = dims(x.unit)
     for k in d:
         if k % 2:
             raise FunctionError("sqrt of %s: unit %s is not a square" % (text(x), x.unit))
-    if x.value < 0:
-        raise FunctionError("argument %s outside the function's domain" % text(x))
     si = x.si()
     unit = unit_text(tuple(k // 2 for k in d))
     return Quantity(math.sqrt(si), unit) if unit else math.sqrt(si)
@@ -203,72 +164,148 @@ def _to_boolean(s):
     raise FunctionError("to Boolean: %r is neither TRUE nor FALSE" % (s,))
 
 
-# name: (function, min args, max args (-1: any), argument kinds, result kind)
-# kinds: N number with any unit, D dimensionless number or angle, I integer, S string,
-#        A absolute time, R relative time, * anything; the last kind repeats.
-# results: = (like the first argument), i= (integer with the first argument's unit), and the
-#        type codes r, i, s, b, a, rt
+def _atan2(y, x):
+    return math.atan2(_num(y), _num(x))
+
+
+def _trunc(x):
+    return int(x)
+
+
+def _floor(x):
+    return int(math.floor(x))
+
+
+def _ceiling(x):
+    return int(math.ceil(x))
+
+
+def _sign_of(x):
+    return _sign(x.value if isinstance(x, Quantity) else x)
+
+
+def _min(*xs):
+    return _pick(xs, True)
+
+
+def _max(*xs):
+    return _pick(xs, False)
+
+
+def _pick(xs, smallest):
+    best = xs[0]
+    for x in xs[1:]:
+        a = best.value if isinstance(best, Quantity) else best
+        b = x.to(best.unit).value if isinstance(x, Quantity) and isinstance(best, Quantity) else x
+        if isinstance(b, Quantity):
+            b = b.value
+        if (b < a) if smallest else (b > a):
+            best = x
+    return best
+
+
+def _concatenate(*s):
+    return "".join(s)
+
+
+def _upper(s):
+    return s.upper()
+
+
+def _lower(s):
+    return s.lower()
+
+
+# name: (function, "call min max kinds result"), the spec a constant string (no heap on a board)
+#   call: m  maths on plain numbers (angles in radians, domain errors reported)
+#         k  keeps the unit of its one argument (abs, round...)
+#         -  called with the values as they are
+#   min, max: argument counts (max * : any)
+#   kinds: N number with any unit, D dimensionless number or angle, I integer, S string,
+#          A absolute time, R relative time, * anything; the last kind repeats
+#   result: = like the first argument, i= integer in the first argument's unit, sqrt, or a
+#           type code (r, i, s, b, a, rt)
 FUNCTIONS = {
     # mathematical
-    "abs": (_keep(abs), 1, 1, "N", "="),
-    "sqrt": (_sqrt, 1, 1, "N", "sqrt"),
-    "exp": (_math1(math.exp), 1, 1, "D", "r"),
-    "ln": (_math1(math.log), 1, 1, "D", "r"),
-    "log": (_math1(_log10), 1, 1, "D", "r"),
-    "sin": (_math1(math.sin), 1, 1, "D", "r"),
-    "cos": (_math1(math.cos), 1, 1, "D", "r"),
-    "tan": (_math1(math.tan), 1, 1, "D", "r"),
-    "arcsin": (_math1(math.asin), 1, 1, "D", "r"),
-    "arccos": (_math1(math.acos), 1, 1, "D", "r"),
-    "arctan": (_math1(math.atan), 1, 1, "D", "r"),
-    "arctan2": (lambda y, x: math.atan2(_num(y), _num(x)), 2, 2, "D", "r"),
-    "sinh": (_math1(math.sinh), 1, 1, "D", "r"),
-    "cosh": (_math1(math.cosh), 1, 1, "D", "r"),
-    "tanh": (_math1(math.tanh), 1, 1, "D", "r"),
-    "round": (_keep(_round), 1, 1, "N", "i="),
-    "trunc": (_keep(lambda x: int(x)), 1, 1, "N", "i="),
-    "floor": (_keep(lambda x: int(math.floor(x))), 1, 1, "N", "i="),
-    "ceiling": (_keep(lambda x: int(math.ceil(x))), 1, 1, "N", "i="),
-    "sign": (lambda x: _sign(x.value if isinstance(x, Quantity) else x), 1, 1, "N", "i"),
-    "min": (_minmax(lambda b, a: b < a), 1, -1, "N", "="),
-    "max": (_minmax(lambda b, a: b > a), 1, -1, "N", "="),
+    "abs": (abs, "k 1 1 N ="),
+    "sqrt": (_sqrt, "- 1 1 N sqrt"),
+    "exp": (math.exp, "m 1 1 D r"),
+    "ln": (math.log, "m 1 1 D r"),
+    "log": (_log10, "m 1 1 D r"),
+    "sin": (math.sin, "m 1 1 D r"),
+    "cos": (math.cos, "m 1 1 D r"),
+    "tan": (math.tan, "m 1 1 D r"),
+    "arcsin": (math.asin, "m 1 1 D r"),
+    "arccos": (math.acos, "m 1 1 D r"),
+    "arctan": (math.atan, "m 1 1 D r"),
+    "arctan2": (_atan2, "m 2 2 D r"),
+    "sinh": (math.sinh, "m 1 1 D r"),
+    "cosh": (math.cosh, "m 1 1 D r"),
+    "tanh": (math.tanh, "m 1 1 D r"),
+    "round": (_round, "k 1 1 N i="),
+    "trunc": (_trunc, "k 1 1 N i="),
+    "floor": (_floor, "k 1 1 N i="),
+    "ceiling": (_ceiling, "k 1 1 N i="),
+    "sign": (_sign_of, "- 1 1 N i"),
+    "min": (_min, "- 1 * N ="),
+    "max": (_max, "- 1 * N ="),
     # time
-    "current time": (None, 0, 0, "", "a"),
-    "seconds": (seconds, 1, 1, "R", "r"),
-    "to relative time": (_to_relative_time, 1, 1, "D", "rt"),
-    "to absolute time": (_to_absolute_time, 1, 1, "S", "a"),
-    "year": (_year, 1, 1, "A", "i"),
-    "month": (_month, 1, 1, "A", "i"),
-    "day of month": (_day_of_month, 1, 1, "A", "i"),
-    "day of year": (_day_of_year, 1, 1, "A", "i"),
-    "day of week": (_day_of_week, 1, 1, "A", "i"),
-    "hour": (_hour, 1, 1, "A", "i"),
-    "minute": (_minute, 1, 1, "A", "i"),
-    "second": (_second, 1, 1, "A", "r"),
+    "current time": (None, "- 0 0 - a"),
+    "seconds": (seconds, "- 1 1 R r"),
+    "to relative time": (_to_relative_time, "- 1 1 D rt"),
+    "to absolute time": (_to_absolute_time, "- 1 1 S a"),
+    "year": (_year, "- 1 1 A i"),
+    "month": (_month, "- 1 1 A i"),
+    "day of month": (_day_of_month, "- 1 1 A i"),
+    "day of year": (_day_of_year, "- 1 1 A i"),
+    "day of week": (_day_of_week, "- 1 1 A i"),
+    "hour": (_hour, "- 1 1 A i"),
+    "minute": (_minute, "- 1 1 A i"),
+    "second": (_second, "- 1 1 A r"),
     # string
-    "length": (len, 1, 1, "S", "i"),
-    "substring": (_substring, 2, 3, "SII", "s"),
-    "concatenate": (lambda *s: "".join(s), 1, -1, "S", "s"),
-    "index of": (_index_of, 2, 2, "S", "i"),
-    "to upper case": (lambda s: s.upper(), 1, 1, "S", "s"),
-    "to lower case": (lambda s: s.lower(), 1, 1, "S", "s"),
-    "trim": (_strip, 1, 1, "S", "s"),
-    "to string": (text, 1, 1, "*", "s"),
-    "to integer": (_to_integer, 1, 1, "S", "i"),
-    "to real": (_to_real, 1, 1, "S", "r"),
-    "to Boolean": (_to_boolean, 1, 1, "S", "b"),
+    "length": (len, "- 1 1 S i"),
+    "substring": (_substring, "- 2 3 SII s"),
+    "concatenate": (_concatenate, "- 1 * S s"),
+    "index of": (_index_of, "- 2 2 S i"),
+    "to upper case": (_upper, "- 1 1 S s"),
+    "to lower case": (_lower, "- 1 1 S s"),
+    "trim": (_strip, "- 1 1 S s"),
+    "to string": (text, "- 1 1 * s"),
+    "to integer": (_to_integer, "- 1 1 S i"),
+    "to real": (_to_real, "- 1 1 S r"),
+    "to Boolean": (_to_boolean, "- 1 1 S b"),
 }
 
-# the most words any function name has (the parser looks no further ahead), and the words
-# function names start with ("to" too: 'to <anything>(' is a conversion the checker names)
+# the most words any function name has (the parser looks no further ahead), and the first
+# words of the names of several words ("to": 'to <anything>(' is a conversion the checker names)
 MAX_NAME_WORDS = 3
-FIRST_WORDS = set(["to"])
-for _name in FUNCTIONS:
-    FIRST_WORDS.add(_name.split(" ")[0])
+FIRST_WORDS = ("to", "current", "day", "index")
+
+
+def spec(name):
+    """(min args, max args or -1, argument kinds, result) of function ``name``, or None."""
+    f = FUNCTIONS.get(name)
+    if f is None:
+        return None
+    _, lo, hi, kinds, res = f[1].split(" ")
+    return int(lo), -1 if hi == "*" else int(hi), kinds, res
 
 
 def call(name, args, now):
     """Apply standard function ``name`` to evaluated ``args``; ``now`` feeds 'current time'."""
     if name == "current time":
         return AbsTime(now)
-    return FUNCTIONS[name][0](*args)
+    f, how = FUNCTIONS[name]
+    if how[0] == "k":
+        x = args[0]
+        return Quantity(f(x.value), x.unit) if isinstance(x, Quantity) else f(x)
+    if how[0] == "m":
+        try:
+            return f(*[_num(x) for x in args])
+        except (ValueError, ZeroDivisionError, OverflowError) as e:
+            if isinstance(e, FunctionError):
+                raise
+            raise FunctionError(
+                "argument %s outside the function's domain" % ", ".join([text(x) for x in args])
+            ) from None
+    return f(*args)

@@ -6,7 +6,7 @@ dimension vector (numbers) or None. A relative time is ("r", TIME).
 """
 
 from obsw.pluto import units
-from obsw.pluto.builtins import FUNCTIONS
+from obsw.pluto.builtins import spec
 from obsw.pluto.lexer import PlutoError, line_col
 from obsw.pluto.show import source, unit_text
 
@@ -238,11 +238,11 @@ class ExprChecker:
         return (base, tuple(a[1][i] + k * b[1][i] for i in range(8)))
 
     def function(self, e, ts):
-        spec = FUNCTIONS.get(e[2])
-        if spec is None:
+        f = spec(e[2])
+        if f is None:
             self.fail(PlutoReferenceError, "unknown function %s" % e[2], e[1])
             return ANY
-        _, lo, hi, kinds, res = spec
+        lo, hi, kinds, res = f
         if len(ts) < lo or (hi >= 0 and len(ts) > hi):
             self.fail(PlutoTypeError, "%s takes %s arguments, got %d"
                       % (e[2], lo if lo == hi else "%d or more" % lo, len(ts)), e[1])  # fmt: skip

@@ -238,7 +238,8 @@ class ExprParser:
     def function_name(self):
         """The longest standard function name (Annex C, words such as 'to' or 'of' included)
         that starts here and is followed by '(', with its words taken; else None."""
-        if self.toks[self.i][1] not in FIRST_WORDS:
+        w = self.toks[self.i][1]
+        if w not in FIRST_WORDS and w not in FUNCTIONS:  # 'log(' too: 'log' opens a statement
             return None
         words = []
         best = None

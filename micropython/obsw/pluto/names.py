@@ -7,6 +7,7 @@ finds ``CpduN.set_state_bits``); ``target_of`` turns a path into ``(component, m
 ``plain`` turns procedure values into what the interaction layer carries.
 """
 
+from obsw.pluto.system import argument_code
 from obsw.pluto.units import AbsTime, Quantity, UnitError, isdigits
 from obsw.pluto.units import parse as parse_unit
 
@@ -44,33 +45,6 @@ def type_code(t):
 
 
 _PTC = {1: "b", 3: "i", 4: "i", 5: "r", 8: "s"}
-
-# PLUTO's predefined types as an argument declaration may name them
-_PLUTO_TYPES = {
-    "boolean": "b",
-    "signed integer": "i",
-    "integer": "i",
-    "unsigned integer": "u",
-    "real": "r",
-    "string": "s",
-    "absolute time": "a",
-    "relative time": "rt",
-}
-
-
-def argument_code(t):
-    """Checker type code of a declared activity argument: a PLUTO predefined type name
-    ("unsigned integer", "relative time"...) or a database type ("uint8", "float32", [3, 4]);
-    unsigned integers give "u", types PLUTO cannot check "?"."""
-    if isinstance(t, (list, tuple)) and len(t) == 2:
-        return "u" if t[0] == 3 else _PTC.get(t[0], "?")
-    name = str(t or "").lower()
-    code = _PLUTO_TYPES.get(name)
-    if code is not None:
-        return code
-    if name.startswith("uint") or name == "unsigned":
-        return "u"
-    return type_code(t)
 
 
 def _unit(u):

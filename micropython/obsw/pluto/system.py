@@ -5,7 +5,6 @@ JSON-like description on a virtual clock (dry runs and tests); ``run_virtual`` d
 procedure to its end against it, advancing the clock straight to each deadline.
 """
 
-from obsw.pluto.names import argument_code
 from obsw.pluto.units import TIME, Quantity, UnitError, dims, parse_iso
 from obsw.pluto.units import parse as parse_unit
 
@@ -58,6 +57,37 @@ class System:
         """The arguments activity ``path`` declares, [(name, type code, unit)] (type codes
         as ``describe`` gives, "u" unsigned, "rt" relative time), or None: any arguments."""
         return None
+
+
+# PLUTO's predefined types as an argument declaration may name them
+_PLUTO_TYPES = {
+    "boolean": "b",
+    "signed integer": "i",
+    "integer": "i",
+    "unsigned integer": "u",
+    "real": "r",
+    "string": "s",
+    "absolute time": "a",
+    "relative time": "rt",
+}
+_PTC_CODES = {1: "b", 3: "u", 4: "i", 5: "r", 8: "s"}
+
+
+def argument_code(t):
+    """Checker type code of a declared activity argument: a PLUTO predefined type name
+    ("unsigned integer", "relative time"...) or a database type ("uint8", "float32", [3, 4]);
+    unsigned integers give "u", types PLUTO cannot check "?"."""
+    if isinstance(t, (list, tuple)) and len(t) == 2:
+        return _PTC_CODES.get(t[0], "?")
+    name = str(t or "").lower()
+    code = _PLUTO_TYPES.get(name)
+    if code is not None:
+        return code
+    for prefix, code in (("uint", "u"), ("int", "i"), ("float", "r"), ("bool", "b"),
+                         ("str", "s")):  # fmt: skip
+        if name.startswith(prefix):
+            return code
+    return "?"
 
 
 class SystemSpecError(ValueError):

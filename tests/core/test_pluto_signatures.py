@@ -14,7 +14,7 @@ from obsw.pluto.names import Catalog
 from obsw.pluto.system import SimulatedSystem, argument_code, run_virtual
 from obsw.pus.sdb import Sdb, SdbError
 
-T0 = 1735689600.0  # 2025-01-01T00:00:00Z
+T0 = 0.0  # the IL clock near the epoch: exact in a board's single-precision floats
 
 SDB = {
     "components": [
@@ -27,7 +27,7 @@ SDB = {
                                {"name": "mask", "type": "uint8"}]},
                 {"name": "pulse",
                  "arguments": [{"name": "line", "type": "uint8"},
-                               {"name": "width", "type": "float32", "unit": "ms"}]},
+                               {"name": "width", "type": "float32", "unit": "s"}]},
                 {"name": "label", "arguments": [{"name": "text", "type": "string"},
                                                 {"name": "armed", "type": "bool"},
                                                 {"name": "anything"}]},
@@ -86,14 +86,12 @@ class TestDeclared(unittest.TestCase):
     def test_database_gives_the_signature(self):
         ops = Sdb(SDB).operations
         self.assertEqual(ops["CpduN.pulse"].signature,
-                         [("line", "uint8", None), ("width", "float32", "ms")])  # fmt: skip
-        self.assertEqual(ops["CpduN.pulse"].arguments, [("line", None), ("width", "ms")])
+                         [("line", "uint8", None), ("width", "float32", "s")])  # fmt: skip
+        self.assertEqual(ops["CpduN.pulse"].arguments, [("line", None), ("width", "s")])
         self.assertEqual(ops["CpduN.reset"].signature, [])
         self.assertIsNone(ops["CpduN.flush"].signature)  # arguments not declared: any
         s, _ = system()
-        self.assertEqual(
-            s.signature("pulse of CpduN"), [("line", "u", None), ("width", "r", "ms")]
-        )
+        self.assertEqual(s.signature("pulse of CpduN"), [("line", "u", None), ("width", "r", "s")])
         self.assertEqual(s.signature("set state bits of Cpdu N")[0], ("state", "u", None))
         self.assertIsNone(s.signature("state of CpduN"))  # a parameter, no activity
         self.assertIsNone(s.signature("flush of CpduN"))
@@ -132,7 +130,7 @@ class TestLoadTime(unittest.TestCase):
         p = Procedure(load(procedure(
             "initiate and confirm set_state_bits of CpduN with arguments mask := 0xFF,"
             " state := 5 end with; initiate and confirm pulse of CpduN with arguments 3,"
-            ' 0.02 s end with; initiate and confirm label of CpduN with arguments'
+            ' 2 min end with; initiate and confirm label of CpduN with arguments'
             ' text := "x", armed := TRUE, anything := 2.5 V end with;'
             " initiate and confirm reset of CpduN;")), s, poll=0.5)  # fmt: skip
         p.start(T0)
@@ -142,7 +140,7 @@ class TestLoadTime(unittest.TestCase):
                 break
             s.node.clock.advance(0.5)
         self.assertEqual(p.outcome, "confirmed")
-        self.assertEqual(cpdu.calls, [("set_state_bits", 5, 255), ("pulse", 3, 20.0),
+        self.assertEqual(cpdu.calls, [("set_state_bits", 5, 255), ("pulse", 3, 120),
                                       ("label", "x", True, 2.5), ("reset",)])  # fmt: skip
 
     def test_unknown_argument(self):
@@ -193,8 +191,8 @@ class TestLoadTime(unittest.TestCase):
         self.rejected(
             "initiate and confirm pulse of CpduN with arguments line := 1, width := 2 m"
             " end with;", PlutoTypeError,
-            "activity pulse of CpduN: argument width takes a real in ms, got 2 m: units m and"
-            " ms differ")  # fmt: skip
+            "activity pulse of CpduN: argument width takes a real in s, got 2 m: units m and"
+            " s differ")  # fmt: skip
         self.rejected(
             "initiate and confirm set_state_bits of CpduN with arguments state := 1 V,"
             " mask := 1 end with;", PlutoTypeError,

@@ -64,14 +64,21 @@ def _show(t):
     return {"b": "Boolean", "s": "string", "a": "absolute time", "e": "enumerated", "?": "?"}[b]
 
 
-_KINDS = {
-    "N": "a number",
-    "D": "a dimensionless number or an angle",
-    "I": "an integer without units",
-    "S": "a string",
-    "A": "an absolute time",
-    "R": "a relative time",
-}
+_KINDS = (
+    ("N", "a number"),
+    ("D", "a dimensionless number or an angle"),
+    ("I", "an integer without units"),
+    ("S", "a string"),
+    ("A", "an absolute time"),
+    ("R", "a relative time"),
+)
+
+
+def _kind(k):
+    for key, text in _KINDS:
+        if key == k:
+            return text
+    return k
 
 
 def _num(t):
@@ -261,7 +268,7 @@ class ExprChecker:
             )
             if not ok:
                 self.fail(PlutoTypeError, "argument %d of %s, %s, is not %s"
-                          % (i + 1, e[2], self.operand(e[3][i], t), _KINDS[kind]),
+                          % (i + 1, e[2], self.operand(e[3][i], t), _kind(kind)),
                           e[1])  # fmt: skip
         first = ts[0] if ts else ANY
         if res == "=":

@@ -7,7 +7,7 @@ finds ``CpduN.set_state_bits``); ``target_of`` turns a path into ``(component, m
 ``plain`` turns procedure values into what the interaction layer carries.
 """
 
-from obsw.pluto.system import argument_code
+from obsw.pluto.system import argument_code, norm
 from obsw.pluto.units import AbsTime, Quantity, UnitError, isdigits
 from obsw.pluto.units import parse as parse_unit
 
@@ -19,11 +19,6 @@ class ParameterError(ValueError):
         super().__init__("%s: %s" % (path, cause))
         self.path = path
         self.cause = cause
-
-
-def norm(name):
-    """A name's spelling-free form: lower case, without spaces and underscores."""
-    return name.replace(" ", "").replace("_", "").lower()
 
 
 def type_code(t):

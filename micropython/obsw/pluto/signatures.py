@@ -10,7 +10,7 @@ from obsw.pluto.exprcheck import (
     _a,
     _show,
 )
-from obsw.pluto.names import norm
+from obsw.pluto.system import norm
 from obsw.pluto.units import Quantity, dims
 
 

@@ -59,18 +59,26 @@ class System:
         return None
 
 
-# PLUTO's predefined types as an argument declaration may name them
-_PLUTO_TYPES = {
-    "boolean": "b",
-    "signed integer": "i",
-    "integer": "i",
-    "unsigned integer": "u",
-    "real": "r",
-    "string": "s",
-    "absolute time": "a",
-    "relative time": "rt",
-}
-_PTC_CODES = {1: "b", 3: "u", 4: "i", 5: "r", 8: "s"}
+def norm(name):
+    """A name's spelling-free form: lower case, without spaces and underscores (how member
+    and argument names are matched)."""
+    return name.replace(" ", "").replace("_", "").lower()
+
+
+# PLUTO's predefined types as an argument declaration may name them, and packet field types
+# by PTC; tuples of constants (frozen in flash on a board, where a dict would take heap)
+_PLUTO_TYPES = (
+    ("boolean", "b"),
+    ("signed integer", "i"),
+    ("integer", "i"),
+    ("unsigned integer", "u"),
+    ("real", "r"),
+    ("string", "s"),
+    ("absolute time", "a"),
+    ("relative time", "rt"),
+)
+_DB_PREFIXES = (("uint", "u"), ("int", "i"), ("float", "r"), ("bool", "b"), ("str", "s"))
+_PTC_CODES = ("?", "b", "?", "u", "i", "r", "?", "?", "s")
 
 
 def argument_code(t):
@@ -78,13 +86,13 @@ def argument_code(t):
     ("unsigned integer", "relative time"...) or a database type ("uint8", "float32", [3, 4]);
     unsigned integers give "u", types PLUTO cannot check "?"."""
     if isinstance(t, (list, tuple)) and len(t) == 2:
-        return _PTC_CODES.get(t[0], "?")
+        ptc = t[0]
+        return _PTC_CODES[ptc] if type(ptc) is int and 0 <= ptc < len(_PTC_CODES) else "?"
     name = str(t or "").lower()
-    code = _PLUTO_TYPES.get(name)
-    if code is not None:
-        return code
-    for prefix, code in (("uint", "u"), ("int", "i"), ("float", "r"), ("bool", "b"),
-                         ("str", "s")):  # fmt: skip
+    for whole, code in _PLUTO_TYPES:
+        if name == whole:
+            return code
+    for prefix, code in _DB_PREFIXES:
         if name.startswith(prefix):
             return code
     return "?"

@@ -17,12 +17,9 @@ transaction: written whole (a new image renamed over a file-backed one) or, if i
 read back, put back as it was.
 
 Loads by reference (TC[6,19], [6,21]) take each area's data from a file of the onboard
-filestore, dumps to file (TC[6,20], [6,22]) write each area to one; paths, locks and maximum
-sizes are those of ST[23] (``obsw.pus.services.file_refs``). A dump to file larger than
-``chunk`` octets proceeds ``chunk`` octets per cycle into a temporary file renamed into place
-at the end, and completes then; TC[6,12] aborts every such dump, which fails its completion
-with ``FAILURE_ABORTED`` and leaves no file behind. Dumps in telemetry larger than
-``max_dump`` octets are refused. TC[6,17] checks a whole object (TM[6,18]).
+filestore, named as in ST[23]; dumps to file (TC[6,20], [6,22]) and their abort (TC[6,12])
+are ``obsw.pus.services.s06_files``. Dumps in telemetry larger than ``max_dump`` octets are
+refused. TC[6,17] checks a whole object (TM[6,18]).
 
 Scrubbing (TC[6,13], [6,14]; ``obsw.pus.services.s06_scrub``) reads ``scrub_blocks`` blocks
 of each scrubbed memory per cycle and raises an event for each block it repaired from a
@@ -30,14 +27,10 @@ mirror copy and each it could not. Protection and scrubbing references persist i
 context store.
 """
 
-import asyncio
-
 from obsw.compat import const
 from obsw.crc import crc16_ccitt
 from obsw.il.interface import LOW, MEDIUM
 from obsw.pus.messages import (
-    FAILURE_ABORTED,
-    FAILURE_FILESTORE,
     FAILURE_OUT_OF_BOUNDS,
     FAILURE_READBACK,
     FAILURE_REFUSED,
@@ -68,8 +61,7 @@ from obsw.pus.messages import (
     TM_MEM_DUMP_RAW_REPORT,
 )
 from obsw.pus.services import s06_layouts as lay
-from obsw.pus.services.base import Service
-from obsw.pus.services.file_refs import read_file, writable_file
+from obsw.pus.services.file_refs import read_file
 from obsw.pus.services.s01_verification import PusFailure
 from obsw.pus.services.s06_areas import (  # noqa: F401 (the module's public names)
     BytesMemory,
@@ -77,14 +69,13 @@ from obsw.pus.services.s06_areas import (  # noqa: F401 (the module's public nam
     MirroredMemory,
     areas_from_sdb,
 )
+from obsw.pus.services.s06_files import MemoryFiles
 from obsw.pus.services.s06_scrub import REPAIRED, Scrub
 from obsw.pus.services.s06_user import MemoryUser  # noqa: F401
-from obsw.pus.structure import Structure
 
 EVENT_SCRUB_REPAIRED = const(0xFF06)  # aux: memory ID, address of the block
 EVENT_SCRUB_UNCORRECTABLE = const(0xFF07)
 
-_EMPTY = Structure([])
 _SLICE = const(1024)  # octets read at once by checks and dumps
 
 
@@ -98,7 +89,7 @@ def _crc(area, off, n):
     return crc16_ccitt(b"") if crc is None else crc
 
 
-class MemoryManagement(Service):
+class MemoryManagement(MemoryFiles):
     """The service 6 provider over ``areas`` (memory ID -> area); see the module text."""
 
     SERVICE = SERVICE_MEMORY_MANAGEMENT
@@ -132,26 +123,21 @@ class MemoryManagement(Service):
         scrub_blocks=4,
         events=(EVENT_SCRUB_REPAIRED, EVENT_SCRUB_UNCORRECTABLE),
     ):
-        super().__init__()
+        super().__init__(chunk)
         self.areas = dict(areas)
         self.max_dump = max_dump
-        self.chunk = chunk
         self.scrub_block = scrub_block
         self.scrub_blocks = scrub_blocks
         self.events = events
         self.protected = set()  # memory IDs whose write protection is on
         self.scrubs = {}  # memory ID -> Scrub
-        self.dumps = 0  # dumps to file in progress
-        self.aborted = 0  # dumps to file aborted by TC[6,12]
-        self._aborts = 0
-        self._cycle = None  # the asyncio.Event dumps to file wait on for the next cycle
 
     # -------------------------------------------------------------------------- context
 
     def context(self):
         return {
             "protected": sorted(self.protected),
-            "scrub": [[mid, s.refs] for mid, s in self.scrubs.items()],
+            "scrub": [[mid, self.scrubs[mid].refs] for mid in sorted(self.scrubs)],
         }
 
     def restore(self, ctx):
@@ -388,90 +374,6 @@ class MemoryManagement(Service):
         tc["checksum"] = _crc(area, off, n)
         req.report(TM_MEM_CHECK_OBJECT_WHOLE_REPORT, lay.OBJECT_WHOLE_REPORT.pack(tc))
 
-    # -------------------------------------------------------------------------- dumps to file
-
-    def _file_jobs(self, area, items, spans):
-        jobs = []
-        names = []
-        for i, off in zip(items, spans):
-            fs, name = writable_file(self.app, i["repository"], i["file"], i["length"])
-            if name in names:
-                raise PusFailure(FAILURE_REFUSED, "%s named twice" % name)
-            names.append(name)
-            jobs.append((area, off, i["length"], fs, name))
-        return jobs
-
-    def dump_to_file(self, req):
-        tc, area, spans = self._raw_ranges(req, lay.DUMP_TO_FILE)
-        return self._dump_files(req, self._file_jobs(area, tc["items"], spans))
-
-    def dump_object_to_file(self, req):
-        tc, area, spans = self._object_ranges(req, lay.OBJECT_DUMP_TO_FILE)
-        return self._dump_files(req, self._file_jobs(area, tc["items"], spans))
-
-    def _dump_files(self, req, jobs):
-        req.start()
-        total = 0
-        for job in jobs:
-            total += job[2]
-        if total > self.chunk:
-            return self._dump_later(jobs)  # the request completes when the files do
-        for area, off, n, fs, name in jobs:
-            self._fs(fs.write_atomic, name, area.read(off, n))
-        return None
-
-    def _fs(self, fn, *args):
-        try:
-            return fn(*args)
-        except OSError as e:
-            raise PusFailure(FAILURE_FILESTORE, str(e)) from None
-
-    async def _next_cycle(self):
-        ev = self._cycle
-        if ev is None:
-            ev = self._cycle = asyncio.Event()
-        await ev.wait()
-
-    async def _dump_later(self, jobs):
-        gen = self._aborts
-        self.dumps += 1
-        tmp = None
-        try:
-            for area, off, n, fs, name in jobs:
-                tmp = name + ".part"
-                self._fs(fs.write_bytes, tmp, b"")
-                done = 0
-                while done < n:
-                    k = n - done if n - done < self.chunk else self.chunk
-                    h = self._fs(fs.open_write, tmp, False)
-                    try:
-                        self._fs(h.write, done, area.read(off + done, k))
-                    finally:
-                        h.close()
-                    done += k
-                    await self._next_cycle()
-                    if self._aborts != gen:
-                        self.aborted += 1
-                        raise PusFailure(FAILURE_ABORTED, "dump aborted by TC[6,12]")
-                self._fs(fs.rename, tmp, name)
-                tmp = None
-        finally:
-            self.dumps -= 1
-            if tmp is not None and fs.exists(tmp):
-                fs.delete(tmp)
-
-    def abort_dumps(self, req):
-        req.decode(_EMPTY)
-        req.start()
-        self._aborts += 1
-        self._wake()
-
-    def _wake(self):
-        ev = self._cycle
-        if ev is not None:
-            self._cycle = None
-            ev.set()
-
     # -------------------------------------------------------------------------- protection
 
     def _one(self, req):
@@ -507,7 +409,8 @@ class MemoryManagement(Service):
 
     def cyclic(self, now):
         self._wake()
-        for mid, scrub in self.scrubs.items():
+        for mid in sorted(self.scrubs):
+            scrub = self.scrubs[mid]
             for kind, off in scrub.step(self.scrub_blocks):
                 where = lay.WHERE.pack({"memory": mid, "address": scrub.area.start + off})
                 if kind == REPAIRED:

@@ -77,6 +77,16 @@ class TestCopyByTimeWindow(unittest.TestCase):
             (tx.reply["stores"][0]["oldest"], tx.reply["stores"][0]["newest"]), (1020.0, 1030.0)
         )
 
+    def test_bounds_at_the_time_tags_resolution(self):
+        h = Harness()
+        h.create(1)
+        h.run(h.user.add_types(APID, 1, {APID: {17: [2]}}))
+        h.run(h.user.enable(APID, [1]))
+        h.pings([1010.3, 1020.7])  # not whole 1/65536 s: the tags round them
+        h.create(2)
+        self.assertTrue(h.run(h.user.copy_window(APID, 1, 2, 1010.3, 1020.7)).ok)
+        self.assertEqual(len(h.storage.stores[2].packets), 2)
+
     def test_an_empty_window_copies_nothing(self):
         h = filled()
         self.assertTrue(h.run(h.user.copy_window(APID, 1, 2, 2000.0, 3000.0)).ok)

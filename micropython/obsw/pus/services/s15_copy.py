@@ -2,14 +2,14 @@
 storage-control configuration (TC[15,31], [15,32], [15,37], TM[15,38]): a part of
 ``Storage`` (``obsw.pus.services.s15_storage`` has the module text).
 
-TC[15,24] copies the packets of the source packet store whose storage time lies in the
-window (from time tag 1 to time tag 2, after time tag 1, or before time tag 2, bounds
-included) into the target packet store, in storage order and with their storage times, so
-the copy can be retrieved, summarised or deleted by time like the original. The target must
-be another store, exist, be empty and not be retrieved; a bounded target must hold the whole
-selection (a circular one keeps the newest packets, as when storing). The diagnostic
-configuration selects TM[3,26] by structure ID per APID, as the housekeeping one selects
-TM[3,25].
+TC[15,24] copies the packets of the source packet store whose storage time (at the time tags'
+resolution) lies in the window (from time tag 1 to time tag 2, after time tag 1, or before
+time tag 2, bounds included) into the target packet store, in storage order and with their
+storage times, so the copy can be retrieved, summarised or deleted by time like the original.
+The target must be another store, exist, be empty and not be retrieved; a bounded target
+must hold the whole selection (a circular one keeps the newest packets, as when storing). The
+diagnostic configuration selects TM[3,26] by structure ID per APID, as the housekeeping one
+selects TM[3,25].
 """
 
 from obsw.pus.messages import (
@@ -33,6 +33,12 @@ from obsw.pus.services.s15_layouts import (
 
 def _refuse(msg, sid):
     return PusFailure(FAILURE_REFUSED, msg, STORE_ID.pack(sid))
+
+
+def _at_tag_resolution(t):
+    """A storage time as a time tag carries it (the times reports give, and TCs name)."""
+    code = TIME_TAG.code
+    return code.to_seconds(*code.from_seconds(t))
 
 
 def window_bounds(window, tag1, tag2):
@@ -69,11 +75,11 @@ class CopyAndDiagnostics(Service):
             raise _refuse("target store %d is not empty" % dst.id, dst.id)
         if dst.range_queue is not None or dst.open_active:
             raise _refuse("target store %d is being retrieved" % dst.id, dst.id)
-        chosen = [
-            p
-            for p in src.packets
-            if (first is None or p[1] >= first) and (last is None or p[1] <= last)
-        ]
+        chosen = []
+        for p in src.packets:
+            t = _at_tag_resolution(p[1])
+            if (first is None or t >= first) and (last is None or t <= last):
+                chosen.append(p)
         size = 0
         for p in chosen:
             size += len(p[2])

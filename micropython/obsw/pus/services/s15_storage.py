@@ -50,6 +50,7 @@ from obsw.pus.messages import (
     TC_STORE_RETRIEVE_SEQUENCE_RANGE,
     TC_STORE_START_TIME_RANGE_RETRIEVAL,
     TC_STORE_SUSPEND_OPEN_RETRIEVAL,
+    TM_HK_DIAG_REPORT,
     TM_STORE_BLOCKED_EVENTS_REPORT,
     TM_STORE_CONFIGURATION_REPORT,
     TM_STORE_CONTENT_SUMMARY_REPORT,
@@ -90,9 +91,6 @@ def _failure(code, msg, sid):
     return PusFailure(code, msg, STORE_ID.pack(sid))
 
 
-_DIAG = (3, 26)
-
-
 class Control:
     """What one store keeps: report types, housekeeping and diagnostic SIDs, blocked event
     IDs."""
@@ -106,7 +104,7 @@ class Control:
     def selects(self, h):
         if not self.types.selects(h.apid, h.service, h.subtype):
             return False
-        if h.service == _DIAG[0] and h.subtype == _DIAG[1]:
+        if h.service == TM_HK_DIAG_REPORT[0] and h.subtype == TM_HK_DIAG_REPORT[1]:
             return self.diag.has(h.apid, h.sid())
         kind = hk_or_event_id(h)
         if kind is None:

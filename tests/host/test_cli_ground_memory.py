@@ -72,3 +72,16 @@ def test_store_sequence_and_orbit(obc, tmp_path):  # noqa: F811
     assert code == 0, out
     code, out = ground(port, "params", "get", "nav.distance")
     assert out["replies"][0]["values"]["nav.distance"] == 1234
+
+
+def test_bad_input_is_named_without_a_traceback():
+    for args, text in (
+        (("memory", "load", 1, "zz", "00"), "'zz': expected an integer"),
+        (("memory", "load", 1, 0, "xyz"), "'xyz': expected hexadecimal octets"),
+        (("store", "copy", 1, 2, "--from", "yesterday"), "'yesterday': expected YYYY-MM-DD"),
+        (("store", "copy", 1, 2), "without a time window"),
+        (("memory", "load-file", 1, 0, "SAT:/x.bin"), "one of the arguments --local"),
+    ):
+        r = obsw("ground", *args)
+        assert r.returncode in (1, 2) and text in r.stderr, (args, r.stderr)
+        assert "Traceback" not in r.stderr

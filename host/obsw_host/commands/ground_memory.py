@@ -21,9 +21,11 @@ Addresses and lengths take 0x prefixes; with ``--object ID`` the address is an o
 object (object 0: the whole memory). Times are UTC (``...Z``) or on-board seconds.
 """
 
+import argparse
 import shlex
 
 from obsw.crc import crc16_ccitt
+from obsw.utc import parse_utc
 
 from obsw_host.commands import ground as ground_cmd
 from obsw_host.errors import UserError
@@ -33,19 +35,21 @@ def _number(text):
     try:
         return int(text, 0)
     except ValueError:
-        raise UserError("number %r" % text, expected="an integer like 4096 or 0x1000") from None
+        raise argparse.ArgumentTypeError(
+            "%r: expected an integer like 4096 or 0x1000" % text
+        ) from None
 
 
 def _hex(text):
     try:
         return bytes.fromhex(text)
     except ValueError:
-        raise UserError("data %r" % text, expected="hexadecimal octets like cafe01") from None
+        raise argparse.ArgumentTypeError(
+            "%r: expected hexadecimal octets like cafe01" % text
+        ) from None
 
 
 def _time(text):
-    from obsw.utc import parse_utc
-
     try:
         return float(text)
     except ValueError:
@@ -53,9 +57,8 @@ def _time(text):
     try:
         return parse_utc(text)
     except ValueError:
-        raise UserError(
-            "time %r" % text, expected="YYYY-MM-DDTHH:MM:SS[.fff]Z or seconds"
-        ) from None
+        expected = "YYYY-MM-DDTHH:MM:SS[.fff]Z or on-board seconds"
+        raise argparse.ArgumentTypeError("%r: expected %s" % (text, expected)) from None
 
 
 def add_to_ground(s):

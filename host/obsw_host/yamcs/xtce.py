@@ -481,6 +481,7 @@ class Generator:
         )
         self.obcp_commands(pus)
         self.file_commands(pus)
+        self.memory_storage_commands(pus)
 
     def obcp_commands(self, pus):
         def obcp():
@@ -534,6 +535,126 @@ class Generator:
             ],
             "TC[23,14] copy a file (by CFDP between SAT: and GROUND:)",
         )
+
+    # ------------------------------------------------------------------ services 6, 15, 21, 22
+    def memory_storage_commands(self, pus):
+        """Service 6 (the loads that carry their data in the TC are the CLI's: XTCE loads
+        from files), 15 (copy by time window, diagnostic storage control), 21 (sequences by
+        reference) and 22 (orbit number)."""
+
+        def u(name, pair):
+            return ("arg", name, argument_type("", pair))
+
+        def path(name):
+            return ("arg", name, argument_type("", (8, 0)))
+
+        one = ("fixed", "n", 1, 8)
+
+        def mem():  # each command gets its own argument type elements
+            return u("memory", U16)
+
+        def obj():
+            return u("object", U16)
+
+        def rng(first="address"):
+            return [u(first, U32), u("length", U32)]
+
+        def files():
+            return [path("repository"), path("file")]
+
+        self.command(pus, "memory_abort_dumps", M.TC_MEM_ABORT_ALL_DUMPS, (), "TC[6,12]")
+        for name, mt in (
+            ("memory_scrub_enable", M.TC_MEM_ENABLE_SCRUBBING),
+            ("memory_scrub_disable", M.TC_MEM_DISABLE_SCRUBBING),
+            ("memory_protect", M.TC_MEM_ENABLE_WRITE_PROTECTION),
+            ("memory_unprotect", M.TC_MEM_DISABLE_WRITE_PROTECTION),
+        ):
+            self.command(pus, name, mt, [mem()], "TC[%d,%d]" % mt)
+        for name, mt, fields in (
+            ("memory_dump", M.TC_MEM_DUMP_RAW, lambda: [mem(), one] + rng()),
+            ("memory_check", M.TC_MEM_CHECK_RAW, lambda: [mem(), one] + rng()),
+            (
+                "memory_dump_object",
+                M.TC_MEM_DUMP_OBJECT,
+                lambda: [mem(), obj(), one] + rng("offset"),
+            ),
+            (
+                "memory_check_object",
+                M.TC_MEM_CHECK_OBJECT,
+                lambda: [mem(), obj(), one] + rng("offset"),
+            ),
+            ("memory_check_whole_object", M.TC_MEM_CHECK_OBJECT_WHOLE, lambda: [mem(), obj()]),
+            (
+                "memory_load_file",
+                M.TC_MEM_LOAD_RAW_BY_REFERENCE,
+                lambda: [mem(), one, u("address", U32)] + files() + [u("crc", U16)],
+            ),
+            (
+                "memory_dump_file",
+                M.TC_MEM_DUMP_RAW_TO_FILE,
+                lambda: [mem(), one] + rng() + files(),
+            ),
+            (
+                "memory_load_object_file",
+                M.TC_MEM_LOAD_OBJECT_BY_REFERENCE,
+                lambda: [mem(), obj(), one, u("offset", U32)] + files() + [u("crc", U16)],
+            ),
+            (
+                "memory_dump_object_file",
+                M.TC_MEM_DUMP_OBJECT_TO_FILE,
+                lambda: [mem(), obj(), one] + rng("offset") + files(),
+            ),
+        ):
+            self.command(pus, name, mt, fields(), "TC[%d,%d]" % mt)
+        whole = [
+            self.header_param("memory_id", 16),
+            self.header_param("memory_object_id", 16),
+            self.header_param("memory_object_length", 32),
+            self.header_param("memory_object_checksum", 16),
+        ]
+        self.report("memory_whole_object_report", M.TM_MEM_CHECK_OBJECT_WHOLE_REPORT, whole)
+        self.report("memory_object_dump", M.TM_MEM_DUMP_OBJECT_REPORT, whole[:2])
+        self.report("memory_object_check", M.TM_MEM_CHECK_OBJECT_REPORT, whole[:2])
+        # ST[15]: time tags as the CUC coarse (seconds) and fine (1/65536 s) parts
+        windows = {0: "from_to", 1: "after", 2: "before"}
+        self.command(
+            pus,
+            "store_copy",
+            M.TC_STORE_COPY_BY_TIME_WINDOW,
+            [
+                ("arg", "window", argument_type("", E8, labels=windows)),
+                u("tag1_seconds", U32),
+                ("fixed", "tag1_fraction", 0, 16),
+                u("tag2_seconds", U32),
+                ("fixed", "tag2_fraction", 0, 16),
+                u("source", U16),
+                u("target", U16),
+            ],
+            "TC[15,24] copy the packets of a time window into an empty store",
+        )
+        for name, mt in (
+            ("store_diag_add", M.TC_STORE_ADD_DIAG_STRUCTURES),
+            ("store_diag_delete", M.TC_STORE_DELETE_DIAG_STRUCTURES),
+        ):
+            fields = [u("store", U16), one, ("fixed", "apid", self.apid, 16)]
+            fields += [("fixed", "sid_count", 1, 8), u("sid", U16)]
+            self.command(pus, name, mt, fields, "TC[%d,%d]" % mt)
+        self.command(
+            pus, "store_diag_report", M.TC_STORE_REPORT_DIAG_STRUCTURES, [u("store", U16)]
+        )
+        self.report(
+            "store_diag_report",
+            M.TM_STORE_DIAG_STRUCTURES_REPORT,
+            [self.header_param("store_id", 16)],
+        )
+        # ST[21] sequences from files, ST[22] the orbit number
+        for name, mt in (
+            ("sequence_load_file", M.TC_SEQUENCE_LOAD_BY_REFERENCE),
+            ("sequence_load_file_activate", M.TC_SEQUENCE_LOAD_AND_ACTIVATE),
+        ):
+            fields = [("arg", "sequence", argument_type("", (8, 8)))]
+            self.command(pus, name, mt, fields + files())
+        self.command(pus, "position_set_orbit", M.TC_POS_SCHED_SET_ORBIT_NUMBER, [u("orbit", U32)])
 
     def parameter_commands(self):
         for pid in sorted(self.sc.params):

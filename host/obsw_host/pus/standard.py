@@ -116,18 +116,18 @@ _TABLE = """
  6  8 TM TM_MEM_CHECK_OBJECT_REPORT                    checked object memory data report
  6  9 TC TC_MEM_CHECK_RAW                              check raw memory data
  6 10 TM TM_MEM_CHECK_RAW_REPORT                       checked raw memory data report
- 6 11 TC TC_MEM_LOAD_RAW_ATOMIC                        load raw memory data atomically
- 6 12 TC TC_MEM_ABORT_DUMPS                            abort all memory dumps
- 6 13 TC TC_MEM_ENABLE_SCRUBBING                       enable memory scrubbing
- 6 14 TC TC_MEM_DISABLE_SCRUBBING                      disable memory scrubbing
- 6 15 TC TC_MEM_REPORT_SCRUBBING                       report the memory scrubbing status
- 6 16 TM TM_MEM_SCRUBBING_REPORT                       memory scrubbing status report
- 6 17 TC TC_MEM_ENABLE_WRITE_PROTECTION                enable memory write protection
- 6 18 TC TC_MEM_DISABLE_WRITE_PROTECTION               disable memory write protection
- 6 19 TC TC_MEM_REPORT_WRITE_PROTECTION                report the memory write protection status
- 6 20 TM TM_MEM_WRITE_PROTECTION_REPORT                memory write protection status report
- 6 21 TC TC_MEM_LOAD_FROM_FILE                         load memory data from a file
- 6 22 TC TC_MEM_DUMP_TO_FILE                           dump memory data to a file
+ 6 11 TC TC_MEM_LOAD_RAW_ATOMIC                        load raw memory data areas atomically
+ 6 12 TC TC_MEM_ABORT_ALL_DUMPS                        abort all memory dumps
+ 6 13 TC TC_MEM_ENABLE_SCRUBBING                       enable the memory scrubbing
+ 6 14 TC TC_MEM_DISABLE_SCRUBBING                      disable the memory scrubbing
+ 6 15 TC TC_MEM_ENABLE_WRITE_PROTECTION                enable the write protection of a memory
+ 6 16 TC TC_MEM_DISABLE_WRITE_PROTECTION               disable the write protection of a memory
+ 6 17 TC TC_MEM_CHECK_OBJECT_WHOLE                     check a whole memory object
+ 6 18 TM TM_MEM_CHECK_OBJECT_WHOLE_REPORT              checked whole memory object report
+ 6 19 TC TC_MEM_LOAD_RAW_BY_REFERENCE                  load raw memory data areas by reference
+ 6 20 TC TC_MEM_DUMP_RAW_TO_FILE                       dump raw memory data areas to file
+ 6 21 TC TC_MEM_LOAD_OBJECT_BY_REFERENCE               load object memory data areas by reference
+ 6 22 TC TC_MEM_DUMP_OBJECT_TO_FILE                    dump object memory data areas to file
  8  1 TC TC_FUNCTION_PERFORM                           perform a function
  9  1 TC TC_TIME_SET_REPORT_RATE                       set the time report generation rate
  9  2 TM TM_TIME_CUC_REPORT                            CUC time report

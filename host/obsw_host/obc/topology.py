@@ -14,7 +14,7 @@ process). ``describe()`` gives the whole topology as data (``obsw obc config`` p
 
 import os
 
-from obsw.il.interface import Interface, Operation
+from obsw.il.interface import DATA, Attribute, Interface, Operation
 
 from obsw_host.obc import defaults, plugins
 from obsw_host.obc.config import ConfigError
@@ -28,6 +28,15 @@ PLATFORM = Interface(
     description="the platform manager's events, raised by the PUS process",
 )
 PLATFORM_EVENTS = ("started", "died", "restarted", "power_cycle", "stopped")
+FRAME_PROCESSOR = Interface(
+    "FrameProcessor",
+    0x7E10,
+    [
+        Attribute("uart_a_dropped", 1, DATA, type="u32", description="TM frames UART A lost"),
+        Attribute("uart_b_dropped", 2, DATA, type="u32", description="TM frames UART B lost"),
+    ],
+    description="the frame processor's counters",
+)
 
 
 def health_interface(name, index):
@@ -80,10 +89,6 @@ class Topology:
             ProcessPlan(name, i, kinds, self.components)
             for i, (name, kinds) in enumerate(config.processes.items())
         ]
-        listed = {c.name for p in self.processes for c in p.components}
-        for name in self.components:
-            if name not in listed:
-                raise ConfigError("components.%s" % name, "named by no process of 'processes'")
 
     def __repr__(self):
         return "Topology(%s: %s)" % (self.config.name, self.processes)
@@ -115,7 +120,8 @@ class Topology:
         """Import every component module and find its interface and class; ``PluginError``
         names the mission file's entry if one cannot be used. Returns self."""
         for c in self.components.values():
-            c.check()
+            if self.runs(c.name):
+                c.check()
         return self
 
     # -------------------------------------------------------------------------- data
@@ -166,12 +172,13 @@ class Topology:
         return [eq.interface for eq in self.equipments()] if self.runs("spacecan") else []
 
     def component_interfaces(self):
-        """The interfaces of the mission's plug-in components."""
-        return [c.interface() for c in self.components.values()]
+        """The interfaces of the mission's plug-in components that some process runs."""
+        return [c.interface() for c in self.components.values() if self.runs(c.name)]
 
     def interfaces(self):
         """Every component interface of the OBC, wherever it runs (the OBCP engine's)."""
-        return self.component_interfaces() + self.equipment_interfaces()
+        frames = [FRAME_PROCESSOR] if self.runs("frames") else []
+        return self.component_interfaces() + self.equipment_interfaces() + frames
 
     def describe(self):
         """The topology as data: processes, their units and components, and connections."""
@@ -188,7 +195,7 @@ class Topology:
                 "module": c.module_ref,
                 "class": c.class_name,
                 "options": c.options,
-                "process": self.process_of(c.name).name,
+                "process": getattr(self.process_of(c.name), "name", None),  # None: not run
             }
         out["interaction_layer"] = os.path.abspath(self.config.il_directory)
         return out

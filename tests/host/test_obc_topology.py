@@ -11,7 +11,7 @@ from obsw_host.obc.plugins import Component, PluginError, component_for
 from obsw_host.obc.topology import Topology
 from obsw_host.pus.onboard import SERVICES
 
-PLUGIN = '''
+PLUGIN = """
 from obsw.il.interface import DATA, Attribute, Interface, Operation
 
 MAGNETORQUER = Interface(
@@ -30,7 +30,7 @@ class Torquer:
     def fire(self, dipole):
         self.dipole = min(dipole, self.limit)
         return self.dipole
-'''
+"""
 
 
 def sample():
@@ -139,7 +139,7 @@ def test_a_plug_in_from_a_file_with_its_class_and_options(tmp_path):
         ({"module": "magnetorquer.py"}, "components.Magnetorquer.class", "no class"),
         ({"module": "magnetorquer.py", "klass": "Torquer"}, "components.Magnetorquer", "klass"),
         ({"module": 5}, "components.Magnetorquer.module", "expected"),
-        ({"module": "magnetorquer.py", "options": []}, "components.Magnetorquer.options", "object"),
+        ({"module": "magnetorquer.py", "options": []}, "components.Magnetorquer.options", "obj"),
     ],
 )
 def test_a_component_that_cannot_be_used_is_a_config_error(tmp_path, entry, key, words):

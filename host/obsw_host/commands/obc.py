@@ -102,16 +102,18 @@ def serve(args):
 
 
 def _serve_process(topology, args, out):
-    """One process of the topology; a process that cannot be built says why in one line and
-    ends with status 2, which the platform manager takes as final (no restart)."""
+    """One process of the topology. One that cannot be built says why in one line: status 2
+    for a configuration error (final: the platform manager does not restart it), else 1."""
     from obsw_host.obc.assembly import ObcProcess
 
     try:
         process = ObcProcess(topology, args.process, out=out)
     except ConfigError as e:
         return _refuse("process %s: %s" % (args.process, e))
-    except Exception as e:
-        return _refuse("process %s cannot start: %s: %s" % (args.process, type(e).__name__, e))
+    except Exception as e:  # one line, not a traceback; the platform manager counts it
+        print("obsw obc: process %s cannot start: %s: %s" % (
+            args.process, type(e).__name__, e), file=sys.stderr, flush=True)  # fmt: skip
+        return 1
     try:
         process.serve(parent=args.parent)
     except KeyboardInterrupt:

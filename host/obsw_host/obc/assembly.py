@@ -49,7 +49,7 @@ class ObcProcess:
         self.units = [
             (label, unit_class(kind)(topology, plan, out)) for label, kind in plan.units()
         ]
-        self.node = Node("obc-" + name)
+        self.node = Node("obc-%s-health" % name)
         self.transport = SocketTransport(self.node, config.il_directory)
         self.health = _Health(self.units)
         self.node.provide(plan.health, self.health)

@@ -417,7 +417,7 @@ class ComponentUnit:
 
     def __init__(self, topology, process, out=print):
         self.out = out
-        self.node = Node("obc-" + process.name)
+        self.node = Node("obc-%s-components" % process.name)
         self.transport = SocketTransport(self.node, topology.config.il_directory)
         self.components = [c.build() for c in process.components]
         for itf, impl in self.components:

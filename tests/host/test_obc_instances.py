@@ -45,8 +45,9 @@ def mission(tmp_path, processes, components=None, tm_to=None, **platform):
 
 def obc(*args, **kw):
     env = dict(os.environ, PYTHONPATH=python_path())
-    return subprocess.Popen([sys.executable, "-m", "obsw_host.cli", "obc", *args], env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)  # fmt: skip
+    cmd = [sys.executable, "-m", "obsw_host.cli", "obc", *args]
+    pipe = subprocess.PIPE
+    return subprocess.Popen(cmd, env=env, stdout=pipe, stderr=pipe, text=True, **kw)
 
 
 def pinged(path):
@@ -142,14 +143,14 @@ def test_a_process_that_dies_right_after_start_is_stopped_without_power_cycle(tm
 
 
 def test_a_process_that_refuses_its_configuration_is_stopped_at_once(tmp_path):
-    path = mission(tmp_path, {"core": ["pus"], "panel": ["SolarPanel"]},
-                   {"SolarPanel": {"module": "obsw_host.solar_panel", "options": {"size": 2}}})  # fmt: skip
+    panel = {"module": "obsw_host.solar_panel", "options": {"size": 2}}  # no such argument
+    path = mission(tmp_path, {"core": ["pus"], "panel": ["SolarPanel"]}, {"SolarPanel": panel})
     lines = []
     pm = PlatformManager(obc_config.load(path), out=lines.append).start()
     try:
-        panel = pm.child("panel")
-        assert wait_for(lambda: panel.stopped), lines
-        assert panel.restarts == 0 and "configuration" in panel.stopped
+        child = pm.child("panel")
+        assert wait_for(lambda: child.stopped), lines
+        assert child.restarts == 0 and "configuration" in child.stopped
     finally:
         pm.stop()
     assert pm.power_cycles == 0

@@ -3,7 +3,7 @@
 # modules (all frozen: their code takes no heap, as on a board whose image carries its tests).
 metadata(version="0.1.0", description="obsw core and tests on the QEMU Cortex-M board")
 
-package("obsw", base_path="../micropython")  # the core, as core.py freezes it
+include("core.py")  # the core
 # asyncio as a Pyboard has it (the qemu port builds without it): the package with its pure-Python
 # task queue in place of the C one
 package(

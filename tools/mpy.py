@@ -61,9 +61,10 @@ class Manifest:
 
     def __init__(self):
         self.modules = []  # (path on disk, module path in the image)
-        self.required = []
+        self.required = []  # names of the packages required, in order
         self.metadata = None
         self.included = []  # the manifest files themselves
+        self.libraries = {}  # name -> folder of per-package manifests (add_library)
         self._dirs = []
 
     def _base(self, base_path):
@@ -71,13 +72,16 @@ class Manifest:
 
     def execute(self, path):
         path = pathlib.Path(path).resolve()
+        if str(path) in self.included:
+            return  # each manifest once, as manifestfile.py does
         self.included.append(str(path))
         self._dirs.append(path.parent)
         code = compile(path.read_text(), str(path), "exec")
         env = {
             "metadata": self._metadata,
             "include": self._include,
-            "require": self.required.append,
+            "require": self._require,
+            "add_library": self._add_library,
             "package": self._package,
             "module": self._module,
             "freeze": self._freeze,
@@ -89,6 +93,22 @@ class Manifest:
     def _metadata(self, description=None, version=None, license=None, author=None):
         if self.metadata is None:
             self.metadata = {"description": description, "version": version}
+
+    def _add_library(self, library, library_path, prepend=False):
+        self.libraries[library] = self._base(library_path)
+
+    def _require(self, name, version=None, library=None, **kwargs):
+        """A package of a library added with add_library: ``<library>/**/<name>/manifest.py``
+        (micropython-lib's own packages, without a library, are not the project's)."""
+        self.required.append(name)
+        folders = [self.libraries[library]] if library is not None else self.libraries.values()
+        for folder in folders:
+            for found in sorted(folder.rglob("manifest.py")):
+                if found.parent.name == name:
+                    self.execute(found)
+                    return
+        if library is not None:
+            raise ValueError("package %r not found in library %r" % (name, library))
 
     def _include(self, manifest_path, **kwargs):
         if manifest_path.startswith("$("):

@@ -99,3 +99,20 @@ def test_the_drops_are_published_as_attributes():
     assert sub.receive().value == 7
     assert node.get("FrameProcessor.uart_b_dropped", timeout=1.0) == 7
     assert node.get("FrameProcessor.uart_a_dropped", timeout=1.0) == 0
+
+
+def test_a_serial_port_nobody_reads_never_blocks_either():
+    from obsw_host.frames.links import SerialLink
+
+    controller, device = os.openpty()
+    tty.setraw(device)
+    path = os.ttyname(device)
+    os.close(device)
+    link = SerialLink(path, queue=4)  # the device end, as the OBC opens its UART
+    t = time.monotonic()
+    for _ in range(1000):
+        link.write(bytes(1024))
+    assert time.monotonic() - t < 5.0
+    assert link.dropped > 0 and link.pending() <= 4
+    link.close()
+    os.close(controller)

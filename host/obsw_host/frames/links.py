@@ -72,13 +72,14 @@ class SerialLink(_Outbox):
         import serial
 
         self.name = port
-        # with a queue, writes never wait (pyserial: write_timeout 0 is non-blocking)
-        self.port = serial.Serial(port, baudrate, timeout=0, write_timeout=0 if queue else 2)
+        self.port = serial.Serial(port, baudrate, timeout=0, write_timeout=2)
         self.enabled = True
         self._outbox(queue)
 
     def _send(self, view):
-        return self.port.write(view) or 0
+        # pyserial opens the port non-blocking; its own write with write_timeout=0 would
+        # retry EAGAIN in a busy loop, so the queue writes to the descriptor itself
+        return os.write(self.port.fileno(), view)
 
     def fileno(self):
         return self.port.fileno()

@@ -111,6 +111,8 @@ class Manifest:
             raise ValueError("package %r not found in library %r" % (name, library))
 
     def _include(self, manifest_path, **kwargs):
+        # a mission's manifest names this tree as $(OBSW) (make MICROPY_MANIFEST_OBSW=...)
+        manifest_path = manifest_path.replace("$(OBSW)", str(ROOT))
         if manifest_path.startswith("$("):
             return  # MicroPython's own manifests (asyncio, ...): not the project's modules
         p = self._dirs[-1] / manifest_path

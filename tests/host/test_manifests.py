@@ -92,8 +92,8 @@ def test_a_mission_manifest_adds_its_component_to_the_core(tmp_path):
     mission = tmp_path / "manifest.py"
     mission.write_text(
         'metadata(version="1.0", description="a mission image")\n'
-        'include("%s")\n'
-        'module("magnetorquer.py")\n' % (ROOT / "manifests" / "core.py")
+        'include("$(OBSW)/manifests/core.py")\n'
+        'module("magnetorquer.py")\n'
     )
     m = _frozen(mission)
     frozen = [t for _, t in m.modules]

@@ -92,10 +92,26 @@ def test_a_mission_manifest_adds_its_component_to_the_core(tmp_path):
     mission = tmp_path / "manifest.py"
     mission.write_text(
         'metadata(version="1.0", description="a mission image")\n'
-        'include("$(OBSW)/manifests/core.py")\n'
+        'add_library("obsw", "$(OBSW)/manifests/lib")\n'
+        'require("obsw", library="obsw")\n'
         'module("magnetorquer.py")\n'
     )
     m = _frozen(mission)
     frozen = [t for _, t in m.modules]
     assert "magnetorquer.py" in frozen and "obsw/pus/app.py" in frozen
     assert len(frozen) == len(set(frozen))
+
+
+def test_a_package_calls_metadata_once(tmp_path):
+    """As MicroPython's manifestfile.py: include() shares the includer's metadata, so an image
+    that includes another image's manifest (both with metadata) is refused; require() does not."""
+    bad = tmp_path / "bad.py"
+    bad.write_text('metadata(version="1")\ninclude("%s")\n' % (ROOT / "manifests" / "core.py"))
+    try:
+        _frozen(bad)
+    except ValueError as e:
+        assert "metadata" in str(e)
+    else:
+        raise AssertionError("a second metadata() was accepted")
+    for image in ("core.py", "unix.py", "qemu.py", "reconfig.py"):
+        _frozen(ROOT / "manifests" / image)

@@ -189,3 +189,16 @@ def test_a_component_outside_a_mission_is_named_by_its_interface():
     assert (c.name, c.class_name) == ("SolarPanel", "SolarPanel")
     itf, impl = c.build()
     assert itf.name == "SolarPanel" and impl.angle == 0.0
+
+
+def test_the_plug_in_example_is_the_one_the_documentation_shows():
+    import re
+
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    with open(os.path.join(root, "docs", "topology.md")) as f:
+        shown = re.findall(r"```python\n(.*?)```", f.read(), re.S)[0]
+    with open(os.path.join(root, "examples", "torquer.py")) as f:
+        assert shown in f.read()
+    c = component_for(os.path.join(root, "examples", "torquer.py"), cls="Torquer")
+    itf, impl = c.build()
+    assert itf.name == "Magnetorquer" and impl.limit == 0.2

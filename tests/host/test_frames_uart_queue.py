@@ -13,8 +13,8 @@ from obsw.il.queue import EMPTY
 from obsw.spp import SpacePacket
 from obsw_host.frames.links import FdLink
 from obsw_host.frames.processor import FrameProcessorHost
+from obsw_host.obc.frames_unit import FrameCounters
 from obsw_host.obc.topology import FRAME_PROCESSOR
-from obsw_host.obc.units import FrameCounters
 from obsw_host.sample import load_sdb
 
 

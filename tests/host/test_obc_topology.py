@@ -10,6 +10,7 @@ from obsw_host.obc import registry
 from obsw_host.obc.plugins import Component, PluginError, component_for
 from obsw_host.obc.topology import Topology
 from obsw_host.pus.onboard import SERVICES
+from test_obc_assembly import free_port
 
 PLUGIN = """
 from obsw.il.interface import DATA, Attribute, Interface, Operation
@@ -45,6 +46,8 @@ def mission(tmp_path, change=None, plugin=PLUGIN):
     doc["sdb"] = os.path.join(base, doc["sdb"])
     doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])
     doc["state"] = str(tmp_path / "state")
+    doc["pus"]["port"] = free_port()  # another OBC may run on this machine
+    doc["cfdp"]["port"] = free_port()
     doc.update(change or {})
     (tmp_path / "magnetorquer.py").write_text(plugin)
     path = tmp_path / "mission.json"

@@ -12,8 +12,8 @@ import importlib
 
 UNITS = {
     "pus": "obsw_host.obc.units:PusUnit",
-    "spacecan": "obsw_host.obc.units:SpaceCanUnit",
-    "frames": "obsw_host.obc.units:FramesUnit",
+    "spacecan": "obsw_host.obc.spacecan_unit:SpaceCanUnit",
+    "frames": "obsw_host.obc.frames_unit:FramesUnit",
     "component": "obsw_host.obc.units:ComponentUnit",
 }
 WITH_PUS = ("cfdp", "obcp")  # run inside the pus unit, in its process

@@ -1,4 +1,5 @@
-"""The units an OBC process runs (``obsw_host.obc.registry`` names them), each built from the
+"""The PUS and component units of an OBC process (``obsw_host.obc.registry`` names every unit
+kind; the SpaceCAN and frame processor units have modules of their own), each built from the
 topology (``obsw_host.obc.topology``) and its section of the mission configuration.
 
 A unit is built as ``Unit(topology, process, out)`` and has ``start()``, ``stop()`` and
@@ -23,7 +24,7 @@ from obsw.store import Store
 
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.il.transport import SocketTransport
-from obsw_host.obc.topology import FRAME_PROCESSOR, PLATFORM, PLATFORM_EVENTS
+from obsw_host.obc.topology import PLATFORM, PLATFORM_EVENTS
 from obsw_host.pus.onboard import Onboard
 
 
@@ -239,179 +240,6 @@ class PusUnit:
         _close_components(self.components)
 
 
-class SpaceCanUnit:
-    """The SpaceCAN master, the equipment components and device access, in their own thread."""
-
-    def __init__(self, topology, process, out=print):
-        from obsw_host.spacecan.obc import ObcSpaceCan
-
-        opts = topology.section("spacecan")
-        self.out = out
-        self.opts = opts
-        interface = opts["interface"]
-        channels = tuple(opts["channels"])
-        buses = None
-        if interface == "hub":  # the simulated reconfiguration module's CAN hub (UDP ports)
-            from obsw_host.reconfig.canhub import HubBus
-
-            buses = [HubBus(int(channels[0])), HubBus(int(channels[1]))]
-        self.obc = ObcSpaceCan(
-            topology.equipments(),
-            interface=interface,
-            channels=channels,
-            buses=buses,
-            directory=topology.config.il_directory,
-            heartbeat_period=float(opts["heartbeat_period"]),
-            timeout=float(opts["timeout"]),
-            retries=int(opts["retries"]),
-            device_access=True,
-        )
-        self._thread = None
-
-    def start(self):
-        self.obc.start()
-        if self.opts.get("simulate"):
-            self.obc.simulate()
-        self._thread = threading.Thread(target=self.obc.serve, name="spacecan", daemon=True)
-        self._thread.start()
-        self.out("%r on %s" % (self.obc, self.obc.interface))
-        return self
-
-    def alive(self):
-        return self._thread is not None and self._thread.is_alive()
-
-    def stop(self):
-        self.obc.stop()
-        if self._thread is not None:
-            self._thread.join(2.0)
-        self.obc.close()
-
-
-class FrameCounters:
-    """``FRAME_PROCESSOR``: frames each UART's queue dropped (nobody read it in time)."""
-
-    def __init__(self, links):
-        self.links = links
-        self.il = None
-        self._published = (0, 0)
-
-    def il_bind(self, provider):
-        self.il = provider
-
-    @property
-    def uart_a_dropped(self):
-        return getattr(self.links[0], "dropped", 0)
-
-    @property
-    def uart_b_dropped(self):
-        return getattr(self.links[1], "dropped", 0)
-
-    def publish(self):
-        """Publish the counters that changed since the last call (from the IL's thread)."""
-        now = (self.uart_a_dropped, self.uart_b_dropped)
-        if now != self._published and self.il is not None:
-            for name, old, new in zip(("uart_a_dropped", "uart_b_dropped"), self._published, now):
-                if old != new:
-                    self.il.node.publish(FRAME_PROCESSOR.name, name, new)
-            self._published = now
-        return False
-
-
-class FramesUnit:
-    """The frame processor on two UARTs (device paths, or ``pty``: a pseudo-terminal pair
-    whose other end's path is written to ``STATE/uart_a`` and ``STATE/uart_b``); with
-    ``keys`` (a key file) TC frames are authenticated. Writing to a UART never blocks the
-    frame processor: each link queues at most ``uart_queue`` frames and drops the oldest
-    beyond; the drops are attributes of the ``FrameProcessor`` component (housekeeping)."""
-
-    def __init__(self, topology, process, out=print):
-        from obsw_host.frames.links import FdLink, SerialLink
-        from obsw_host.frames.processor import FrameProcessorHost
-
-        config = topology.config
-        sdb = topology.sdb
-        opts = topology.section("frames")
-        self.out = out
-        links = []
-        self.paths = {}
-        queue = int(opts["uart_queue"])
-        for side in ("a", "b"):
-            dev = opts["uart_" + side]
-            if dev == "pty":
-                controller, path = _pty()
-                links.append(FdLink(controller, side.upper(), queue=queue))
-                with open(os.path.join(config.state, "uart_" + side), "w") as f:
-                    f.write(path + "\n")
-                self.paths[side] = path
-            else:
-                path = config.resolve(dev) if dev.startswith(".") else dev
-                links.append(SerialLink(path, queue=queue))
-                self.paths[side] = dev
-        apid = topology.pus_apid()
-        port = topology.pus_port()
-        tm_port = int(opts["tm_port"])
-        plan = sdb.tm_vcs
-        security = {}
-        if opts.get("keys"):  # TC frames authenticated (SDLS) with this key file
-            from obsw_host.frames.processor import security_options
-
-            state = os.path.join(config.state, "frames.keys.state")
-            security = security_options(config.resolve(opts["keys"]), sdb, state)
-        self.fp = FrameProcessorHost(
-            links[0],
-            links[1],
-            int(opts["scid"]),
-            host=config.host,
-            port_base=port - apid,
-            tm_port=tm_port,
-            vc_ports={int(opts["playback_vc"]): tm_port + 1},
-            tm_plan=plan,
-            tm_frame_length=int(opts["tm_frame_length"]),
-            clcw_period=float(opts["clcw_period"]),
-            **security,
-        )
-        self.last_step = time.monotonic()
-        self._stop = threading.Event()
-        self._thread = None
-        self.node = Node("obc-frames")
-        self.transport = SocketTransport(self.node, config.il_directory)
-        self.counters = FrameCounters(self.fp.links)
-        self.node.provide(FRAME_PROCESSOR, self.counters)
-        self._il_thread = None
-
-    def _run(self):
-        while not self._stop.is_set():
-            self.fp.step(0.05)
-            self.last_step = time.monotonic()
-
-    def _serve_il(self):
-        """The transport's thread: serves the counters and publishes them when they change."""
-        self.transport.serve(until=lambda: self.counters.publish() or self._stop.is_set())
-
-    def start(self):
-        self._thread = threading.Thread(target=self._run, name="frames", daemon=True)
-        self._thread.start()
-        self._il_thread = threading.Thread(target=self._serve_il, name="frames-il", daemon=True)
-        self._il_thread.start()
-        self.out(
-            "frame processor: UART A %s, UART B %s, TM in on udp %d"
-            % (self.paths["a"], self.paths["b"], self.fp.tm_port)
-        )
-        return self
-
-    def alive(self):
-        return self._thread is not None and time.monotonic() - self.last_step < 2.0
-
-    def stop(self):
-        self._stop.set()
-        self.transport.stop()
-        for thread in (self._thread, self._il_thread):
-            if thread is not None:
-                thread.join(2.0)
-        self.transport.close()
-        self.fp.close()
-
-
 class ComponentUnit:
     """The process's plug-in components, on a node of their own (a process without PUS)."""
 
@@ -442,14 +270,3 @@ class ComponentUnit:
             self._thread.join(2.0)
         self.transport.close()
         _close_components(self.components)
-
-
-def _pty():
-    import tty
-
-    controller, device = os.openpty()
-    tty.setraw(device)
-    path = os.ttyname(device)
-    # the device end stays open here: with no one on it, the controller end would read EIO
-    # (and be "readable") until the ground opens the path
-    return controller, path

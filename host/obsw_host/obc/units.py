@@ -15,9 +15,8 @@ import time
 
 from obsw.il.node import Node
 
+from obsw_host.ids import MissionIds
 from obsw_host.il.transport import SocketTransport
-
-PLAYBACK_PORT = 5000  # the frame processor's playback input (UDP 4999 + 1)
 
 
 def equipment_interfaces(config):
@@ -96,13 +95,12 @@ class PusUnit:
 
             self.interfaces.append(SOLAR_PANEL)
         self.interfaces += equipment_interfaces(config) if config.runs("spacecan") else []
+        self.ids = ids = MissionIds(sdb, config.sdb_path, config)
         playback_to = None
         tm_to = None
         if config.runs("frames"):
-            f = config.section("frames")
-            tm_port = int(f.get("tm_port", 4999))
-            tm_to = (config.host, tm_port)
-            playback_to = {int(f.get("playback_vc", 1)): (config.host, tm_port + 1)}
+            tm_to = (config.host, ids.ports.tm)
+            playback_to = {ids.playback_vc: (config.host, ids.ports.playback)}
         if opts.get("tm_to"):  # a fixed ground address besides the last TC's sender
             host, port = str(opts["tm_to"]).rsplit(":", 1)
             tm_to = (host, int(port))
@@ -111,9 +109,10 @@ class PusUnit:
         self.onboard = Onboard(
             sdb,
             node=self.node,
-            apid=opts.get("apid"),
+            apid=ids.pus_apid,
             host=config.host,
-            port=opts.get("port"),
+            port=ids.ports.pus,
+            config=ids.pus_config,
             period=float(opts.get("period", 0.1)),
             store=Store(os.path.join(state, "context")),
             tm_to=tm_to,
@@ -143,16 +142,23 @@ class PusUnit:
         from obsw_host.cfdp.filestore import RootedFilestore
         from obsw_host.cfdp.link import UdpEntity, make_entity
 
-        sdb = self.sdb
         self.files = RootedFilestore(os.path.join(self.config.state, "files"))
-        local = sdb.filestore_entity(sdb.local_filestore)
+        ids = self.ids
+        local, ground = ids.cfdp_entities
         peers = {}
         for eid, address in opts.get("peers", {}).items():
             host, port = address.rsplit(":", 1)
             peers[int(eid)] = (host, int(port))
+        if not peers:  # the ground entity of the filestores, on its port of the mission
+            peers[ground] = (self.config.host, ids.ports.cfdp_ground)
         entity = make_entity(local, list(peers), self.files)
-        self.cfdp = UdpEntity(entity, (self.config.host, int(opts.get("port", 5100))), peers)
-        self.cfdp.packet_type = TYPE_TM
+        self.cfdp = UdpEntity(
+            entity,
+            (self.config.host, ids.ports.cfdp),
+            peers,
+            apid=ids.apid("cfdp"),
+            packet_type=TYPE_TM,
+        )
         self.copy = RemoteCopy(entity)
         self.node.provide(REMOTE_COPY, self.copy)
         self.cfdp.on_indication = self.copy.indication
@@ -344,11 +350,8 @@ class FramesUnit:
             else:
                 links.append(config.resolve(dev) if dev.startswith(".") else dev)
                 self.paths[side] = dev
-        pus = config.section("pus")
-        apid = int(pus.get("apid", sdb.apid("pus")))
-        port = int(pus.get("port", 5000 + apid))
-        tm_port = int(opts.get("tm_port", 4999))
-        plan = sdb.tm_vcs
+        ids = MissionIds(sdb, config.sdb_path, config)
+        ports = ids.ports
         security = {}
         if opts.get("keys"):  # TC frames authenticated (SDLS) with this key file
             from obsw_host.frames.processor import security_options
@@ -358,12 +361,15 @@ class FramesUnit:
         self.fp = FrameProcessorHost(
             links[0],
             links[1],
-            int(opts.get("scid", 0x42)),
+            ids.scid,
             host=config.host,
-            port_base=port - apid,
-            tm_port=tm_port,
-            vc_ports={int(opts.get("playback_vc", 1)): tm_port + 1},
-            tm_plan=plan,
+            port_base=ports.pus - ids.pus_apid,
+            tm_port=ports.tm,
+            vc_ports={ids.playback_vc: ports.playback},
+            tm_plan=ids.tm_vcs,
+            tm_channels=ids.tm_channels(),
+            tm_vc_of_apid=ids.tm_vc_of_apid(),
+            tc_vcids=(ids.tc_vc,),
             tm_frame_length=int(opts.get("tm_frame_length", 256)),
             clcw_period=float(opts.get("clcw_period", 0.5)),
             **security,

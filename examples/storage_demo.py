@@ -67,11 +67,12 @@ class Segment:
             ground_id, [sat_id], self.ground_fs, segment=segment, persist=False, **timers
         )
         local = ("127.0.0.1", 0)
+        apid = sdb.apid("cfdp")
         self.sat_udp = UdpEntity(
-            self.sat_entity, local, {}, packet_type=TYPE_TM, loss=loss, seed=seed
+            self.sat_entity, local, {}, apid=apid, packet_type=TYPE_TM, loss=loss, seed=seed
         )
         self.ground_udp = UdpEntity(
-            self.ground_entity, local, {}, packet_type=TYPE_TC, loss=loss, seed=seed + 1
+            self.ground_entity, local, {}, apid=apid, packet_type=TYPE_TC, loss=loss, seed=seed + 1
         )
         self.sat_udp.peers[ground_id] = self.ground_udp.address
         self.ground_udp.peers[sat_id] = self.sat_udp.address

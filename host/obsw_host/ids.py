@@ -70,13 +70,12 @@ def load_config(path):
 
 
 def load_sdb(path):
-    """The spacecraft database at ``path``; its errors as one line naming the file."""
+    """The spacecraft database at ``path``; its errors as one line naming the file (a file
+    that cannot be read raises its OSError, which ``obsw`` prints as one line too)."""
     try:
         return sdb_module.load(path)
     except sdb_module.SdbError as e:
         raise UserError("%s: %s" % (path, e)) from None
-    except OSError as e:
-        raise UserError("%s: cannot read (%s)" % (path, e.strerror)) from None
 
 
 class MissionIds:

@@ -29,8 +29,20 @@ ESSENTIAL_MAP = 63  # the reconfiguration module's MAP unless the frames plan na
 PACKETS_MAP = 1  # the MAP of ordinary TC packets unless the frames plan names one
 FRAMES_KEYS = ("scid", "tc_vc", "maps", "tm_vcs", "cfdp_vc")
 MAP_ROLES = ("packets", "essential")
+# built-in events, looked up by name in the spacecraft database's events
+EVENT_OVERRUN = "pus.cycle_overrun"  # periodic work overran its cycle (service, u8)
+EVENT_COPY_COMPLETED = "files.copy_completed"  # service 23 copy done (operation u16, status)
+EVENT_COPY_FAILED = "files.copy_failed"  # service 23 copy failed or aborted (same data)
 # ports older mission files give in a component's section: port name -> (section, key)
 LEGACY_PORTS = {"pus": ("pus", "port"), "cfdp": ("cfdp", "port"), "tm": ("frames", "tm_port")}
+
+
+def event_id(sdb, name):
+    """The id the database gives built-in event ``name``, or None when it declares none."""
+    try:
+        return sdb.event(name).id
+    except KeyError:
+        return None
 
 
 class MissionError(UserError):
@@ -190,6 +202,14 @@ class MissionIds:
             return from_sdb(self.sdb)
         except PusLayoutError as e:
             raise self.error(str(e).split(":")[0], str(e).split(": ", 1)[1]) from None
+
+    def event(self, name):
+        """The id of built-in event ``name`` (``files.copy_completed``, ...), which the
+        database must declare."""
+        found = event_id(self.sdb, name)
+        if found is None:
+            raise self.error("events", "no event %r; expected the built-in event's id" % name)
+        return found
 
     # -------------------------------------------------------------------------- frames
 

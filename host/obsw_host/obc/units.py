@@ -15,7 +15,7 @@ import time
 
 from obsw.il.node import Node
 
-from obsw_host.ids import MissionIds
+from obsw_host.ids import EVENT_COPY_COMPLETED, EVENT_COPY_FAILED, MissionIds
 from obsw_host.il.transport import SocketTransport
 
 
@@ -215,7 +215,12 @@ class PusUnit:
         app.register(Storage(filestore=self.files, rate=int(opts.get("playback_rate", 64))))
         app.register(
             FileManagement(
-                self.files, sdb.filestores, sdb.local_filestore, self.node, poll_every=4
+                self.files,
+                sdb.filestores,
+                self.ids.local_prefix,
+                self.node,
+                poll_every=4,
+                events=(self.ids.event(EVENT_COPY_COMPLETED), self.ids.event(EVENT_COPY_FAILED)),
             )
         )
 

@@ -18,7 +18,7 @@ import time
 
 from obsw.il.clock import REAL_CLOCK
 from obsw.il.node import Node
-from obsw.pus.app import EVENT_CYCLE_OVERRUN, ApplicationProcess
+from obsw.pus.app import ApplicationProcess
 from obsw.pus.config import from_sdb
 from obsw.pus.events import EventManager
 from obsw.pus.parameters import ParameterPool
@@ -34,6 +34,7 @@ from obsw.pus.services.s20_parameters import ParameterManagement
 from obsw.pus.services.s21_sequencing import RequestSequencing
 from obsw.pus.services.s22_position_scheduling import PositionScheduling
 
+from obsw_host.ids import EVENT_OVERRUN, event_id
 from obsw_host.net import DEFAULT_HOST
 from obsw_host.ports import app_port
 from obsw_host.pus.tm_fanout import TmFanout
@@ -99,11 +100,7 @@ class Onboard:
         self._stopping = None
         self._ready = threading.Event()
         self._error = None
-        overrun = EVENT_CYCLE_OVERRUN
-        try:
-            overrun = sdb.event("pus.cycle_overrun").id
-        except KeyError:
-            pass
+        overrun = event_id(sdb, EVENT_OVERRUN)  # None: the database declares none
         self.app = ApplicationProcess(
             self.apid,
             self._send,

@@ -69,6 +69,7 @@ package(
         "eeprom.py",
         "essential.py",
         "hal.py",
+        "mission.py",
         "node.py",
         "safeguard.py",
         "watchdog.py",

@@ -102,7 +102,8 @@ class Endpoints:
         if onboard:
             default_id, port, peer = sat, ids.ports.cfdp, (ground, ids.ports.cfdp_ground)
         else:
-            default_id, port, peer = ground, 0, (sat, ids.ports.cfdp)
+            # the ground entity's port of the mission: where the onboard entity sends to it
+            default_id, port, peer = ground, ids.ports.cfdp_ground, (sat, ids.ports.cfdp)
         self.id = args.id if args.id is not None else default_id
         self.port = args.port if args.port is not None else port
         if args.peer:

@@ -16,9 +16,9 @@ from obsw.reconfig.eeprom import M24512
 from obsw.reconfig.essential import (
     ESSENTIAL_MAP,
     HPC_POWER_CYCLE,
-    HPTM_VCID,
     HPC_PRIORITY,
     HPC_SELECT_OBC,
+    HPTM_VCID,
     TARGET_BOTH,
     Essential,
     Hpc,

@@ -30,9 +30,10 @@ from obsw.spp import TYPE_TC, TYPE_TM
 from obsw.store import Store
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity
+from obsw_host.ids import MissionIds
 
 HK_STORE = 1
-SCID = 0x2A
+SCID = MissionIds.sample().scid  # the sample spacecraft's
 
 
 class Segment:

@@ -118,6 +118,11 @@ class MissionIds:
         path = sdb or config.sdb_path
         return cls(load_sdb(path), path, config)
 
+    @classmethod
+    def sample(cls):
+        """The ids of the sample spacecraft shipped with the product (demos, simulations)."""
+        return cls.locate(mission_config.SAMPLE)
+
     def _port_section(self):
         """The mission file's ``ports``, with the ports older mission files give in their
         component sections (``pus.port``, ``cfdp.port``, ``frames.tm_port``)."""

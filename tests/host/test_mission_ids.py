@@ -124,7 +124,7 @@ def mission(tmp_path, monkeypatch):
 
 def sample_values():
     """The sample mission's ids, none of which may show in the tailored mission's output."""
-    ids = MissionIds.locate()
+    ids = MissionIds.sample()
     return {
         "scid": ids.scid,
         "pus": ids.apid("pus"),

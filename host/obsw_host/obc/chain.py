@@ -160,7 +160,7 @@ class Chain:
         os.makedirs(sim_dir, exist_ok=True)
         self.sim = ReconfigSim(sim_dir, obc_command=self._obc_command, out=self.out)
         security, state = keys.load(self.sim.key_file, os.path.join(self.work, "station.state"))
-        self.ids = MissionIds.locate()  # the sample's, as write_config gives the OBC
+        self.ids = MissionIds.sample()  # the sample's, as write_config gives the OBC
         self.station = _station_class()(
             self.links, self.ids.scid, tm_frame_length=256, security=security, state=state
         )

@@ -160,7 +160,7 @@ class ReconfigSim:
         self.dir = directory or tempfile.mkdtemp(prefix="obsw-reconfig-")
         os.makedirs(self.dir, exist_ok=True)
         # the mission's ids (default: the sample's), on the controllers' "flash" as on a board
-        self.ids = ids = ids or MissionIds.locate()
+        self.ids = ids = ids or MissionIds.sample()
         board_file(ids, self.dir)
         self.nodes = ids.reconfig_nodes
         self.essential_map = ids.maps["essential"]

@@ -34,8 +34,10 @@ from obsw_host.cli import main
 from obsw_host.ids import MissionError, MissionIds
 from obsw_host.obc import config as obc_config
 from obsw_host.obc.units import FramesUnit, PusUnit
+from obsw_host.pus.tm_fanout import SUBSCRIBE
 from obsw_host.reconfig import board_file
 from obsw_host.yamcs import database
+from obsw_host.yamcs.obc_link import ObcLink
 from obsw_host.yamcs.xtce import generate
 
 BASE = 41000  # the mission's port base: the sample's is 5000
@@ -420,3 +422,39 @@ def test_the_ground_tools_operate_the_missions_obc_by_mission_alone(mission, tmp
     finally:
         log = end(obc)
     assert "APID %d on udp 127.0.0.1:%d" % (APIDS["pus"], BASE + APIDS["pus"]) in log, log
+
+
+def test_yamcs_links_to_a_running_obc_on_the_missions_ports(mission):
+    ids = MissionIds.locate(mission)
+    obc_pus = udp(0)
+    obc_cfdp = udp(BASE + APIDS["cfdp"])
+    link = ObcLink(ids, obc_pus.getsockname(), {"pus": 0, "cfdp": 0}).start()
+    yamcs_pus = yamcs_cfdp = None
+    try:
+        assert obc_pus.recvfrom(100)[0] == SUBSCRIBE  # TM flows without a TC
+        yamcs_pus = socket.create_connection(("127.0.0.1", link.ports()["pus"]), timeout=10)
+        yamcs_cfdp = socket.create_connection(("127.0.0.1", link.ports()["cfdp"]), timeout=10)
+        deadline = time.monotonic() + 10
+        while not (link.gateway.connected("pus") and link.gateway.connected("cfdp")):
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        tc = SpacePacket(1, APIDS["pus"], b"\x2f\x11\x01\x33", seq_count=1).pack()
+        yamcs_pus.sendall(tc)
+        data, gateway = obc_pus.recvfrom(100)
+        assert data == tc
+        tm = SpacePacket(0, APIDS["pus"], b"\x20\x11\x02" + bytes(12), seq_count=1).pack()
+        obc_pus.sendto(tm, gateway)  # the OBC answers the TC's sender
+        assert yamcs_pus.recv(100) == tm
+        pdu = SpacePacket(1, APIDS["cfdp"], b"\x04" + bytes(10), seq_count=2).pack()
+        yamcs_cfdp.sendall(pdu)  # Yamcs' CFDP PDUs reach the OBC's entity ...
+        assert obc_cfdp.recv(100) == pdu
+        down = SpacePacket(0, APIDS["cfdp"], b"\x04" + bytes(10), seq_count=3).pack()
+        obc_cfdp.sendto(down, ("127.0.0.1", BASE + APIDS["cfdp"] + 1))  # ... and its PDUs Yamcs
+        assert yamcs_cfdp.recv(100) == down
+    finally:
+        for s in (yamcs_pus, yamcs_cfdp):
+            if s is not None:
+                s.close()
+        link.close()
+        obc_pus.close()
+        obc_cfdp.close()

@@ -162,7 +162,13 @@ class Chain:
         security, state = keys.load(self.sim.key_file, os.path.join(self.work, "station.state"))
         self.ids = MissionIds.sample()  # the sample's, as write_config gives the OBC
         self.station = _station_class()(
-            self.links, self.ids.scid, tm_frame_length=256, security=security, state=state
+            self.links,
+            self.ids.scid,
+            vcid=self.ids.tc_vc,
+            map_id=self.ids.maps["packets"],
+            tm_frame_length=256,
+            security=security,
+            state=state,
         )
         self._thread = threading.Thread(target=self.station.run, args=(self._stop,), daemon=True)
         self._thread.start()

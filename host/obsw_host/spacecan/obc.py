@@ -44,7 +44,6 @@ def cpdu_node():
         return json.load(f)
 
 
-
 _IDLE_WAIT = 0.2  # longest a wait blocks with nothing due (stop() is seen this soon)
 
 
@@ -306,8 +305,7 @@ def mission_equipment(ids):
     if not nodes:
         raise ids.error("nodes", "none; expected the SpaceCAN equipment nodes (or --equipment)")
     return [
-        Equipment(n.name, n.node_id, NodeDefinition.load(n.definition, n.node_id))
-        for n in nodes
+        Equipment(n.name, n.node_id, NodeDefinition.load(n.definition, n.node_id)) for n in nodes
     ]
 
 

@@ -185,6 +185,9 @@ class MissionIds:
             )
         return apid
 
+    def has_source_id(self):
+        return "source_id" in (self.sdb.pus or {}) or "ground" in self.sdb.apids
+
     @property
     def source_id(self):
         """The source id of the ground's TCs: ``pus.source_id``, else ``apids.ground``."""

@@ -84,8 +84,10 @@ class Ground:
         self.log = log  # callable(str) shown every packet, or None
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind((self.target[0], 0))
-        if source_id is None:  # the database's (pus.source_id or apids.ground); raw use: 0
-            source_id = MissionIds(sdb, None).source_id if sdb is not None else 0
+        if source_id is None:  # the database's (pus.source_id or apids.ground), else 0; the
+            # ground tools pass MissionIds.source_id, which refuses a database without one
+            ids = MissionIds(sdb, None) if sdb is not None else None
+            source_id = ids.source_id if ids is not None and ids.has_source_id() else 0
         if config is None:  # the database's packet layout
             config = from_sdb(sdb) if sdb is not None else DEFAULT
         self.config = config

@@ -251,7 +251,18 @@ class MissionIds:
 
     @property
     def playback_vc(self):
-        return self.tm_vcs["playback"]
+        """The packet stores' playback VC: ``frames.tm_vcs.playback`` (the mission file may
+        repeat it as ``frames.playback_vc``, not differ)."""
+        vc = self.tm_vcs["playback"]
+        other = self.config.section("frames").get("playback_vc") if self.config else None
+        if other is not None and other != vc:
+            raise MissionError(
+                self.mission_file,
+                "frames.playback_vc",
+                "%r differs from the spacecraft database's frames.tm_vcs.playback %d; give it "
+                "once, in %s" % (other, vc, self.sdb_file),
+            )
+        return vc
 
     @property
     def cfdp_vc(self):

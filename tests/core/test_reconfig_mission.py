@@ -2,6 +2,7 @@
 and used by the application (node id per role, SCID, essential MAP and HPTM VC)."""
 
 import json
+import os
 import unittest
 
 from obsw.reconfig import mission
@@ -47,21 +48,25 @@ class TestMissionFile(unittest.TestCase):
                 self.fail("accepted %r" % (doc,))
 
     def test_load_from_a_file_and_none_without_one(self):
-        path = "/tmp/obsw-test-reconfig-mission.json"
-        with open(path, "w") as f:
-            f.write(json.dumps(DOC))
-        self.assertEqual(mission.load(path)["node_ids"], (20, 21))
-        with open(path, "w") as f:
-            f.write("{not json")
-        self.assertRaises(mission.MissionFileError, mission.load, path)
-        self.assertIsNone(mission.load(path + ".absent"))
+        path = "obsw-test-reconfig-mission.json"  # the working folder: a board's is its flash
+        try:
+            with open(path, "w") as f:
+                f.write(json.dumps(DOC))
+            self.assertEqual(mission.load(path)["node_ids"], (20, 21))
+            with open(path, "w") as f:
+                f.write("{not json")
+            self.assertRaises(mission.MissionFileError, mission.load, path)
+        finally:
+            os.remove(path)
+        self.assertIsNone(mission.load(path))
 
 
 class TestAppTakesTheMissionsIds(unittest.TestCase):
     def test_node_id_per_role_scid_map_and_vc(self):
         options = mission.parse(DOC)
         for role, node in ((NOMINAL, 20), (REDUNDANT, 21)):
-            app = ReconfigApp(ModelHal(role), **options)
+            # small EEPROM models: the test fits a board's heap too
+            app = ReconfigApp(ModelHal(role, eeprom_size=4096), **options)
             self.assertEqual(app.node.responder.node_id, node)
             frames = app.essential.frames
             self.assertEqual((frames.scid, frames.essential_map), (341, 40))

@@ -364,6 +364,41 @@ class MissionIds:
                 )
         return found["nominal"], found["redundant"]
 
+    # -------------------------------------------------------------------------- checking
+
+    def problems(self):
+        """Every id the mission's processes need and the mission does not give (or gives
+        twice), one line each naming the file and the key: for ``obsw mission check``."""
+        runs = self.config.runs if self.config is not None else (lambda kind: True)
+        checks = [
+            lambda: self.name,
+            lambda: self.pus_apid,
+            lambda: self.pus_config,
+            lambda: self.tm_vcs,
+            lambda: self.tc_vc,
+            lambda: self.maps,
+        ]
+        if runs("pus"):
+            checks += [lambda: self.local_prefix]
+            checks += [
+                lambda: self.event(EVENT_COPY_COMPLETED),
+                lambda: self.event(EVENT_COPY_FAILED),
+            ]
+        if runs("cfdp"):
+            checks += [lambda: self.apid("cfdp"), lambda: self.cfdp_entities]
+        if runs("frames"):
+            checks += [lambda: self.scid, lambda: self.playback_vc]
+            if self.has_cfdp_vc():
+                checks.append(lambda: self.cfdp_vc)
+        found = []
+        for check in checks:
+            try:
+                check()
+            except UserError as e:
+                if str(e) not in found:
+                    found.append(str(e))
+        return found
+
     def reconfig_board(self):
         """What the reconfiguration module's boards need to know of the mission, as written to
         their filesystem (``obsw.reconfig.mission``)."""

@@ -458,3 +458,20 @@ def test_yamcs_links_to_a_running_obc_on_the_missions_ports(mission):
         link.close()
         obc_pus.close()
         obc_cfdp.close()
+
+
+def test_problems_lists_every_missing_id_once(mission):
+    assert MissionIds.locate(mission).problems() == []
+    path = os.path.join(mission, "sdb.json")
+    with open(path) as f:
+        doc = json.load(f)
+    del doc["apids"]["cfdp"]
+    doc["events"] = [e for e in doc["events"] if e["name"] != "files.copy_failed"]
+    doc["frames"]["maps"] = {"packets": 3, "essential": 3}
+    with open(path, "w") as f:
+        json.dump(doc, f)
+    assert MissionIds.locate(mission).problems() == [
+        "sdb.json: frames.maps: packets and essential share MAP 3",
+        "sdb.json: events: no event 'files.copy_failed'; expected the built-in event's id",
+        "sdb.json: apids.cfdp: missing; expected the APID of the cfdp process (0-2047)",
+    ]

@@ -28,12 +28,13 @@ from obsw.pus.tc import PusTc
 from obsw.reconfig.mission import load as load_board_file
 from obsw.spp import SpacePacket
 from obsw.timecode import Cuc
-from obsw_host import ids as mission_ids
 from obsw_host import sample
 from obsw_host.cli import main
 from obsw_host.ids import MissionError, MissionIds
 from obsw_host.obc import config as obc_config
-from obsw_host.obc.units import FramesUnit, PusUnit
+from obsw_host.obc.frames_unit import FramesUnit
+from obsw_host.obc.topology import Topology
+from obsw_host.obc.units import PusUnit
 from obsw_host.pus.tm_fanout import SUBSCRIBE
 from obsw_host.reconfig import board_file
 from obsw_host.yamcs import database
@@ -110,7 +111,7 @@ def write_mission(folder):
     doc["sdb"] = "sdb.json"
     doc["state"] = "state"
     doc["ports"] = {"base": BASE}
-    doc["processes"] = {"obc": ["pus", "cfdp", "obcp", "solar_panel"]}
+    doc["processes"] = {"obc": ["pus", "cfdp", "obcp", "SolarPanel"], "frames": ["frames"]}
     doc["pus"].pop("apid", None)  # the database's: said once
     doc["platform"]["power_cycle"]["component"] = "MtqN"
     with open(os.path.join(folder, "mission.json"), "w") as f:
@@ -122,6 +123,12 @@ def write_mission(folder):
 def mission(tmp_path, monkeypatch):
     monkeypatch.delenv("OBSW_PORT_BASE", raising=False)
     return write_mission(str(tmp_path / "tailored"))
+
+
+def mission_topology(folder):
+    config = obc_config.load(os.path.join(folder, "mission.json"))
+    os.makedirs(config.state, exist_ok=True)
+    return Topology(config)
 
 
 def sample_values():
@@ -237,10 +244,8 @@ def test_signed_tc_frames_carry_the_missions_scid_vc_and_map(mission, tmp_path, 
 
 
 def test_the_obc_units_use_the_missions_ids(mission):
-    config = obc_config.load(os.path.join(mission, "mission.json"))
-    os.makedirs(config.state, exist_ok=True)
-    db = mission_ids.load_sdb(config.sdb_path)
-    unit = PusUnit(config, db, ["pus", "cfdp"], out=lambda s: None)
+    topology = mission_topology(mission)
+    unit = PusUnit(topology, topology.process("obc"), out=lambda s: None)
     try:
         assert unit.onboard.port == BASE + APIDS["pus"] and unit.app.apid == APIDS["pus"]
         assert unit.app.config == PusConfig(source_id_size=1, time=Cuc(4, 3))
@@ -255,10 +260,9 @@ def test_the_obc_units_use_the_missions_ids(mission):
 
 
 def test_tm_frames_carry_the_missions_scid_and_vcs(mission):
-    config = obc_config.load(os.path.join(mission, "mission.json"))
-    os.makedirs(config.state, exist_ok=True)
-    db = mission_ids.load_sdb(config.sdb_path)
-    unit = FramesUnit(config, db, out=lambda s: None)
+    topology = mission_topology(mission)
+    config = topology.config
+    unit = FramesUnit(topology, topology.process("frames"), out=lambda s: None)
     with open(os.path.join(config.state, "uart_a")) as f:
         uart = os.open(f.read().strip(), os.O_RDONLY | os.O_NONBLOCK)
     sender = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -287,7 +291,7 @@ def test_tm_frames_carry_the_missions_scid_and_vcs(mission):
     finally:
         sender.close()
         os.close(uart)
-        unit.fp.close()
+        unit.stop()
 
 
 def test_the_reconfiguration_boards_get_the_missions_ids(mission, tmp_path):

@@ -330,9 +330,10 @@ def test_the_yamcs_configuration_is_the_missions(mission, tmp_path, capsys):
     assert "unhex('%04X" % (0x1000 | APIDS["cfdp"]) in sql
     mdb = ET.parse(str(out / "mdb" / "tailored.xml")).getroot()
     ns = {"x": "http://www.omg.org/spec/XTCE/20180204"}
+    base = [c for c in mdb.iter("{%s}MetaCommand" % ns["x"]) if c.get("name") == "pus_tc"]
     args = {
         a.get("name"): a.get("initialValue")
-        for a in mdb.iter("{%s}Argument" % ns["x"])
+        for a in base[0].iter("{%s}Argument" % ns["x"])
         if a.get("name") in ("apid", "source")
     }
     assert args == {"apid": str(APIDS["pus"]), "source": str(SOURCE_ID)}

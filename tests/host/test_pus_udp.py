@@ -6,8 +6,9 @@ import json
 import pytest
 from obsw.store import Store
 from obsw_host.commands import ground as ground_command
+from obsw_host.ports import app_port
 from obsw_host.pus.ground import Ground, PusTimeout
-from obsw_host.pus.onboard import Onboard, port_for
+from obsw_host.pus.onboard import Onboard
 from obsw_host.sample import load_sdb
 from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 
@@ -32,7 +33,7 @@ def system(tmp_path):
 
 def test_port_convention():
     sdb = load_sdb()
-    assert port_for(sdb.apid("pus")) == 5000 + sdb.apid("pus")
+    assert app_port(sdb.apid("pus")) == 5000 + sdb.apid("pus")
     assert Onboard(sdb).port == 5000 + sdb.apid("pus")
 
 

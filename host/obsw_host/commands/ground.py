@@ -45,6 +45,7 @@ import argparse
 import json
 import sys
 
+from obsw_host import ids as mission_ids
 from obsw_host.errors import UserError
 from obsw_host.net import DEFAULT_HOST
 
@@ -56,9 +57,9 @@ def add_parser(sub):
         description=__doc__,
         formatter_class=_raw(),
     )
-    p.add_argument("--sdb", help="spacecraft database JSON (default: the sample database)")
+    mission_ids.add_arguments(p)
     p.add_argument("--host", default=DEFAULT_HOST, help="on-board host (default %(default)s)")
-    p.add_argument("--port", type=int, help="on-board UDP port (default 5000 + APID)")
+    p.add_argument("--port", type=int, help="on-board UDP port (default: the mission's)")
     p.add_argument("--apid", type=int, help="on-board APID (default: the database's 'pus')")
     p.add_argument("--timeout", type=float, default=2.0, help="seconds per request")
     p.add_argument("--json", action="store_true", help="print JSON for scripts")
@@ -247,7 +248,9 @@ def _add_operator(s):
         choices=("parameters", "functions", "events", "hk", "obcps", "files"),
         help="what to list (obcps and files ask the on-board process)",
     )
-    x.add_argument("repository", nargs="?", default="SAT:/", help="for files (default SAT:/)")
+    x.add_argument(
+        "repository", nargs="?", help="for files (default: the mission's onboard filestore)"
+    )
     x.set_defaults(func=_list)
 
 
@@ -258,16 +261,30 @@ def _raw():
 def _ground(args):
     from obsw_host.pus.ground import Ground
     from obsw_host.pus.monitor import SessionLog
-    from obsw_host.pus.onboard import port_for
-    from obsw_host.sample import load_sdb
 
-    sdb = load_sdb(args.sdb)
-    apid = args.apid if args.apid is not None else sdb.apid("pus")
-    target = (args.host, args.port if args.port is not None else port_for(apid))
+    ids = mission_ids.from_args(args)
+    apid = args.apid if args.apid is not None else ids.pus_apid
+    target = (args.host, _port(args, ids, apid))
     log = (lambda s: print(s, file=sys.stderr)) if args.verbose else None
     session = SessionLog(args.log) if getattr(args, "log", None) else None
-    g = Ground(sdb, apid=apid, target=target, timeout=args.timeout, log=log, session=session)
+    g = Ground(
+        ids.sdb,
+        apid=apid,
+        target=target,
+        timeout=args.timeout,
+        log=log,
+        session=session,
+        source_id=ids.source_id,
+        config=ids.pus_config,
+    )
     return _fresh(g)
+
+
+def _port(args, ids, apid):
+    """The on-board UDP port: ``--port``, else the mission's port of process ``apid``."""
+    if args.port is not None:
+        return args.port
+    return ids.ports.pus if apid == ids.apid("pus") else ids.ports.app(apid)
 
 
 def _colour(args):
@@ -316,9 +333,8 @@ def _monitor_live(args):
 
 def _replay(args):
     from obsw_host.pus.monitor import replay
-    from obsw_host.sample import load_sdb
 
-    for line in replay(args.session_log, load_sdb(args.sdb), _colour(args)):
+    for line in replay(args.session_log, mission_ids.from_args(args).sdb, _colour(args)):
         print(line)
     return 0
 
@@ -327,9 +343,7 @@ def _list(args):
     from obsw_host.pus.catalog import KINDS, catalog, table
 
     if args.kind in KINDS:
-        from obsw_host.sample import load_sdb
-
-        rows = catalog(load_sdb(args.sdb), args.kind)
+        rows = catalog(mission_ids.from_args(args).sdb, args.kind)
         print(json.dumps(rows) if args.json else table(rows))
         return 0
     if args.kind == "obcps":
@@ -338,7 +352,8 @@ def _list(args):
         return _run(args, lambda g: ObcpGround(g).report_status())
     from obsw_host.pus.storage_ground import StorageGround
 
-    return _run(args, lambda g: StorageGround(g).directory(args.repository))
+    repository = args.repository or "%s:/" % mission_ids.from_args(args).local_prefix
+    return _run(args, lambda g: StorageGround(g).directory(repository))
 
 
 def _run(args, fn):
@@ -351,6 +366,7 @@ def _run(args, fn):
         except PusTimeout as e:
             tx = e.transaction
         sdb = g.sdb
+        target = g.target
     result = text.transaction(tx)
     detail = text.failure_detail(tx, sdb)
     if args.json:
@@ -365,21 +381,15 @@ def _run(args, fn):
     for reply in tx.replies:
         print(text.readable(reply, sdb))
     if not tx.done:
-        print(_no_answer(args, tx))
+        print(_no_answer(args, tx, target))
     return 0 if tx.ok else 1
 
 
-def _port(apid):
-    from obsw_host.pus.onboard import port_for
-
-    return port_for(apid)
-
-
-def _no_answer(args, tx):
+def _no_answer(args, tx, target):
     if not tx.verification():
         return "no report from %s:%s within %ss: is `obsw obc serve` running there?" % (
-            args.host,
-            args.port if args.port is not None else 5000 + tx.tc.apid,
+            target[0],
+            target[1],
             args.timeout,
         )
     return "no completion report within %ss" % args.timeout

@@ -1,7 +1,7 @@
 """The ground application process on the host: service users over UDP, and a scripting API.
 
     from obsw_host.pus.ground import Ground
-    with Ground(sdb) as ground:               # talks to 127.0.0.1:5000 + the sdb's 'pus' APID
+    with Ground(sdb) as ground:               # talks to 127.0.0.1:base + the sdb's 'pus' APID
         tx = ground.ping()                    # a Transaction: tx.ok, tx.reply, tx.verification()
         hk = ground.housekeeping(1)           # {'sid': 1, 'values': {'SolarPanel.angle': 0.0, ..}}
         ground.set_parameter("SolarPanel.speed", 7.5)
@@ -25,6 +25,7 @@ import select
 import socket
 
 from obsw.il.clock import REAL_CLOCK
+from obsw.pus.config import DEFAULT, from_sdb
 from obsw.pus.services.s03_housekeeping import HousekeepingUser
 from obsw.pus.services.s05_events import EventUser
 from obsw.pus.services.s08_functions import FunctionUser, functions
@@ -38,9 +39,11 @@ from obsw.pus.services.s21_sequencing import RequestSequencingUser
 from obsw.pus.services.s22_position_scheduling import PositionSchedulingUser
 from obsw.pus.user import UserProcess
 
+from obsw_host.ids import MissionIds
 from obsw_host.net import DEFAULT_HOST
+from obsw_host.ports import app_port
 from obsw_host.pus import text
-from obsw_host.pus.onboard import port_for, tai_now
+from obsw_host.pus.onboard import tai_now
 from obsw_host.pus.tm_fanout import SUBSCRIBE, UNSUBSCRIBE
 
 
@@ -69,18 +72,26 @@ class Ground:
         source_id=None,
         log=None,
         session=None,
+        config=None,
     ):
         self.sdb = sdb
         self.session = session  # a SessionLog, or None
-        self.apid = apid if apid is not None else (sdb.apid("pus") if sdb else 10)
-        self.target = target or (host, port_for(self.apid))
+        if apid is None and sdb is None:
+            raise ValueError("Ground: give a spacecraft database or the on-board APID")
+        self.apid = apid if apid is not None else sdb.apid("pus")
+        self.target = target or (host, app_port(self.apid))
         self.timeout = timeout
         self.log = log  # callable(str) shown every packet, or None
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind((self.target[0], 0))
-        if source_id is None:
-            source_id = sdb.apids.get("ground", 0) if sdb else 0
-        self.proc = UserProcess(self._send, REAL_CLOCK, source_id=source_id)
+        if source_id is None:  # the database's (pus.source_id or apids.ground), else 0; the
+            # ground tools pass MissionIds.source_id, which refuses a database without one
+            ids = MissionIds(sdb, None) if sdb is not None else None
+            source_id = ids.source_id if ids is not None and ids.has_source_id() else 0
+        if config is None:  # the database's packet layout
+            config = from_sdb(sdb) if sdb is not None else DEFAULT
+        self.config = config
+        self.proc = UserProcess(self._send, REAL_CLOCK, source_id=source_id, config=config)
         self.proc.listeners.append(self._show)
         self.received = []  # (tm, decoded) of TM no request asked for (events, periodic HK)
         self.keep_unsolicited = 1000
@@ -110,7 +121,7 @@ class Ground:
         if self.session is not None:
             from obsw.pus.tc import PusTc
 
-            self.session.write("TC", raw, line=text.tc_line(PusTc.unpack(raw)))
+            self.session.write("TC", raw, line=text.tc_line(PusTc.unpack(raw, self.config)))
 
     def subscribe(self):
         """Ask the on-board process for its TM without sending a TC (repeat within its

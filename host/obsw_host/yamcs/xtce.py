@@ -119,10 +119,12 @@ class Generator:
 
     def __init__(self, sc, config=None):
         self.sc = sc
-        self.cfg = config or PusConfig()
+        ids = sc.ids  # the mission's: layout, source id, APIDs
+        self.cfg = config or (ids.pus_config if ids is not None else PusConfig())
         self.root = SpaceSystem(_label(sc.mission), "/" + _label(sc.mission))
         self.refs = {}  # parameter id -> absolute reference
-        self.apid = sc.apid("pus", 10)
+        self.apid = sc.required_apid("pus")
+        self.source_id = ids.source_id if ids is not None else 0
 
     # ------------------------------------------------------------------ helpers
     def system_of(self, parts):
@@ -330,7 +332,8 @@ class Generator:
     def tc_base(self):
         r = self.root
         cfg = self.cfg
-        for name, bits in (("apid_t", 11), ("ack_t", 4), ("u8_t", 8), ("source_t", 16)):
+        source_bits = 8 * cfg.source_id_size or 16
+        for name, bits in (("apid_t", 11), ("ack_t", 4), ("u8_t", 8), ("source_t", source_bits)):
             r.atypes.append(argument_type(name, (0, bits)))
         cmd = _sub(ET.Element("root"), "MetaCommand", name="pus_tc", abstract="true")
         cmd.set("shortDescription", "PUS-C telecommand: header, then the service's data")
@@ -340,7 +343,13 @@ class Generator:
         _sub(args, "Argument", name="service", argumentTypeRef="u8_t")
         _sub(args, "Argument", name="subtype", argumentTypeRef="u8_t")
         if cfg.source_id_size:
-            _sub(args, "Argument", name="source", argumentTypeRef="source_t", initialValue=0)
+            _sub(
+                args,
+                "Argument",
+                name="source",
+                argumentTypeRef="source_t",
+                initialValue=self.source_id,
+            )
         cc = _sub(cmd, "CommandContainer", name="pus_tc")
         entries = _sub(cc, "EntryList")
         _fixed(entries, "ccsds_version_type_flag", 0b00011, 5)

@@ -19,8 +19,10 @@
 Also parsed here, so nothing else reads the JSON: ``functions`` (service 8: id, name, the
 operation's typed arguments), components' ``operations`` (name and arguments with units, for
 PLUTO's checker), ``position_scheduling`` (service 22's position parameter), ``frames``
-(``tm_vcs``: the TM virtual channel plan, role -> VC ID, and ``scid``), and ``nodes`` (SpaceCAN
-equipment: name, node id, node definition file relative to the database file).
+(``tm_vcs``: the TM virtual channel plan, role -> VC ID, and ``scid``; ``tc_vc``, ``maps`` and
+``cfdp_vc`` are kept in ``frames`` for the mission's ids), ``pus`` (the packet layout and the
+ground's source id, read by ``obsw.pus.config.from_sdb``) and ``nodes`` (SpaceCAN equipment:
+name, node id, node definition file relative to the database file).
 
 ``filestores`` maps the path prefixes of file management (``SAT:/data/x``) to CFDP entity
 ids (the onboard one is the first, unless one says ``"local": true``); ``memories`` declares
@@ -221,14 +223,16 @@ def _operation(cname, op):
 
 
 class NodeDef:
-    """A SpaceCAN equipment node: its component name, node id and definition file."""
+    """A SpaceCAN equipment node: its component name, node id and definition file; ``role``
+    is ``nominal`` or ``redundant`` for the reconfiguration module's two controllers."""
 
-    __slots__ = ("name", "node_id", "definition")
+    __slots__ = ("name", "node_id", "definition", "role")
 
-    def __init__(self, name, node_id, definition):
+    def __init__(self, name, node_id, definition, role=None):
         self.name = name
         self.node_id = node_id
         self.definition = definition
+        self.role = role
 
     def __repr__(self):
         return "NodeDef(%s, %d)" % (self.name, self.node_id)
@@ -254,6 +258,8 @@ class Sdb:
         self.position_parameter = None  # service 22's position parameter (a Parameter)
         self.tm_vcs = None  # TM virtual channel plan (role -> VC ID), None: the default
         self.scid = None  # spacecraft id, when the database gives it
+        self.frames = {}  # the frames plan as given (scid, tc_vc, maps, tm_vcs, cfdp_vc)
+        self.pus = {}  # the PUS section as given: packet layout and source id (obsw.pus.config)
         self.nodes = {}  # SpaceCAN equipment name -> NodeDef
         self.base = base  # the folder relative paths start from
         self._params_by_name = {}
@@ -369,6 +375,8 @@ class Sdb:
             self.tm_vcs = {str(k): _int(v, "TM VC of %s" % k) for k, v in frames["tm_vcs"].items()}
         if "scid" in frames:
             self.scid = _int(frames["scid"], "spacecraft id")
+        self.frames = frames
+        self.pus = doc.get("pus") or {}
         ids = set()
         for n in doc.get("nodes", []):
             nid = _int(n["node_id"], "node id of %s" % n["name"])
@@ -378,7 +386,12 @@ class Sdb:
             path = n.get("definition")
             if path and self.base and not path.startswith("/"):
                 path = self.base + "/" + path
-            self.nodes[n["name"]] = NodeDef(n["name"], nid, path)
+            role = n.get("role")
+            if role not in (None, "nominal", "redundant"):
+                raise SdbError(
+                    "node %s: role %r, expected nominal or redundant" % (n["name"], role)
+                )
+            self.nodes[n["name"]] = NodeDef(n["name"], nid, path, role)
 
     def function(self, key):
         """The FunctionDef with this id or name ('SolarPanel.set_angle')."""
@@ -508,6 +521,7 @@ _KNOWN = (
     "position_scheduling",
     "frames",
     "nodes",
+    "pus",
 )
 
 

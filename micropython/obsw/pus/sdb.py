@@ -32,6 +32,7 @@ A type is a name (``uint8`` .. ``uint64``, ``int8`` .. ``int64``, ``float32``, `
 """
 
 from obsw import jsonsafe
+from obsw.pus.calibration import CalibrationError, Values
 from obsw.pus.fields import field
 from obsw.pus.structure import Structure
 
@@ -80,10 +81,13 @@ def field_type(spec, where="type"):
 
 
 class Parameter:
-    """An attribute of a component as a PUS parameter. ``extras`` are the optional entries for
-    mission control, kept as given: ``range`` ([low, high] a set may use), ``limits``
-    (``{"warning": [low, high], "critical": [low, high]}``), ``calibration``
-    (``{"polynomial": [c0, c1, ..]}`` or ``{"spline": [[raw, eng], ..]}``), ``description``."""
+    """An attribute of a component as a PUS parameter. ``type`` is the raw value (what packets
+    carry); ``unit`` the engineering unit, ``raw_unit`` the raw one. ``extras`` are the optional
+    entries, kept as given and checked by ``obsw.pus.calibration``: ``range`` ([low, high] a set
+    may use, engineering units), ``limits`` (``{"warning": [low, high], "critical": [low,
+    high]}``, engineering units), ``calibration`` (``{"polynomial": [c0, c1, ..]}`` or
+    ``{"spline": [[raw, eng], ..]}``), ``enumeration`` (labels of raw values),
+    ``description``. ``values`` converts raw <-> engineering."""
 
     def __init__(
         self, id, component, name, type_spec, unit=None, writable=False, default=None, extras=None
@@ -100,7 +104,25 @@ class Parameter:
         self.range = extras.get("range")
         self.limits = extras.get("limits")
         self.calibration = extras.get("calibration")
+        self.enumeration = extras.get("enumeration")
+        self.raw_unit = extras.get("raw_unit")
         self.description = extras.get("description")
+        try:
+            self.values = Values(self.type, extras, "parameter " + self.qualified)
+        except CalibrationError as e:
+            raise SdbError(str(e)) from None
+
+    def engineering(self, raw):
+        """The engineering value of raw value ``raw`` (a label for an enumeration)."""
+        return self.values.engineering(raw)
+
+    def to_raw(self, eng):
+        """The raw value of an engineering value or label (CalibrationError if none)."""
+        return self.values.to_raw(eng)
+
+    def out_of_range(self, raw):
+        """None if raw value ``raw`` is within the parameter's range, else why not."""
+        return self.values.out_of_range(raw)
 
     @property
     def qualified(self):

@@ -300,8 +300,8 @@ class Values:
         """None if raw value ``raw`` is within ``range`` (engineering units), else why not."""
         if self.range is None:
             return None
-        try:
-            eng = self.engineering(raw)
+        try:  # labels are not ordered: an enumeration's range is on its raw values
+            eng = raw if self.calibration is None else self.calibration.engineering(raw)
         except CalibrationError as e:
             return str(e)
         low, high = self.range

@@ -394,3 +394,6 @@ FAILURE_PATH = const(14)  # a path that escapes the filestore root or names no r
 FAILURE_FILESTORE = const(15)  # the filestore refused (no such file, exists, locked, full)
 FAILURE_OUT_OF_BOUNDS = const(16)  # an address or length outside the declared memory area
 FAILURE_OBCP_REJECTED = const(24)  # ST[18] procedure text that does not load (line, column)
+
+# project-defined failure codes of raw and engineering values (ST[20])
+FAILURE_OUT_OF_RANGE = const(30)  # a value outside the parameter's declared range

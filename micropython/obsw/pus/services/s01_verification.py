@@ -15,6 +15,7 @@ from obsw.pus.messages import (
     FAILURE_ILLEGAL_APP_DATA,
     FAILURE_OBCP_REJECTED,
     FAILURE_OUT_OF_BOUNDS,
+    FAILURE_OUT_OF_RANGE,
     FAILURE_PATH,
     FAILURE_REFUSED,
     FAILURE_TIMEOUT,
@@ -53,6 +54,7 @@ FAILURE_NAMES = {
     FAILURE_FILESTORE: "filestore refused",
     FAILURE_OUT_OF_BOUNDS: "out of bounds",
     FAILURE_OBCP_REJECTED: "OBCP rejected",
+    FAILURE_OUT_OF_RANGE: "out of range",
 }
 
 # stages of a request, in order

@@ -7,6 +7,11 @@ type) and the check type's own fields: an expected-value check has a mask, an ex
 value and an event; a limit check a low limit and its event and a high limit and its event
 (limits of the parameter's own type); a delta check low and high thresholds on the mean of
 a number of consecutive deltas (float64) with their events. Event ID 0 raises no event.
+A check transition of an expected-value check carries the check's mask before the value.
+
+A functional monitoring definition (FMON) is an ID, a validity condition (parameter, mask,
+expected value), the event it raises when it fails, the minimum number of failing PMONs that
+fails it, and its PMON IDs; reports add its protection and enabled statuses.
 """
 
 from obsw.bits import Decoder, Encoder
@@ -63,6 +68,79 @@ IDS = Structure([("ids", Repeated(PMON_COUNT, PMON_ID))])
 DELAY_LAYOUT = Structure([("delay", DELAY)])
 STATUS_REPORT = Structure(
     [("items", Repeated(PMON_COUNT, [("pmon", PMON_ID), ("enabled", STATUS)]))]
+)
+
+
+# functional monitoring (FMON): field sizes, statuses, messages
+FMON_ID = U16
+FMON_COUNT = U16
+FAILING_NUMBER = U16  # minimum number of failing PMONs that fails the FMON
+PROTECTION = E8  # 1 protected, 0 unprotected
+FMON_CHECKING_STATUS = E8
+FMON_UNCHECKED = const(0)
+FMON_RUNNING = const(1)
+FMON_INVALID = const(2)
+FMON_FAILED = const(3)
+FMON_STATUS_NAMES = {
+    FMON_UNCHECKED: "unchecked",
+    FMON_RUNNING: "running",
+    FMON_INVALID: "invalid",
+    FMON_FAILED: "failed",
+}
+FMON_IDS = Structure([("ids", Repeated(FMON_COUNT, FMON_ID))])
+_VALIDITY = [
+    ("validity", PARAMETER_ID),
+    ("validity_mask", MASK),
+    ("validity_value", MASK),
+]
+_PMONS = ("pmons", Repeated(FMON_COUNT, PMON_ID))
+FMON_ADD = Structure(
+    [
+        (
+            "items",
+            Repeated(
+                FMON_COUNT,
+                [("fmon", FMON_ID)]
+                + _VALIDITY
+                + [("event", EVENT_ID), ("failing", FAILING_NUMBER), _PMONS],
+            ),
+        )
+    ]
+)
+FMON_REPORT = Structure(
+    [
+        (
+            "items",
+            Repeated(
+                FMON_COUNT,
+                [("fmon", FMON_ID)]
+                + _VALIDITY
+                + [
+                    ("protected", PROTECTION),
+                    ("enabled", STATUS),
+                    ("event", EVENT_ID),
+                    ("failing", FAILING_NUMBER),
+                    _PMONS,
+                ],
+            ),
+        )
+    ]
+)
+FMON_STATUS_REPORT = Structure(
+    [
+        (
+            "items",
+            Repeated(
+                FMON_COUNT,
+                [
+                    ("fmon", FMON_ID),
+                    ("protected", PROTECTION),
+                    ("enabled", STATUS),
+                    ("checking", FMON_CHECKING_STATUS),
+                ],
+            ),
+        )
+    ]
 )
 
 
@@ -144,7 +222,9 @@ class Layouts:
             ("time", TRANSITION_TIME),
         ]
         entries = {
-            CHECK_EXPECTED_VALUE: Structure([("value", value), ("limit", MASK)] + tail),
+            CHECK_EXPECTED_VALUE: Structure(
+                [("mask", MASK), ("value", value), ("limit", MASK)] + tail
+            ),
             CHECK_LIMIT: Structure([("value", value), ("limit", value)] + tail),
             CHECK_DELTA: Structure([("value", DELTA), ("limit", DELTA)] + tail),
         }

@@ -315,13 +315,22 @@ class Values:
         that a raw value is out of the raw limits exactly when its engineering value is out
         of the engineering ones; a decreasing calibration swaps the two (``swapped``)."""
         cal = self.calibration
-        if cal is None:
-            return low, high, False
-        a, b = cal.raw(low), cal.raw(high)
-        swapped = not cal.increasing()
-        if swapped:
-            a, b = b, a
+        swapped = False
+        if cal is not None:
+            low, high = cal.raw(low), cal.raw(high)
+            swapped = not cal.increasing()
+            if swapped:
+                low, high = high, low
         if self.integer:
-            a = -int(-a // 1) if a != int(a) else int(a)  # ceil
-            b = int(b // 1)  # floor
-        return a, b, swapped
+            low = -int(-low // 1)  # ceil
+            high = int(high // 1)  # floor
+        return low, high, swapped
+
+    def raw_limits_of(self, low, high):
+        """Raw limits as given, checked to fit the raw type (integers for integer types)."""
+        if not self.integer:
+            return low, high
+        for x in (low, high):
+            if x != int(x):
+                raise CalibrationError("raw limit %r of an integer parameter" % (x,))
+        return int(low), int(high)

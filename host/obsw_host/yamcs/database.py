@@ -31,6 +31,7 @@ class Param:
         self.range = extra.get("range")
         self.limits = extra.get("limits")
         self.calibration = extra.get("calibration")
+        self.labels = extra.get("labels")  # {raw value: label} of an enumeration, or None
         self.description = extra.get("description")
 
 
@@ -96,6 +97,7 @@ def loads(text):
             "range": p.range,
             "limits": p.limits,
             "calibration": p.calibration,
+            "labels": p.values.labels,
             "description": p.description,
         }
         params[pid] = Param(pid, p.qualified, _pair(p.type_spec), p.unit, p.writable, extra)

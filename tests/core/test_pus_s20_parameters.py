@@ -209,6 +209,18 @@ class TestDefinitions(unittest.TestCase):
         tx = loop2.run(user2.report_definitions(APID, [2]))
         self.assertEqual(tx.reply["definitions"][0]["address"], 12)
 
+    def test_saved_definitions_wait_for_their_memory_area(self):
+        store = Store("/ctx", SimFs())
+        loop, pool, user = make(memory_db(), {1: self.ram}, store)
+        self.assertTrue(loop.run(user.change_raw_definitions(APID, [(2, 1, 4096)])).ok)
+        self.ram.write(0, b"\x3f\x80\x00\x00")
+        loop2, pool2, user2 = make(memory_db(), None, store)
+        self.assertEqual(pool2.get(2), 3.0)  # the component's value until the area is served
+        loop2.app.services[20].use_memories({1: self.ram})
+        self.assertEqual(pool2.get(2), 1.0)
+        tx = loop2.run(user2.report_definitions(APID, [2]))
+        self.assertEqual(tx.reply["definitions"][0]["kind"], "raw memory")
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -203,7 +203,9 @@ class PusUnit:
         app = self.app
         app.register(DeviceAccess(self.node, timeout=float(opts.get("device_timeout", 5.0))))
         app.register(ParameterStatistics(self.onboard.pool))
-        app.register(MemoryManagement(areas_from_sdb(sdb, self.files)))
+        areas = areas_from_sdb(sdb, self.files)
+        app.register(MemoryManagement(areas))
+        app.services[20].use_memories(areas)  # service 20 places parameters in the same areas
         app.register(LargePacketTransfer())
         app.register(ForwardingControl())
         app.register(Storage(filestore=self.files, rate=int(opts.get("playback_rate", 64))))

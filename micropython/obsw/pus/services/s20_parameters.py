@@ -170,6 +170,7 @@ class ParameterManagement(Service):
         self.memories = memories or {}
         self.layout = values_layout(self._type)
         self.definitions = {}  # pid -> (kind, memory ID, absolute address)
+        self._pending = []  # saved definitions whose memory area is not served yet
 
     def _type(self, pid):
         try:
@@ -280,12 +281,32 @@ class ParameterManagement(Service):
             items.append({"id": pid, "kind": kind, "memory": memory, "address": address})
         req.report(TM_PARAM_DEFINITION_REPORT, DEFINITION_REPORT.pack({"items": items}))
 
+    def use_memories(self, areas):
+        """Serve memory areas ``areas`` (service 6's, by ID) too, and the saved definitions
+        that place parameters in them."""
+        self.memories.update(areas)
+        self._apply_pending()
+
+    def _apply_pending(self):
+        left = []
+        for pid, kind, memory, address in self._pending:
+            if memory not in self.memories:
+                left.append((pid, kind, memory, address))
+                continue
+            try:
+                self._place(pid, kind, memory, address)
+            except PusFailure:  # the database changed under a saved definition: drop it
+                if self.app is not None:
+                    self.app.count("context_rejected")
+        self._pending = left
+
     def context(self):
-        return {"definitions": [[pid] + list(d) for pid, d in sorted(self.definitions.items())]}
+        defs = [[pid] + list(d) for pid, d in sorted(self.definitions.items())]
+        return {"definitions": defs + [list(p) for p in self._pending]}
 
     def restore(self, ctx):
-        for pid, kind, memory, address in ctx["definitions"]:
-            self._place(pid, kind, memory, address)
+        self._pending = [tuple(d) for d in ctx["definitions"]]
+        self._apply_pending()
 
 
 class ParameterUser(ServiceUser):

@@ -63,6 +63,8 @@ def test_engineering_values_raw_on_request_and_ranges(obc):
     assert r.returncode == 0
     r = ground(obc, "--json", "params", "get", "SolarPanel.speed")
     assert json.loads(r.stdout)["replies"][0]["values"] == {"SolarPanel.speed": 9.0}
+    r = ground(obc, "params", "set", "SolarPanel.angle=1")  # read-only: refused on board
+    assert r.returncode == 1 and "refused (code 10) (parameter SolarPanel.angle)" in r.stdout
 
 
 def test_limits_in_engineering_units_on_an_integer_parameter(obc):

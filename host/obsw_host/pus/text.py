@@ -410,4 +410,8 @@ def failure_detail(tx, sdb=None):
 
         fn = functions(sdb).get(fid)
         return "function %s" % (fn.name if fn else fid)
+    if tx.tc.service == 20 and data and len(data) == 2:
+        pid = int.from_bytes(bytes(data), "big")
+        p = _parameter(sdb, pid)
+        return "parameter %s" % (p.qualified if p is not None else pid)
     return ""

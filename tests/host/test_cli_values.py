@@ -80,6 +80,13 @@ def test_limits_in_engineering_units_on_an_integer_parameter(obc):
     assert [(i["low"], i["high"]) for i in items] == [(0, 100), (0.5, 5.0)]
     r = ground(obc, "monitor", "list")
     assert "10 deg/s" in r.stdout  # the table shows engineering limits
+    r = ground(obc, "--raw", "monitor", "add", "3", "CpduN.state_bits", "1.5", "3")
+    assert r.returncode == 2 and "raw limit 1.5 of an integer parameter" in r.stderr
+    r = ground(obc, "--raw", "monitor", "add", "3", "SolarPanel.speed", "1", "3")  # raw 2..6
+    assert r.returncode == 0
+    r = ground(obc, "--json", "monitor", "list")
+    items = json.loads(r.stdout)["replies"][0]["items"]
+    assert (items[-1]["low"], items[-1]["high"]) == (1.0, 3.0)
 
 
 def test_functional_monitoring_and_definitions(obc):

@@ -344,14 +344,30 @@ def engineering(sdb, key, raw_value):
 _LIMIT_KEYS = ("low", "high", "value", "limit")
 
 
+_EVENT_KEYS = ("event", "low_event", "high_event")
+_PARAMETER_KEYS = ("parameter", "validity")
+
+
 def _engineering_row(row, sdb, raw):
-    """A service 12 row with its limits and values in engineering units (limit checks)."""
-    if raw or sdb is None or row.get("check") != 1 or "parameter" not in row:
+    """A service 12 row as operators read it: event and parameter names instead of IDs, a
+    limit check's limits and values in engineering units (``raw``: left as they are)."""
+    if raw or sdb is None:
         return row
     out = dict(row)
-    for k in _LIMIT_KEYS:
-        if k in out and isinstance(out[k], (int, float)) and not isinstance(out[k], bool):
-            out[k] = value_text(sdb, row["parameter"], out[k]).split(" (raw")[0]
+    if row.get("check") == 1 and "parameter" in row:
+        for k in _LIMIT_KEYS:
+            x = out.get(k)
+            if isinstance(x, (int, float)) and not isinstance(x, bool):
+                out[k] = value_text(sdb, row["parameter"], x).split(" (raw")[0]
+    for k in _EVENT_KEYS:
+        if out.get(k):
+            out[k] = _event_name(sdb, out[k])
+    for k in _PARAMETER_KEYS:
+        if k == "validity" and not row.get("validity_mask"):
+            continue
+        p = _parameter(sdb, out.get(k)) if isinstance(out.get(k), int) else None
+        if p is not None:
+            out[k] = p.qualified
     return out
 
 
@@ -372,7 +388,8 @@ def readable(value, sdb=None, raw=False):
         return "\n".join(lines)
     for key in ("functional", "definitions"):
         if set(v) == {key} and isinstance(v[key], list):
-            return table([{k: _cell(x) for k, x in r.items()} for r in v[key]])
+            rows = [_engineering_row(r, sdb, raw) for r in v[key]]
+            return table([{k: _cell(x) for k, x in r.items()} for r in rows])
     if isinstance(v.get("activities"), list):
         return table([_activity(a) for a in v["activities"]])
     if set(v) == {"ids"} and isinstance(v["ids"], list):

@@ -270,6 +270,8 @@ class ParameterManagement(Service):
 
     def report_definitions(self, req):
         ids = req.decode(IDS)["ids"] or sorted(self.pool.sdb.parameters)
+        if len(ids) > 255:  # N is one octet: a database this large is reported by name
+            raise PusFailure(FAILURE_REFUSED, "%d parameters: name at most 255" % len(ids))
         for pid in ids:
             self._known(pid)
         req.start()

@@ -19,10 +19,10 @@ F32 = field(5, 1)
 
 
 class TestPolynomial(unittest.TestCase):
-    def test_degree_one_both_ways(self):
-        c = calibration({"polynomial": [-50.0, 0.05]})
-        self.assertAlmostEqual(c.engineering(1400), 20.0)
-        self.assertAlmostEqual(c.raw(20.0), 1400.0)
+    def test_degree_one_both_ways(self):  # binary-exact numbers: the same on a board's floats
+        c = calibration({"polynomial": [-50.0, 0.0625]})
+        self.assertEqual(c.engineering(1400), 37.5)
+        self.assertEqual(c.raw(37.5), 1400.0)
 
     def test_xtce_terms(self):
         c = calibration({"polynomial": [{"coefficient": 2.0, "exponent": 1}]})
@@ -113,8 +113,15 @@ class TestValues(unittest.TestCase):
     def test_raw_limits_rounded_inwards(self):
         v = Values(U16, {"calibration": {"polynomial": [-50, 0.05]}})
         self.assertEqual(v.raw_limits(-10.01, 40.01), (800, 1800, False))
+        # 40 degC is raw 1800 less a rounding error (more in single precision): still 1800
         low, high, _ = v.raw_limits(-10.0, 40.0)
         self.assertEqual((low, high), (800, 1800))
+
+    def test_range_edges_survive_rounding(self):
+        v = Values(U16, {"calibration": {"polynomial": [-50, 0.05]}, "range": [-10, 40]})
+        self.assertIsNone(v.out_of_range(800))
+        self.assertIsNone(v.out_of_range(1800))
+        self.assertIn("outside", v.out_of_range(1801))
 
     def test_raw_limits_of_a_decreasing_calibration_swap(self):
         v = Values(I16, {"calibration": {"polynomial": [100, -1]}})
@@ -134,7 +141,7 @@ class TestValues(unittest.TestCase):
 
 DB = """{"components": [{"name": "Coil", "attributes": [
   {"name": "temp", "parameter": 1, "type": "uint16", "unit": "degC", "raw_unit": "count",
-   "calibration": {"polynomial": [-50, 0.05]}, "range": [-40, 80],
+   "calibration": {"polynomial": [-50, 0.0625]}, "range": [-40, 80],
    "limits": {"warning": [-10, 40]}},
   {"name": "mode", "parameter": 2, "type": "enum8", "enumeration": {"0": "OFF", "1": "ON"}}
 ]}]}"""
@@ -145,15 +152,15 @@ class TestDatabase(unittest.TestCase):
         db = loads(DB)
         temp = db.parameter("Coil.temp")
         self.assertEqual((temp.unit, temp.raw_unit), ("degC", "count"))
-        self.assertAlmostEqual(temp.engineering(1400), 20.0)
-        self.assertEqual(temp.to_raw(20.0), 1400)
+        self.assertEqual(temp.engineering(1400), 37.5)
+        self.assertEqual(temp.to_raw(37.5), 1400)
         self.assertIn("outside", temp.out_of_range(3000))
         self.assertEqual(db.parameter("Coil.mode").engineering(1), "ON")
 
     def test_bad_entries_are_database_errors(self):
         bad = DB.replace('"range": [-40, 80]', '"range": [80, -40]')
         self.assertRaises(SdbError, loads, bad)
-        bad = DB.replace('"polynomial": [-50, 0.05]', '"polynomial": "x"')
+        bad = DB.replace('"polynomial": [-50, 0.0625]', '"polynomial": "x"')
         self.assertRaises(SdbError, loads, bad)
 
 

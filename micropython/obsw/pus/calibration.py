@@ -22,6 +22,15 @@ raises ``NotInvertibleError``: give raw values instead. A raw value outside a sp
 ``limits`` is ``{"warning": [low, high], "critical": [low, high]}`` in engineering units.
 """
 
+# Relative slack of comparisons with engineering values: a board computes calibrations in single
+# precision (about 7 digits), so a raw value at the edge of a range or limit may calibrate a few
+# units in the 7th digit outside it; it still counts as inside.
+_SLACK = 1e-6
+
+
+def _slack(x):
+    return _SLACK * (abs(x) if abs(x) > 1 else 1)
+
 
 class CalibrationError(ValueError):
     """A calibration, enumeration, range or limits entry that is malformed, or a value it
@@ -305,7 +314,9 @@ class Values:
         except CalibrationError as e:
             return str(e)
         low, high = self.range
-        if (low is not None and eng < low) or (high is not None and eng > high):
+        if (low is not None and eng < low - _slack(low)) or (
+            high is not None and eng > high + _slack(high)
+        ):
             return "%r outside the range [%s, %s]" % (eng, low, high)
         return None
 
@@ -322,8 +333,8 @@ class Values:
             if swapped:
                 low, high = high, low
         if self.integer:
-            low = -int(-low // 1)  # ceil
-            high = int(high // 1)  # floor
+            low = -int(-(low - _slack(low)) // 1)  # ceil, a rounding error short of it too
+            high = int((high + _slack(high)) // 1)  # floor
         return low, high, swapped
 
     def raw_limits_of(self, low, high):

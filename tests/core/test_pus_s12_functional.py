@@ -1,13 +1,43 @@
 """ST[12] functional monitoring (TC[12,17] to TM[12,28]): FMONs over PMONs, their statuses,
 protection, events and failure codes."""
 
+import gc
 import unittest
 
+from obsw.pus.parameters import ParameterPool
 from obsw.pus.services.s01_verification import FAILURE_REFUSED, FAILURE_UNKNOWN_ID
-from obsw.pus.services.s12_user import functional_check, limit_check
+from obsw.pus.services.s05_events import EventReporting
+from obsw.pus.services.s12_functional import FunctionalOnBoardMonitoring
+from obsw.pus.services.s12_functional_user import FunctionalMonitoringUser, functional_check
+from obsw.pus.services.s12_layouts import FMON_FAILED, FMON_UNCHECKED
+from obsw.pus.services.s12_user import limit_check
 from obsw.store import Store
+from pus_loop import APID, Loop, sdb
 from store_sim import SimFs
-from test_pus_s12_monitoring import APID, cycle, failure, make
+
+
+def make(store=None):
+    db = sdb()
+    loop = Loop(store=store)
+    pool = ParameterPool(db)
+    pool.values.update({1: 20.0, 2: 3.0, 3: 2, 4: True, 100: 0})
+    loop.app.register(EventReporting(known=db.events))
+    mon = loop.app.register(FunctionalOnBoardMonitoring(pool, db.events))
+    user = loop.ground.register(
+        FunctionalMonitoringUser(lambda pid: db.parameter(pid).type, lambda k: db.parameter(k).id)
+    )
+    return loop, mon, user, pool
+
+
+def cycle(loop, n=1):
+    for _ in range(n):
+        loop.clock.advance(1.0)
+        loop.app.tick()
+    loop.pump()
+
+
+def failure(tx):
+    return (tx.failure["stage"], tx.failure["code"], tx.failure["data"]) if tx.failure else None
 
 
 def setup(store=None):
@@ -131,13 +161,13 @@ class TestFunctionalMonitoring(unittest.TestCase):
         for d, code, data in cases:
             tx = loop.run(user.add_functional(APID, [functional_check(9, [2]), d]))
             self.assertEqual(failure(tx), (2, code, data))
-        self.assertEqual(sorted(mon.functional.fmons), [7])
+        self.assertEqual(sorted(mon.fmons), [7])
         for call in (user.enable_functional, user.protect_functional, user.report_functional):
             self.assertEqual(
                 failure(loop.run(call(APID, [3]))), (2, FAILURE_UNKNOWN_ID, b"\x00\x03")
             )
 
-    def test_the_function_depends_on_parameter_monitoring(self):
+    def test_disabling_the_function_stops_every_fmon(self):
         loop, mon, user, pool = setup()
         loop.run(user.enable_functional(APID, [7]))
         pool.values[2] = 9.0
@@ -145,27 +175,38 @@ class TestFunctionalMonitoring(unittest.TestCase):
         cycle(loop, 2)
         self.assertEqual(statuses(loop, user)[0][3], "unchecked")
         self.assertEqual(events(loop), [])
+        self.assertTrue(loop.run(user.enable_functional_function(APID)).ok)
+        cycle(loop)
+        self.assertEqual(statuses(loop, user)[0][3], "failed")
+
+    def test_the_function_depends_on_parameter_monitoring(self):
+        loop, mon, user, pool = setup()
+        loop.run(user.enable_functional(APID, [7]))
         loop.run(user.disable_function(APID))
+        self.assertFalse(mon.fmon_function)  # disabled with parameter monitoring
         tx = loop.run(user.enable_functional_function(APID))
         self.assertEqual(failure(tx)[:2], (2, FAILURE_REFUSED))
         loop.run(user.enable_function(APID))
-        self.assertFalse(mon.functional.function)  # disabled with parameter monitoring
+        self.assertFalse(mon.fmon_function)  # not enabled again by it
         self.assertTrue(loop.run(user.enable_functional_function(APID)).ok)
+        pool.values[2] = 9.0
         cycle(loop, 2)
-        self.assertEqual(statuses(loop, user)[0][3], "failed")
+        self.assertEqual(mon.fmons[7].status, FMON_FAILED)
         loop.run(user.disable_function(APID))
-        self.assertEqual(statuses(loop, user)[0][3], "unchecked")
+        self.assertEqual(mon.fmons[7].status, FMON_UNCHECKED)
 
     def test_definitions_survive_a_restart(self):
         fs = SimFs()
         loop, mon, user, pool = setup(Store("/ctx", fs))
         loop.run(user.enable_functional(APID, [7]))
         loop.run(user.protect_functional(APID, [7]))
-        loop2, mon2, user2, pool2 = make(Store("/ctx", fs))
-        self.assertEqual(statuses(loop2, user2), [(7, True, True, "unchecked")])
-        pool2.values[1] = 90.0
-        cycle(loop2, 2)
-        self.assertEqual(events(loop2), [b"\x00\x04\x00\x07"])
+        del loop, mon, user, pool  # one spacecraft at a time: a board's heap holds one
+        gc.collect()
+        loop, mon, user, pool = make(Store("/ctx", fs))
+        self.assertEqual(statuses(loop, user), [(7, True, True, "unchecked")])
+        pool.values[1] = 90.0
+        cycle(loop, 2)
+        self.assertEqual(events(loop), [b"\x00\x04\x00\x07"])
 
 
 if __name__ == "__main__":

@@ -6,7 +6,7 @@ from hypothesis import strategies as st
 from obsw.bits import BitsTooShortError, BitsValueError
 from obsw.pus.calibration import Values, calibration
 from obsw.pus.fields import FieldValueError, field
-from obsw.pus.services.s12_layouts import FMON_ADD, FMON_IDS, FMON_REPORT, FMON_STATUS_REPORT
+from obsw.pus.services.s12_layouts import fmon_layouts
 from obsw.pus.services.s20_parameters import (
     DEFINITION_REPORT,
     OBJECT_DEFINITIONS,
@@ -39,18 +39,19 @@ def _items(item, n=6):
     return st.lists(item, max_size=n).map(lambda items: {"items": items})
 
 
+FMON = fmon_layouts()
 CASES = (
-    (FMON_ADD, _items(_fmon(False))),
-    (FMON_REPORT, _items(_fmon(True))),
+    (FMON.add, _items(_fmon(False))),
+    (FMON.report, _items(_fmon(True))),
     (
-        FMON_STATUS_REPORT,
+        FMON.status,
         _items(
             st.fixed_dictionaries(
                 {"fmon": U16, "protected": FLAG, "enabled": FLAG, "checking": st.integers(0, 3)}
             )
         ),
     ),
-    (FMON_IDS, st.lists(U16, max_size=8).map(lambda ids: {"ids": ids})),
+    (FMON.ids, st.lists(U16, max_size=8).map(lambda ids: {"ids": ids})),
     (
         RAW_DEFINITIONS,
         _items(st.fixed_dictionaries({"id": U16, "memory": U16, "address": U32})),

@@ -23,12 +23,12 @@ from obsw.pus.sdb import Sdb  # noqa: E402
 from obsw.pus.services.s01_verification import FAILURE_OUT_OF_RANGE  # noqa: E402
 from obsw.pus.services.s05_events import EventReporting  # noqa: E402
 from obsw.pus.services.s06_memory import BytesMemory  # noqa: E402
-from obsw.pus.services.s12_monitoring import OnBoardMonitoring  # noqa: E402
-from obsw.pus.services.s12_user import (  # noqa: E402
-    OnBoardMonitoringUser,
+from obsw.pus.services.s12_functional import FunctionalOnBoardMonitoring  # noqa: E402
+from obsw.pus.services.s12_functional_user import (  # noqa: E402
+    FunctionalMonitoringUser,
     functional_check,
-    limit_check,
 )
+from obsw.pus.services.s12_user import limit_check  # noqa: E402
 from obsw.pus.services.s20_parameters import ParameterManagement, ParameterUser  # noqa: E402
 from pus_loop import APID, SDB, Loop  # noqa: E402
 
@@ -57,12 +57,12 @@ def scenario():
     pool.values.update({1: 20.0, 2: 3.0, 3: 2, 4: True, 6: 1400})
     app, ground = loop.app, loop.ground
     app.register(EventReporting(known=db.events))
-    app.register(OnBoardMonitoring(pool, db.events))
+    app.register(FunctionalOnBoardMonitoring(pool, db.events))
     app.register(ParameterManagement(pool, {1: BytesMemory(64, start=4096)}))
     EventManager(db).connect(app)
     types = lambda pid: db.parameter(pid).type  # noqa: E731
     ids = lambda k: db.parameter(k).id  # noqa: E731
-    s12 = ground.register(OnBoardMonitoringUser(types, ids))
+    s12 = ground.register(FunctionalMonitoringUser(types, ids))
     s20 = ground.register(
         ParameterUser(types, lambda pid: db.parameter(pid).qualified, ids, db.parameter)
     )
@@ -184,7 +184,7 @@ def test_spacepackets_tcs_served_like_ours():
     pool.values.update({1: 20.0, 2: 3.0, 3: 2, 4: True, 6: 1400})
     ram = BytesMemory(64, start=4096)
     loop.app.register(EventReporting(known=db.events))
-    mon = loop.app.register(OnBoardMonitoring(pool, db.events))
+    mon = loop.app.register(FunctionalOnBoardMonitoring(pool, db.events))
     loop.app.register(ParameterManagement(pool, {1: ram}))
     add = struct.pack(">HHHHIIHHB", 1, 1, 1, 0, 0, 0, 1, 1, 1) + struct.pack(
         ">fHfH", -10, 0, 45, 0
@@ -203,7 +203,7 @@ def test_spacepackets_tcs_served_like_ours():
         tc = SpTc(apid=APID, service=service, message_subtype=subtype, app_data=data, seq_count=n)
         n += 1
         asyncio.run(_serve(loop, tc.pack()))
-    f = mon.functional.fmons[9]
+    f = mon.fmons[9]
     assert (f.enabled, f.protected, f.d["pmons"], f.d["event"]) == (True, True, [1], 3)
     assert ram.read(0, 4) == b"\x00\x00\x00\x00"  # the refused set changed nothing
     assert pool.get(6) == 1400

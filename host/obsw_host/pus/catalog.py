@@ -28,7 +28,7 @@ def parameters(sdb):
                 "type": _type(p.type_spec),
                 "unit": p.unit or "",
                 "writable": "yes" if p.writable else "no",
-                "range": _bounds(p.values.range),
+                "range": _bounds(p.values.range if p.values else None),
                 "values": _conversion(p.values),
             }
         )
@@ -43,6 +43,8 @@ def _bounds(pair):
 
 def _conversion(values):
     """How raw values become engineering ones: calibrated, labels, or nothing."""
+    if values is None:
+        return ""
     if values.labels:
         return ", ".join("%d=%s" % kv for kv in sorted(values.labels.items()))
     cal = values.calibration

@@ -30,7 +30,8 @@ from obsw.pus.services.s05_events import EventUser
 from obsw.pus.services.s08_functions import FunctionUser, functions
 from obsw.pus.services.s09_time import TimeUser
 from obsw.pus.services.s11_scheduling import TimeSchedulingUser
-from obsw.pus.services.s12_user import OnBoardMonitoringUser, functional_check, limit_check
+from obsw.pus.services.s12_functional_user import FunctionalMonitoringUser, functional_check
+from obsw.pus.services.s12_user import limit_check
 from obsw.pus.services.s17_test import ServiceTestUser
 from obsw.pus.services.s19_event_action import EventActionUser
 from obsw.pus.services.s20_parameters import ParameterUser
@@ -99,7 +100,7 @@ class Ground:
             self.events = reg(EventUser(sdb.event))
             self.params = reg(ParameterUser(types, names, ids, sdb.parameter))
             self.functions = reg(FunctionUser(functions(sdb)))
-            self.monitoring = reg(OnBoardMonitoringUser(types, ids))
+            self.monitoring = reg(FunctionalMonitoringUser(types, ids))
         else:
             self.hk = self.events = self.params = self.functions = self.monitoring = None
 
@@ -326,13 +327,9 @@ class Ground:
         ``low`` and ``high`` are engineering values (``raw``: raw ones), sent as raw limits
         (``obsw.pus.calibration.Values.raw_limits``)."""
         low_event, high_event = self._event_id(low_event), self._event_id(high_event)
-        values = self.sdb.parameter(parameter).values
-        if raw:
-            low, high = values.raw_limits_of(low, high)
-        else:
-            low, high, swapped = values.raw_limits(low, high)
-            if swapped:  # a falling calibration: the low raw limit is the high engineering one
-                low_event, high_event = high_event, low_event
+        low, high, swapped = self.sdb.parameter(parameter).raw_limits(low, high, raw)
+        if swapped:  # a falling calibration: the low raw limit is the high engineering one
+            low_event, high_event = high_event, low_event
         d = limit_check(pmon, parameter, low, high, low_event, high_event, **options)
         tx = self._issue(self.monitoring.add(self._apid(apid), [d]), timeout)
         if not tx.ok:

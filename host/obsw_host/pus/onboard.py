@@ -27,7 +27,7 @@ from obsw.pus.services.s05_events import EventReporting
 from obsw.pus.services.s08_functions import FunctionManagement, functions
 from obsw.pus.services.s09_time import TimeManagement
 from obsw.pus.services.s11_scheduling import TimeScheduling
-from obsw.pus.services.s12_monitoring import OnBoardMonitoring
+from obsw.pus.services.s12_functional import FunctionalOnBoardMonitoring
 from obsw.pus.services.s17_test import ServiceTest
 from obsw.pus.services.s19_event_action import EventAction
 from obsw.pus.services.s20_parameters import ParameterManagement
@@ -137,7 +137,7 @@ class Onboard:
         app.register(ParameterManagement(self.pool))
         app.register(FunctionManagement(functions(sdb), self.node))
         app.register(TimeScheduling())
-        app.register(OnBoardMonitoring(self.pool, sdb.events))
+        app.register(FunctionalOnBoardMonitoring(self.pool, sdb.events))  # types 1-28
         app.register(EventAction(known=sdb.events))
         app.register(RequestSequencing())
         if sdb.position_parameter is not None:

@@ -97,7 +97,7 @@ def loads(text):
             "range": p.range,
             "limits": p.limits,
             "calibration": p.calibration,
-            "labels": p.values.labels,
+            "labels": p.labels,
             "description": p.description,
         }
         params[pid] = Param(pid, p.qualified, _pair(p.type_spec), p.unit, p.writable, extra)

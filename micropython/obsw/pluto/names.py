@@ -117,7 +117,7 @@ class Catalog:
         for p in sdb.parameters.values():
             if p.component:
                 code = type_code(p.type_spec)
-                if p.calibration or p.enumeration:  # PLUTO sees the engineering value
+                if p.calibration or p.labels:  # PLUTO sees the engineering value
                     self.calibrated[p.component + "." + p.name] = p
                     code = "r" if p.calibration else "s"
                 self.add("parameter", p.component, p.name, code, p.unit)

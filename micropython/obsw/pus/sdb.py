@@ -32,7 +32,6 @@ A type is a name (``uint8`` .. ``uint64``, ``int8`` .. ``int64``, ``float32``, `
 """
 
 from obsw import jsonsafe
-from obsw.pus.calibration import CalibrationError, Values
 from obsw.pus.fields import field
 from obsw.pus.structure import Structure
 
@@ -104,25 +103,38 @@ class Parameter:
         self.range = extras.get("range")
         self.limits = extras.get("limits")
         self.calibration = extras.get("calibration")
-        self.enumeration = extras.get("enumeration")
         self.raw_unit = extras.get("raw_unit")
         self.description = extras.get("description")
-        try:
-            self.values = Values(self.type, extras, "parameter " + self.qualified)
-        except CalibrationError as e:
-            raise SdbError(str(e)) from None
+        self.values = None  # obsw.pus.calibration.Values, for an entry that has any of them
+        for key in _VALUE_ENTRIES:
+            if extras.get(key) is not None:
+                self.values = _values(self.type, extras, "parameter " + self.qualified)
+                break
+
+    @property
+    def labels(self):
+        """{raw value: label} of an enumeration, or None."""
+        return None if self.values is None else self.values.labels
 
     def engineering(self, raw):
         """The engineering value of raw value ``raw`` (a label for an enumeration)."""
-        return self.values.engineering(raw)
+        return raw if self.values is None else self.values.engineering(raw)
 
     def to_raw(self, eng):
         """The raw value of an engineering value or label (CalibrationError if none)."""
-        return self.values.to_raw(eng)
+        return eng if self.values is None else self.values.to_raw(eng)
 
     def out_of_range(self, raw):
         """None if raw value ``raw`` is within the parameter's range, else why not."""
-        return self.values.out_of_range(raw)
+        return None if self.values is None else self.values.out_of_range(raw)
+
+    def raw_limits(self, low, high, raw=False):
+        """(raw low, raw high, swapped) of a limit check from engineering limits (``raw``:
+        raw limits, checked against the type); see ``obsw.pus.calibration.Values``."""
+        values = self.values if self.values is not None else _values(self.type, {}, "")
+        if raw:
+            return values.raw_limits_of(low, high) + (False,)
+        return values.raw_limits(low, high)
 
     @property
     def qualified(self):
@@ -130,6 +142,20 @@ class Parameter:
 
     def __repr__(self):
         return "Parameter(%d, %s, %s)" % (self.id, self.qualified, self.type.name)
+
+
+_VALUE_ENTRIES = ("calibration", "enumeration", "range", "limits")
+
+
+def _values(ftype, extras, what):
+    # imported here, not at the top: a database with no calibration, label, range or limits
+    # (a small board's) does not pay the module's heap
+    from obsw.pus.calibration import CalibrationError, Values
+
+    try:
+        return Values(ftype, extras, what)
+    except CalibrationError as e:
+        raise SdbError(str(e)) from None
 
 
 class EventDef:

@@ -1,4 +1,5 @@
-"""ST[12] functional monitoring: definitions (FMON) that combine parameter monitoring checks.
+"""ST[12] functional monitoring: definitions (FMON) that combine parameter monitoring checks;
+``FunctionalOnBoardMonitoring`` serves every message type of service 12 (1 to 28).
 
 An FMON names a list of PMONs, a minimum failing number, a validity condition and an event.
 While the functional monitoring function and the FMON are enabled (and the parameter
@@ -22,22 +23,34 @@ contradiction with ``FAILURE_REFUSED`` (the FMON ID in the data). A PMON used by
 cannot be deleted.
 """
 
+from obsw.pus.messages import (
+    TC_MON_ADD_FUNCTIONAL_MONITORING,
+    TC_MON_DELETE_FUNCTIONAL_MONITORING,
+    TC_MON_DISABLE_FUNCTIONAL_MONITORING,
+    TC_MON_DISABLE_FUNCTIONAL_MONITORING_FUNCTION,
+    TC_MON_ENABLE_FUNCTIONAL_MONITORING,
+    TC_MON_ENABLE_FUNCTIONAL_MONITORING_FUNCTION,
+    TC_MON_PROTECT_FUNCTIONAL_MONITORING,
+    TC_MON_REPORT_FUNCTIONAL_MONITORING,
+    TC_MON_REPORT_FUNCTIONAL_MONITORING_STATUS,
+    TC_MON_UNPROTECT_FUNCTIONAL_MONITORING,
+    TM_MON_FUNCTIONAL_MONITORING_REPORT,
+    TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT,
+)
 from obsw.pus.services.base import PARAMETER_ID
 from obsw.pus.services.s01_verification import FAILURE_REFUSED, FAILURE_UNKNOWN_ID, PusFailure
 from obsw.pus.services.s12_layouts import (
     ABOVE_HIGH,
     BELOW_LOW,
     EMPTY,
-    FMON_ADD,
     FMON_FAILED,
     FMON_ID,
-    FMON_IDS,
     FMON_INVALID,
-    FMON_REPORT,
     FMON_RUNNING,
-    FMON_STATUS_REPORT,
     FMON_UNCHECKED,
+    fmon_layouts,
 )
+from obsw.pus.services.s12_monitoring import OnBoardMonitoring
 
 _FAILING = (BELOW_LOW, ABOVE_HIGH)
 _MEDIUM = 3
@@ -59,47 +72,71 @@ class Fmon:
         self.status = FMON_UNCHECKED
 
 
-class FunctionalMonitoring:
-    """The FMONs of one ``OnBoardMonitoring`` provider (``mon``); its handlers take the
-    provider's requests. ``capacity`` bounds the FMONs, ``max_pmons`` the PMONs of one."""
+class FunctionalOnBoardMonitoring(OnBoardMonitoring):
+    """The service 12 provider with functional monitoring (see the module text);
+    ``fmon_capacity`` bounds the FMONs, ``max_pmons`` the PMONs of one."""
 
-    def __init__(self, mon, capacity=16, max_pmons=32):
-        self.mon = mon
-        self.capacity = capacity
+    HANDLERS = OnBoardMonitoring.HANDLERS + (
+        (TC_MON_ENABLE_FUNCTIONAL_MONITORING_FUNCTION, "fmon_enable_function"),
+        (TC_MON_DISABLE_FUNCTIONAL_MONITORING_FUNCTION, "fmon_disable_function"),
+        (TC_MON_ENABLE_FUNCTIONAL_MONITORING, "fmon_enable"),
+        (TC_MON_DISABLE_FUNCTIONAL_MONITORING, "fmon_disable"),
+        (TC_MON_PROTECT_FUNCTIONAL_MONITORING, "fmon_protect"),
+        (TC_MON_UNPROTECT_FUNCTIONAL_MONITORING, "fmon_unprotect"),
+        (TC_MON_ADD_FUNCTIONAL_MONITORING, "fmon_add"),
+        (TC_MON_DELETE_FUNCTIONAL_MONITORING, "fmon_delete"),
+        (TC_MON_REPORT_FUNCTIONAL_MONITORING, "fmon_report_definitions"),
+        (TC_MON_REPORT_FUNCTIONAL_MONITORING_STATUS, "fmon_report_status"),
+    )
+
+    def __init__(self, pool, events=None, capacity=32, batch=16, fmon_capacity=16, max_pmons=32):
+        self.fmons = {}  # FMON ID -> Fmon (before the base class restores a saved context)
+        self.fmon_function = True
+        self.fmon_capacity = fmon_capacity
         self.max_pmons = max_pmons
-        self.fmons = {}  # FMON ID -> Fmon
-        self.function = True
-        self.failures = 0  # transitions to failed
+        self.fmon_failures = 0  # transitions to failed
+        super().__init__(pool, events, capacity, batch)
 
     # -------------------------------------------------------------------------- context
 
     def context(self):
-        return {
-            "function": self.function,
+        ctx = super().context()
+        ctx["functional"] = {
+            "function": self.fmon_function,
             "fmons": [[f.d, f.enabled, f.protected] for f in self.fmons.values()],
         }
+        return ctx
 
     def restore(self, ctx):
+        super().restore(ctx)
+        saved = ctx.get("functional")
+        if saved is None:
+            return
         fmons = {}
-        for d, enabled, protected in ctx["fmons"]:
-            self._check(d)
+        for d, enabled, protected in saved["fmons"]:
+            self._check_fmon(d)
             fmons[d["fmon"]] = Fmon(d, bool(enabled), bool(protected))
-        self.function = bool(ctx["function"])
+        self.fmon_function = bool(saved["function"])
         self.fmons = fmons
 
-    def uses(self, pmon):
-        """The ID of an FMON that lists PMON ``pmon``, or None."""
+    # -------------------------------------------------------------------------- hooks
+
+    def user_of(self, pmon):
         for i, f in sorted(self.fmons.items()):
-            if pmon in f.d["pmons"]:
+            if pmon is None or pmon in f.d["pmons"]:
                 return i
         return None
 
+    def functional_stop(self):
+        self.fmon_function = False
+        for f in self.fmons.values():
+            f.status = FMON_UNCHECKED
+
     # -------------------------------------------------------------------------- checks
 
-    def _check(self, d):
+    def _check_fmon(self, d):
         fmon = d["fmon"]
-        mon = self.mon
-        if d["validity_mask"] and d["validity"] not in mon.pool:
+        if d["validity_mask"] and d["validity"] not in self.pool:
             pid = d["validity"]
             raise PusFailure(FAILURE_UNKNOWN_ID, "no parameter %d" % pid, PARAMETER_ID.pack(pid))
         pmons = d["pmons"]
@@ -108,7 +145,7 @@ class FunctionalMonitoring:
                 FAILURE_REFUSED, "1 to %d different PMONs expected" % self.max_pmons, fmon
             )
         for p in pmons:
-            if p not in mon.pmons:
+            if p not in self.pmons:
                 raise _failure(FAILURE_UNKNOWN_ID, "no PMON %d" % p, fmon)
         if not 1 <= d["failing"] <= len(pmons):
             raise _failure(
@@ -116,10 +153,10 @@ class FunctionalMonitoring:
                 "minimum failing number %d, expected 1 to %d" % (d["failing"], len(pmons)),
                 fmon,
             )
-        if d["event"] and mon.events is not None and d["event"] not in mon.events:
+        if d["event"] and self.events is not None and d["event"] not in self.events:
             raise _failure(FAILURE_UNKNOWN_ID, "no event %d" % d["event"], fmon)
 
-    def _known(self, ids):
+    def _known_fmons(self, ids):
         for i in ids:
             if i not in self.fmons:
                 raise _failure(FAILURE_UNKNOWN_ID, "no FMON %d" % i, i)
@@ -127,28 +164,22 @@ class FunctionalMonitoring:
 
     # -------------------------------------------------------------------------- handlers
 
-    def enable_function(self, req):
+    def fmon_enable_function(self, req):
         req.decode(EMPTY)
-        if not self.mon.function:
+        if not self.function:
             raise PusFailure(FAILURE_REFUSED, "the parameter monitoring function is disabled")
         req.start()
-        self.function = True
-        self.mon.persist()
+        self.fmon_function = True
+        self.persist()
 
-    def disable_function(self, req):
+    def fmon_disable_function(self, req):
         req.decode(EMPTY)
         req.start()
-        self.stop()
-        self.mon.persist()
+        self.functional_stop()
+        self.persist()
 
-    def stop(self):
-        """Disable the function: every FMON becomes unchecked."""
-        self.function = False
-        for f in self.fmons.values():
-            f.status = FMON_UNCHECKED
-
-    def _switch(self, req, enabled):
-        ids = self._known(req.decode(FMON_IDS)["ids"])
+    def _switch_fmons(self, req, enabled):
+        ids = self._known_fmons(req.decode(fmon_layouts().ids)["ids"])
         if not enabled:
             for i in ids:
                 if self.fmons[i].protected:
@@ -158,54 +189,54 @@ class FunctionalMonitoring:
             f = self.fmons[i]
             f.enabled = enabled
             f.status = FMON_UNCHECKED
-        self.mon.persist()
+        self.persist()
 
-    def enable(self, req):
-        self._switch(req, True)
+    def fmon_enable(self, req):
+        self._switch_fmons(req, True)
 
-    def disable(self, req):
-        self._switch(req, False)
+    def fmon_disable(self, req):
+        self._switch_fmons(req, False)
 
     def _protect(self, req, protected):
-        ids = self._known(req.decode(FMON_IDS)["ids"])
+        ids = self._known_fmons(req.decode(fmon_layouts().ids)["ids"])
         req.start()
         for i in ids:
             self.fmons[i].protected = protected
-        self.mon.persist()
+        self.persist()
 
-    def protect(self, req):
+    def fmon_protect(self, req):
         self._protect(req, True)
 
-    def unprotect(self, req):
+    def fmon_unprotect(self, req):
         self._protect(req, False)
 
-    def add(self, req):
-        items = req.decode(FMON_ADD)["items"]
-        if len(self.fmons) + len(items) > self.capacity:
-            raise PusFailure(FAILURE_REFUSED, "at most %d FMONs" % self.capacity)
+    def fmon_add(self, req):
+        items = req.decode(fmon_layouts().add)["items"]
+        if len(self.fmons) + len(items) > self.fmon_capacity:
+            raise PusFailure(FAILURE_REFUSED, "at most %d FMONs" % self.fmon_capacity)
         seen = set()
         for d in items:
             if d["fmon"] in self.fmons or d["fmon"] in seen:
                 raise _failure(FAILURE_REFUSED, "FMON %d exists" % d["fmon"], d["fmon"])
             seen.add(d["fmon"])
-            self._check(d)
+            self._check_fmon(d)
         req.start()
         for d in items:
             self.fmons[d["fmon"]] = Fmon(d)
-        self.mon.persist()
+        self.persist()
 
-    def delete(self, req):
-        ids = self._known(req.decode(FMON_IDS)["ids"])
+    def fmon_delete(self, req):
+        ids = self._known_fmons(req.decode(fmon_layouts().ids)["ids"])
         for i in ids:
             if self.fmons[i].enabled:
                 raise _failure(FAILURE_REFUSED, "FMON %d is enabled" % i, i)
         req.start()
         for i in ids:
             del self.fmons[i]
-        self.mon.persist()
+        self.persist()
 
-    def report_definitions(self, req, message_type):
-        ids = self._known(req.decode(FMON_IDS)["ids"]) or sorted(self.fmons)
+    def fmon_report_definitions(self, req):
+        ids = self._known_fmons(req.decode(fmon_layouts().ids)["ids"]) or sorted(self.fmons)
         req.start()
         items = []
         for i in ids:
@@ -214,9 +245,10 @@ class FunctionalMonitoring:
             d["enabled"] = 1 if f.enabled else 0
             d["protected"] = 1 if f.protected else 0
             items.append(d)
-        req.report(message_type, FMON_REPORT.pack({"items": items}))
+        data = fmon_layouts().report.pack({"items": items})
+        req.report(TM_MON_FUNCTIONAL_MONITORING_REPORT, data)
 
-    def report_status(self, req, message_type):
+    def fmon_report_status(self, req):
         req.decode(EMPTY)
         req.start()
         items = [
@@ -228,45 +260,43 @@ class FunctionalMonitoring:
             }
             for i, f in sorted(self.fmons.items())
         ]
-        req.report(message_type, FMON_STATUS_REPORT.pack({"items": items}))
+        data = fmon_layouts().status.pack({"items": items})
+        req.report(TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT, data)
 
     # -------------------------------------------------------------------------- evaluation
 
-    def _status(self, f):
+    def _fmon_status(self, f):
         d = f.d
-        mon = self.mon
         if d["validity_mask"]:
-            valid = int(mon.pool.get(d["validity"])) & d["validity_mask"] == d["validity_value"]
+            valid = int(self.pool.get(d["validity"])) & d["validity_mask"] == d["validity_value"]
             if not valid:
                 return FMON_INVALID
         failing = 0
         for p in d["pmons"]:
-            m = mon.pmons.get(p)
+            m = self.pmons.get(p)
             if m is not None and m.status in _FAILING:
                 failing += 1
         return FMON_FAILED if failing >= d["failing"] else FMON_RUNNING
 
-    def cyclic(self):
-        """Evaluate every enabled FMON (after the PMONs of this cycle)."""
-        running = self.function and self.mon.function
+    def functional_cycle(self):
+        running = self.fmon_function and self.function
         for key in sorted(self.fmons):
             f = self.fmons[key]
             if not (running and f.enabled):
                 f.status = FMON_UNCHECKED
                 continue
-            status = self._status(f)
+            status = self._fmon_status(f)
             if status == FMON_FAILED and f.status != FMON_FAILED:
-                self.failures += 1
-                self._raise(f.d)
+                self.fmon_failures += 1
+                self._raise_fmon(f.d)
             f.status = status
 
-    def _raise(self, d):
+    def _raise_fmon(self, d):
         event = d["event"]
         if not event:
             return
         severity = _MEDIUM
-        events = self.mon.events
-        if events is not None and event in events:
-            severity = events[event].severity
-        self.mon.raised += 1
-        self.mon.app.event(event, severity, FMON_ID.pack(d["fmon"]))
+        if self.events is not None and event in self.events:
+            severity = self.events[event].severity
+        self.raised += 1
+        self.app.event(event, severity, FMON_ID.pack(d["fmon"]))

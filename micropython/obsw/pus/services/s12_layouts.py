@@ -87,61 +87,38 @@ FMON_STATUS_NAMES = {
     FMON_INVALID: "invalid",
     FMON_FAILED: "failed",
 }
-FMON_IDS = Structure([("ids", Repeated(FMON_COUNT, FMON_ID))])
-_VALIDITY = [
-    ("validity", PARAMETER_ID),
-    ("validity_mask", MASK),
-    ("validity_value", MASK),
-]
-_PMONS = ("pmons", Repeated(FMON_COUNT, PMON_ID))
-FMON_ADD = Structure(
-    [
-        (
-            "items",
-            Repeated(
-                FMON_COUNT,
-                [("fmon", FMON_ID)]
-                + _VALIDITY
-                + [("event", EVENT_ID), ("failing", FAILING_NUMBER), _PMONS],
-            ),
-        )
-    ]
-)
-FMON_REPORT = Structure(
-    [
-        (
-            "items",
-            Repeated(
-                FMON_COUNT,
-                [("fmon", FMON_ID)]
-                + _VALIDITY
-                + [
-                    ("protected", PROTECTION),
-                    ("enabled", STATUS),
-                    ("event", EVENT_ID),
-                    ("failing", FAILING_NUMBER),
-                    _PMONS,
-                ],
-            ),
-        )
-    ]
-)
-FMON_STATUS_REPORT = Structure(
-    [
-        (
-            "items",
-            Repeated(
-                FMON_COUNT,
-                [
-                    ("fmon", FMON_ID),
-                    ("protected", PROTECTION),
-                    ("enabled", STATUS),
-                    ("checking", FMON_CHECKING_STATUS),
-                ],
-            ),
-        )
-    ]
-)
+
+
+class FmonLayouts:
+    """The functional monitoring messages: ``ids`` (TC[12,19]-[12,22], [12,24], [12,25]),
+    ``add`` (TC[12,23]), ``report`` (TM[12,26]), ``status`` (TM[12,28]). Built on first use
+    by ``fmon_layouts()``: a board that defines no FMON keeps their heap."""
+
+    def __init__(self):
+        validity = [
+            ("validity", PARAMETER_ID),
+            ("validity_mask", MASK),
+            ("validity_value", MASK),
+        ]
+        pmons = ("pmons", Repeated(FMON_COUNT, PMON_ID))
+        self.ids = Structure([("ids", Repeated(FMON_COUNT, FMON_ID))])
+        tail = [("event", EVENT_ID), ("failing", FAILING_NUMBER), pmons]
+        head = [("fmon", FMON_ID)] + validity
+        self.add = Structure([("items", Repeated(FMON_COUNT, head + tail))])
+        flags = [("protected", PROTECTION), ("enabled", STATUS)]
+        self.report = Structure([("items", Repeated(FMON_COUNT, head + flags + tail))])
+        status = [("fmon", FMON_ID)] + flags + [("checking", FMON_CHECKING_STATUS)]
+        self.status = Structure([("items", Repeated(FMON_COUNT, status))])
+
+
+_fmon_layouts = []
+
+
+def fmon_layouts():
+    """The one ``FmonLayouts``, built on the first call."""
+    if not _fmon_layouts:
+        _fmon_layouts.append(FmonLayouts())
+    return _fmon_layouts[0]
 
 
 class Items:

@@ -12,7 +12,8 @@ PMON ID and the parameter ID as auxiliary data. New definitions are disabled; di
 one makes it unchecked. An enabled definition cannot be deleted, nor every definition
 while the monitoring function is enabled, nor a PMON that a functional monitoring
 definition uses. Definitions persist in the context store. Functional monitoring
-(TC[12,17] to TM[12,28]) is ``obsw.pus.services.s12_functional``, served by this provider.
+(TC[12,17] to TM[12,28]) is ``obsw.pus.services.s12_functional``, a subclass of this provider
+(a board that needs parameter monitoring only keeps its heap).
 
 Limits are raw values of the parameter's own type, as the standard's messages carry them:
 the ground converts engineering limits to raw ones (``obsw.pus.calibration``), so no
@@ -21,38 +22,25 @@ calibration runs on board for a check.
 
 from obsw.pus.messages import (
     SERVICE_ON_BOARD_MONITORING,
-    TC_MON_ADD_FUNCTIONAL_MONITORING,
     TC_MON_ADD_PARAMETER_MONITORING,
     TC_MON_CHANGE_TRANSITION_DELAY,
     TC_MON_DELETE_ALL_PARAMETER_MONITORING,
-    TC_MON_DELETE_FUNCTIONAL_MONITORING,
     TC_MON_DELETE_PARAMETER_MONITORING,
-    TC_MON_DISABLE_FUNCTIONAL_MONITORING,
-    TC_MON_DISABLE_FUNCTIONAL_MONITORING_FUNCTION,
     TC_MON_DISABLE_PARAMETER_MONITORING,
     TC_MON_DISABLE_PARAMETER_MONITORING_FUNCTION,
-    TC_MON_ENABLE_FUNCTIONAL_MONITORING,
-    TC_MON_ENABLE_FUNCTIONAL_MONITORING_FUNCTION,
     TC_MON_ENABLE_PARAMETER_MONITORING,
     TC_MON_ENABLE_PARAMETER_MONITORING_FUNCTION,
     TC_MON_MODIFY_PARAMETER_MONITORING,
-    TC_MON_PROTECT_FUNCTIONAL_MONITORING,
-    TC_MON_REPORT_FUNCTIONAL_MONITORING,
-    TC_MON_REPORT_FUNCTIONAL_MONITORING_STATUS,
     TC_MON_REPORT_OUT_OF_LIMITS,
     TC_MON_REPORT_PARAMETER_MONITORING,
     TC_MON_REPORT_PARAMETER_MONITORING_STATUS,
-    TC_MON_UNPROTECT_FUNCTIONAL_MONITORING,
     TM_MON_CHECK_TRANSITION_REPORT,
-    TM_MON_FUNCTIONAL_MONITORING_REPORT,
-    TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT,
     TM_MON_OUT_OF_LIMITS_REPORT,
     TM_MON_PARAMETER_MONITORING_REPORT,
     TM_MON_PARAMETER_MONITORING_STATUS_REPORT,
 )
 from obsw.pus.services.base import PARAMETER_ID, Service
 from obsw.pus.services.s01_verification import FAILURE_REFUSED, FAILURE_UNKNOWN_ID, PusFailure
-from obsw.pus.services.s12_functional import FunctionalMonitoring
 from obsw.pus.services.s12_layouts import (
     ABOVE_HIGH,
     BELOW_LOW,
@@ -136,16 +124,6 @@ class OnBoardMonitoring(Service):
         (TC_MON_REPORT_PARAMETER_MONITORING_STATUS, "report_status"),
         (TC_MON_ENABLE_PARAMETER_MONITORING_FUNCTION, "enable_function"),
         (TC_MON_DISABLE_PARAMETER_MONITORING_FUNCTION, "disable_function"),
-        (TC_MON_ENABLE_FUNCTIONAL_MONITORING_FUNCTION, "fmon_enable_function"),
-        (TC_MON_DISABLE_FUNCTIONAL_MONITORING_FUNCTION, "fmon_disable_function"),
-        (TC_MON_ENABLE_FUNCTIONAL_MONITORING, "fmon_enable"),
-        (TC_MON_DISABLE_FUNCTIONAL_MONITORING, "fmon_disable"),
-        (TC_MON_PROTECT_FUNCTIONAL_MONITORING, "fmon_protect"),
-        (TC_MON_UNPROTECT_FUNCTIONAL_MONITORING, "fmon_unprotect"),
-        (TC_MON_ADD_FUNCTIONAL_MONITORING, "fmon_add"),
-        (TC_MON_DELETE_FUNCTIONAL_MONITORING, "fmon_delete"),
-        (TC_MON_REPORT_FUNCTIONAL_MONITORING, "fmon_report_definitions"),
-        (TC_MON_REPORT_FUNCTIONAL_MONITORING_STATUS, "fmon_report_status"),
     )
 
     def __init__(self, pool, events=None, capacity=32, batch=16):
@@ -162,7 +140,6 @@ class OnBoardMonitoring(Service):
         self._age = 0
         self.transitions = 0
         self.raised = 0
-        self.functional = FunctionalMonitoring(self)
 
     # -------------------------------------------------------------------------- context
 
@@ -171,7 +148,6 @@ class OnBoardMonitoring(Service):
             "function": self.function,
             "delay": self.delay,
             "pmons": [[m.d, m.enabled] for m in self.pmons.values()],
-            "functional": self.functional.context(),
         }
 
     def restore(self, ctx):
@@ -182,8 +158,6 @@ class OnBoardMonitoring(Service):
         self.function = bool(ctx["function"])
         self.delay = int(ctx["delay"])
         self.pmons = pmons
-        if "functional" in ctx:
-            self.functional.restore(ctx["functional"])
 
     # -------------------------------------------------------------------------- checks
 
@@ -241,7 +215,7 @@ class OnBoardMonitoring(Service):
         for i in ids:
             if self.pmons[i].enabled:
                 raise _pmon_failure(FAILURE_REFUSED, "PMON %d is enabled" % i, i)
-            fmon = self.functional.uses(i)
+            fmon = self.user_of(i)
             if fmon is not None:
                 raise _pmon_failure(FAILURE_REFUSED, "FMON %d uses PMON %d" % (fmon, i), i)
         req.start()
@@ -253,7 +227,7 @@ class OnBoardMonitoring(Service):
         req.decode(EMPTY)
         if self.function:
             raise PusFailure(FAILURE_REFUSED, "the monitoring function is enabled")
-        if self.functional.fmons:
+        if self.user_of(None) is not None:
             raise PusFailure(FAILURE_REFUSED, "functional monitoring definitions use the PMONs")
         req.start()
         self.pmons = {}
@@ -308,7 +282,7 @@ class OnBoardMonitoring(Service):
                 m.reset()
         self.function = enabled
         if not enabled:
-            self.functional.stop()
+            self.functional_stop()
         self.persist()
 
     def enable_function(self, req):
@@ -345,37 +319,18 @@ class OnBoardMonitoring(Service):
         ]
         req.report(TM_MON_PARAMETER_MONITORING_STATUS_REPORT, STATUS_REPORT.pack({"items": items}))
 
-    # -------------------------------------------------------------------------- functional
+    # -------------------------------------------------------------------------- hooks
 
-    def fmon_enable_function(self, req):
-        self.functional.enable_function(req)
+    def user_of(self, pmon):
+        """The ID of a functional monitoring definition that uses PMON ``pmon`` (any PMON:
+        None), or None; none here (``obsw.pus.services.s12_functional`` has them)."""
+        return None
 
-    def fmon_disable_function(self, req):
-        self.functional.disable_function(req)
+    def functional_stop(self):
+        """The parameter monitoring function was disabled (functional monitoring stops)."""
 
-    def fmon_enable(self, req):
-        self.functional.enable(req)
-
-    def fmon_disable(self, req):
-        self.functional.disable(req)
-
-    def fmon_protect(self, req):
-        self.functional.protect(req)
-
-    def fmon_unprotect(self, req):
-        self.functional.unprotect(req)
-
-    def fmon_add(self, req):
-        self.functional.add(req)
-
-    def fmon_delete(self, req):
-        self.functional.delete(req)
-
-    def fmon_report_definitions(self, req):
-        self.functional.report_definitions(req, TM_MON_FUNCTIONAL_MONITORING_REPORT)
-
-    def fmon_report_status(self, req):
-        self.functional.report_status(req, TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT)
+    def functional_cycle(self):
+        """Evaluate functional monitoring after the PMONs of a cycle."""
 
     # -------------------------------------------------------------------------- monitoring
 
@@ -478,7 +433,7 @@ class OnBoardMonitoring(Service):
                 except (KeyError, TypeError, ValueError):
                     self.app.count("monitoring_errors")
         try:
-            self.functional.cyclic()
+            self.functional_cycle()
         except (KeyError, TypeError, ValueError):
             self.app.count("monitoring_errors")
         self.flush()

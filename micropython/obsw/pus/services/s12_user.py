@@ -1,37 +1,25 @@
 """The ST[12] on-board monitoring user: definitions sent, reports decoded.
 
 ``limit_check``, ``expected_value_check`` and ``delta_check`` build definitions; checks and
-statuses are the numbers of ``obsw.pus.services.s12_layouts``. ``functional_check`` builds a
-functional monitoring definition (FMON) for ``add_functional``.
+statuses are the numbers of ``obsw.pus.services.s12_layouts``. Functional monitoring is
+``obsw.pus.services.s12_functional_user``.
 """
 
 from obsw.pus.messages import (
     SERVICE_ON_BOARD_MONITORING,
-    TC_MON_ADD_FUNCTIONAL_MONITORING,
     TC_MON_ADD_PARAMETER_MONITORING,
     TC_MON_CHANGE_TRANSITION_DELAY,
     TC_MON_DELETE_ALL_PARAMETER_MONITORING,
-    TC_MON_DELETE_FUNCTIONAL_MONITORING,
     TC_MON_DELETE_PARAMETER_MONITORING,
-    TC_MON_DISABLE_FUNCTIONAL_MONITORING,
-    TC_MON_DISABLE_FUNCTIONAL_MONITORING_FUNCTION,
     TC_MON_DISABLE_PARAMETER_MONITORING,
     TC_MON_DISABLE_PARAMETER_MONITORING_FUNCTION,
-    TC_MON_ENABLE_FUNCTIONAL_MONITORING,
-    TC_MON_ENABLE_FUNCTIONAL_MONITORING_FUNCTION,
     TC_MON_ENABLE_PARAMETER_MONITORING,
     TC_MON_ENABLE_PARAMETER_MONITORING_FUNCTION,
     TC_MON_MODIFY_PARAMETER_MONITORING,
-    TC_MON_PROTECT_FUNCTIONAL_MONITORING,
-    TC_MON_REPORT_FUNCTIONAL_MONITORING,
-    TC_MON_REPORT_FUNCTIONAL_MONITORING_STATUS,
     TC_MON_REPORT_OUT_OF_LIMITS,
     TC_MON_REPORT_PARAMETER_MONITORING,
     TC_MON_REPORT_PARAMETER_MONITORING_STATUS,
-    TC_MON_UNPROTECT_FUNCTIONAL_MONITORING,
     TM_MON_CHECK_TRANSITION_REPORT,
-    TM_MON_FUNCTIONAL_MONITORING_REPORT,
-    TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT,
     TM_MON_OUT_OF_LIMITS_REPORT,
     TM_MON_PARAMETER_MONITORING_REPORT,
     TM_MON_PARAMETER_MONITORING_STATUS_REPORT,
@@ -42,11 +30,6 @@ from obsw.pus.services.s12_layouts import (
     CHECK_EXPECTED_VALUE,
     CHECK_LIMIT,
     DELAY_LAYOUT,
-    FMON_ADD,
-    FMON_IDS,
-    FMON_REPORT,
-    FMON_STATUS_NAMES,
-    FMON_STATUS_REPORT,
     IDS,
     STATUS_REPORT,
     Layouts,
@@ -67,8 +50,6 @@ class OnBoardMonitoringUser(ServiceUser):
         (TM_MON_OUT_OF_LIMITS_REPORT, "decode_transitions"),
         (TM_MON_CHECK_TRANSITION_REPORT, "decode_transitions"),
         (TM_MON_PARAMETER_MONITORING_STATUS_REPORT, "decode_status"),
-        (TM_MON_FUNCTIONAL_MONITORING_REPORT, "decode_functional"),
-        (TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT, "decode_functional_status"),
     )
 
     def __init__(self, types, ids=None):
@@ -135,71 +116,6 @@ class OnBoardMonitoringUser(ServiceUser):
             TM_MON_PARAMETER_MONITORING_STATUS_REPORT,
         )
 
-    # ---------------------------------------------------------------------- functional
-
-    def enable_functional_function(self, apid):
-        return self.request(apid, TC_MON_ENABLE_FUNCTIONAL_MONITORING_FUNCTION)
-
-    def disable_functional_function(self, apid):
-        return self.request(apid, TC_MON_DISABLE_FUNCTIONAL_MONITORING_FUNCTION)
-
-    def _fmons(self, message_type, apid, ids, expect=None):
-        return self.request(apid, message_type, FMON_IDS.pack({"ids": list(ids)}), expect)
-
-    def enable_functional(self, apid, ids):
-        return self._fmons(TC_MON_ENABLE_FUNCTIONAL_MONITORING, apid, ids)
-
-    def disable_functional(self, apid, ids):
-        return self._fmons(TC_MON_DISABLE_FUNCTIONAL_MONITORING, apid, ids)
-
-    def protect_functional(self, apid, ids):
-        return self._fmons(TC_MON_PROTECT_FUNCTIONAL_MONITORING, apid, ids)
-
-    def unprotect_functional(self, apid, ids):
-        return self._fmons(TC_MON_UNPROTECT_FUNCTIONAL_MONITORING, apid, ids)
-
-    def add_functional(self, apid, definitions):
-        """TC[12,23] for definitions built with ``functional_check``."""
-        items = []
-        for d in definitions:
-            d = dict(d)
-            if not isinstance(d["validity"], int) and self.ids is not None:
-                d["validity"] = self.ids(d["validity"])
-            items.append(d)
-        data = FMON_ADD.pack({"items": items})
-        return self.request(apid, TC_MON_ADD_FUNCTIONAL_MONITORING, data)
-
-    def delete_functional(self, apid, ids):
-        return self._fmons(TC_MON_DELETE_FUNCTIONAL_MONITORING, apid, ids)
-
-    def report_functional(self, apid, ids=()):
-        return self._fmons(
-            TC_MON_REPORT_FUNCTIONAL_MONITORING, apid, ids, TM_MON_FUNCTIONAL_MONITORING_REPORT
-        )
-
-    def report_functional_status(self, apid):
-        return self.request(
-            apid,
-            TC_MON_REPORT_FUNCTIONAL_MONITORING_STATUS,
-            b"",
-            TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT,
-        )
-
-    def decode_functional(self, tm):
-        items = FMON_REPORT.unpack(tm.data)["items"]
-        for d in items:
-            d["enabled"] = bool(d["enabled"])
-            d["protected"] = bool(d["protected"])
-        return {"functional": items}
-
-    def decode_functional_status(self, tm):
-        items = FMON_STATUS_REPORT.unpack(tm.data)["items"]
-        for d in items:
-            d["enabled"] = bool(d["enabled"])
-            d["protected"] = bool(d["protected"])
-            d["checking"] = FMON_STATUS_NAMES.get(d["checking"], d["checking"])
-        return {"functional": items}
-
     def decode_definitions(self, tm):
         out = self.layouts.report.unpack(tm.data)
         for d in out["items"]:
@@ -255,17 +171,3 @@ def delta_check(pmon, parameter, low, high, consecutive=1, low_event=0, high_eve
     d = {"pmon": pmon, "parameter": parameter, "check": CHECK_DELTA, "low": low, "high": high}
     d.update(consecutive=consecutive, low_event=low_event, high_event=high_event, **options)
     return d
-
-
-def functional_check(fmon, pmons, failing=1, event=0, validity=0, mask=0, expected=0):
-    """A functional monitoring definition: it fails when ``failing`` of ``pmons`` are out of
-    limits (while ``validity`` masked with ``mask`` equals ``expected``; mask 0: always)."""
-    return {
-        "fmon": fmon,
-        "validity": validity,
-        "validity_mask": mask,
-        "validity_value": expected,
-        "event": event,
-        "failing": failing,
-        "pmons": list(pmons),
-    }

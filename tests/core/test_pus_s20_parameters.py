@@ -149,8 +149,8 @@ def memory_db():
 
 
 class TestDefinitions(unittest.TestCase):
-    def setUp(self):
-        self.ram = BytesMemory(64, start=4096)
+    def setUp(self):  # object 5 ("table") is octets 16..23 of the area
+        self.ram = BytesMemory(64, start=4096, objects={5: ("table", 16, 8)})
 
     def test_report_definitions_of_database_parameters(self):
         loop, pool, user = make(memory_db(), {1: self.ram})
@@ -159,8 +159,22 @@ class TestDefinitions(unittest.TestCase):
         self.assertEqual(
             tx.reply["definitions"],
             [
-                {"id": 2, "kind": "component", "memory": 0, "address": 0, "name": "Panel.speed"},
-                {"id": 100, "kind": "component", "memory": 0, "address": 0, "name": "count"},
+                {
+                    "id": 2,
+                    "kind": "component",
+                    "memory": 0,
+                    "object": 0,
+                    "address": 0,
+                    "name": "Panel.speed",
+                },
+                {
+                    "id": 100,
+                    "kind": "component",
+                    "memory": 0,
+                    "object": 0,
+                    "address": 0,
+                    "name": "count",
+                },
             ],
         )
         tx = loop.run(user.report_definitions(APID))
@@ -170,18 +184,25 @@ class TestDefinitions(unittest.TestCase):
         loop, pool, user = make(memory_db(), {1: self.ram})
         tx = loop.run(user.change_raw_definitions(APID, [("Panel.speed", 1, 4100)]))
         self.assertTrue(tx.ok)
-        tx = loop.run(user.change_object_definitions(APID, [("Panel.mode", 1, 8)]))
+        items = [("Panel.mode", 1, 0, 8), ("count", 1, 5, 4)]  # object 0: the whole area
+        tx = loop.run(user.change_object_definitions(APID, items))
         self.assertTrue(tx.ok)
         self.assertTrue(loop.run_async(lambda: user.set(APID, {2: 2.5, 3: 7})).ok)
         self.assertEqual(self.ram.read(4, 4), b"\x40\x20\x00\x00")  # 2.5 as float32
         self.assertEqual(self.ram.read(8, 1), b"\x07")
         self.ram.write(8, b"\x09")
-        self.assertEqual(pool.get(3), 9)  # every reader of the pool reads the memory
+        self.ram.write(20, b"\x00\x00\x01\x02")  # object 5 starts at 16
+        self.assertEqual((pool.get(3), pool.get(100)), (9, 258))  # every reader reads there
         tx = loop.run(user.report(APID, ["Panel.speed", "Panel.mode"]))
         self.assertEqual(tx.reply["values"], {"Panel.speed": 2.5, "Panel.mode": 9})
-        tx = loop.run(user.report_definitions(APID, [2, 3]))
-        rows = [(d["kind"], d["memory"], d["address"]) for d in tx.reply["definitions"]]
-        self.assertEqual(rows, [("raw memory", 1, 4100), ("object memory", 1, 8)])
+        tx = loop.run(user.report_definitions(APID, [2, 3, 100]))
+        rows = [
+            (d["kind"], d["memory"], d["object"], d["address"]) for d in tx.reply["definitions"]
+        ]
+        self.assertEqual(
+            rows,
+            [("raw memory", 1, 0, 4100), ("object memory", 1, 0, 8), ("object memory", 1, 5, 4)],
+        )
 
     def test_bad_definitions_fail_the_start_and_change_nothing(self):
         loop, pool, user = make(memory_db(), {1: self.ram})
@@ -196,13 +217,22 @@ class TestDefinitions(unittest.TestCase):
             tx = loop.run(user.change_raw_definitions(APID, items))
             self.assertEqual((tx.failure["stage"], tx.failure["code"]), (2, code))
             self.assertEqual(tx.failure["data"], data)
+        cases = (
+            ([(2, 1, 9, 0)], FAILURE_UNKNOWN_ID, b"\x00\x01\x00\x09"),  # no object 9
+            ([(2, 1, 5, 5)], FAILURE_OUT_OF_BOUNDS, b"\x00\x01\x00\x05\x00\x00\x00\x05"),
+            ([(2, 1, 0, 61)], FAILURE_OUT_OF_BOUNDS, b"\x00\x01\x00\x00\x00\x00\x00\x3d"),
+        )
+        for items, code, data in cases:
+            tx = loop.run(user.change_object_definitions(APID, items))
+            self.assertEqual((tx.failure["stage"], tx.failure["code"]), (2, code))
+            self.assertEqual(tx.failure["data"], data)
         tx = loop.run(user.report_definitions(APID, [2]))
         self.assertEqual(tx.reply["definitions"][0]["kind"], "component")
 
     def test_definitions_persist(self):
         store = Store("/ctx", SimFs())
         loop, pool, user = make(memory_db(), {1: self.ram}, store)
-        self.assertTrue(loop.run(user.change_object_definitions(APID, [(2, 1, 12)])).ok)
+        self.assertTrue(loop.run(user.change_object_definitions(APID, [(2, 1, 0, 12)])).ok)
         self.ram.write(12, b"\x3f\x80\x00\x00")
         loop2, pool2, user2 = make(memory_db(), {1: self.ram}, store)
         self.assertEqual(pool2.get(2), 1.0)

@@ -58,13 +58,19 @@ CASES = (
     ),
     (
         OBJECT_DEFINITIONS,
-        _items(st.fixed_dictionaries({"id": U16, "memory": U16, "offset": U32})),
+        _items(st.fixed_dictionaries({"id": U16, "memory": U16, "object": U16, "offset": U32})),
     ),
     (
         DEFINITION_REPORT,
         _items(
             st.fixed_dictionaries(
-                {"id": U16, "kind": st.integers(0, 2), "memory": U16, "address": U32}
+                {
+                    "id": U16,
+                    "kind": st.integers(0, 2),
+                    "memory": U16,
+                    "object": U16,
+                    "address": U32,
+                }
             )
         ),
     ),

@@ -82,7 +82,7 @@ def scenario():
             s12.enable_functional_function(APID),
             s12.enable_functional(APID, [7]),
             s20.change_raw_definitions(APID, [("Panel.speed", 1, 4100)]),
-            s20.change_object_definitions(APID, [("Panel.mode", 1, 8)]),
+            s20.change_object_definitions(APID, [("Panel.mode", 1, 0, 8)]),
             s20.report_definitions(APID, [2, 3, 6]),
             s20.set(APID, {"Panel.heater": 30.0}),
         ):
@@ -138,7 +138,7 @@ def test_our_tcs_parse_in_both_peers_with_the_standard_layout():
         (12, 25): struct.pack(">HH", 1, 7),
         (12, 27): b"",
         (20, 4): struct.pack(">BHHI", 1, 2, 1, 4100),
-        (20, 5): struct.pack(">BHHI", 1, 3, 1, 8),
+        (20, 5): struct.pack(">BHHHI", 1, 3, 1, 0, 8),
         (20, 6): struct.pack(">BHHH", 3, 2, 3, 6),
         (20, 3): struct.pack(">BHH", 1, 6, 1600),  # 30 degC sent raw
     }
@@ -173,7 +173,9 @@ def test_functional_reports_decode_field_for_field():
 def test_definition_report_decodes_field_for_field():
     (report,) = tm_of(20, 7)
     assert sp(report) == pl(report)
-    assert sp(report) == struct.pack(">B" + "HBHI" * 3, 3, 2, 1, 1, 4100, 3, 2, 1, 8, 6, 0, 0, 0)
+    assert sp(report) == struct.pack(
+        ">B" + "HBHHI" * 3, 3, 2, 1, 1, 0, 4100, 3, 2, 1, 0, 8, 6, 0, 0, 0, 0
+    )
     assert POOL.get(6) == 1600
 
 

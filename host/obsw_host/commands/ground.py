@@ -9,7 +9,7 @@
     obsw ground hk listen --seconds 3       periodic reports as they come
     obsw ground params get SolarPanel.speed
     obsw ground params set SolarPanel.speed=7.5
-    obsw ground params definitions | define SolarPanel.speed 1 4096 [--object]
+    obsw ground params definitions | define SolarPanel.speed 1 4096 [--object ID]
     obsw ground events disabled | enable NAME.. | disable NAME.. | listen
     obsw ground time rate 0 | listen
     obsw ground connection 10
@@ -32,6 +32,9 @@
     obsw ground action list | enable EVENT | disable EVENT | delete EVENT
     obsw ground sequence load warmup "0 ping" "2 function SolarPanel.set_angle angle=10"
     obsw ground sequence status | content warmup | activate warmup | abort warmup | unload warmup
+    obsw ground memory dump|load|check|load-file|check-object|abort-dumps|scrub|protect ..
+    obsw ground store copy|diag ..   obsw ground sequence file|load-file ..
+    obsw ground position orbit N     (commands of services 6, 15, 21, 22: see their --help)
 
 A request to schedule, sequence or run as an action is ``ping``, ``function NAME
 [ARG=VALUE..]`` or ``set NAME=VALUE..``; activities are named SOURCE:APID:SEQ.
@@ -78,6 +81,10 @@ def add_parser(sub):
 
     obcp.add_to_ground(s)
     cfdp.add_parser(s)  # obsw ground cfdp put|get|status|serve
+    from obsw_host.commands import ground_memory, ground_services
+
+    ground_services.add_to_ground(s)  # obsw ground device|diag|functional|forward (2, 3, 14)
+    ground_memory.add_to_ground(s)  # obsw ground memory ..|store ..
 
     _add_operator(s)
     s.add_parser("ping", help="TC[17,1] are-you-alive").set_defaults(func=_ping)
@@ -112,6 +119,7 @@ def add_parser(sub):
     x = hk.add_parser("listen", help="print periodic reports")
     x.add_argument("--seconds", type=float, default=3.0)
     x.set_defaults(func=_listen, listen=(3, 25))
+    ground_services.add_to_hk(hk)  # obsw ground hk append
 
     pa = s.add_parser("params", help="service 20 parameters").add_subparsers(dest="params")
     pa.required = True
@@ -141,9 +149,9 @@ def add_parser(sub):
     x = ti.add_parser("rate", help="TC[9,1] report every 2**EXPONENT s")
     x.add_argument("exponent", type=int)
     x.set_defaults(func=_time_rate)
-    x = ti.add_parser("listen", help="print time reports")
+    x = ti.add_parser("listen", help="print time reports (CUC TM[9,2] or CDS TM[9,3])")
     x.add_argument("--seconds", type=float, default=3.0)
-    x.set_defaults(func=_listen, listen=(9, 2))
+    x.set_defaults(func=_listen, listen=(9, None))
 
 
 def _add_automation(s):
@@ -178,6 +186,10 @@ def _add_automation(s):
         x = sp.add_parser("delete", help="delete activities")
         x.add_argument("ids", nargs="+", metavar="SOURCE:APID:SEQ")
         x.set_defaults(func=_sched_delete, service=svc)
+        if svc == "position":
+            from obsw_host.commands import ground_memory
+
+            ground_memory.add_to_position(sp)  # obsw ground position orbit N
 
     mo = s.add_parser(
         "monitor",
@@ -227,6 +239,9 @@ def _add_automation(s):
     x.add_argument("steps", nargs="+")
     x.set_defaults(func=_sequence_load)
     se.add_parser("status").set_defaults(func=_sequence_status)
+    from obsw_host.commands import ground_memory
+
+    ground_memory.add_to_sequence(se)  # obsw ground sequence file|load-file
     for action in ("content", "activate", "abort", "unload"):
         x = se.add_parser(action)
         x.add_argument("name")
@@ -697,8 +712,10 @@ def _add_values_commands(s, params):
     x = params.add_parser("define", help="TC[20,4] place a parameter in a memory area")
     x.add_argument("name")
     x.add_argument("memory", type=int, help="memory ID (the database's memories)")
-    x.add_argument("address", type=int, help="absolute address (--object: offset)")
-    x.add_argument("--object", action="store_true", help="TC[20,5]: an offset in the area")
+    x.add_argument("address", type=int, help="absolute address (--object: offset in it)")
+    x.add_argument(
+        "--object", type=int, metavar="ID", help="TC[20,5]: in object ID (0: the whole area)"
+    )
     x.set_defaults(func=_params_define)
     fm = s.add_parser("fmon", help="service 12 functional monitoring").add_subparsers(dest="fm")
     fm.required = True
@@ -723,8 +740,11 @@ def _params_definitions(args):
 
 
 def _params_define(args):
-    item = (_key(args.name), args.memory, args.address)
-    return _run(args, lambda g: g.define_parameters([item], object_memory=args.object))
+    if args.object is None:
+        item = (_key(args.name), args.memory, args.address)
+    else:
+        item = (_key(args.name), args.memory, args.object, args.address)
+    return _run(args, lambda g: g.define_parameters([item], args.object is not None))
 
 
 def _fmon_add(args):

@@ -105,7 +105,7 @@ class Chain:
         doc["sdb"] = os.path.join(base, doc["sdb"])
         doc["state"] = self.state
         doc["processes"] = {
-            "core": ["pus", "cfdp", "obcp", "solar_panel"],
+            "core": ["pus", "cfdp", "obcp", "SolarPanel"],
             "can": ["spacecan"],
             "frames": ["frames"],
         }

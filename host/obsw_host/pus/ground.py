@@ -391,8 +391,8 @@ class Ground:
         return self._issue(self.params.report_definitions(self._apid(apid), keys), timeout)
 
     def define_parameters(self, items, object_memory=False, apid=None, timeout=None):
-        """TC[20,4] (absolute addresses) or TC[20,5] (``object_memory``: offsets):
-        ``items`` are (parameter, memory ID, address or offset)."""
+        """TC[20,4]: ``items`` are (parameter, memory ID, absolute address); or TC[20,5]
+        (``object_memory``): (parameter, memory ID, object ID, offset in the object)."""
         user = self.params
         fn = user.change_object_definitions if object_memory else user.change_raw_definitions
         return self._issue(fn(self._apid(apid), items), timeout)

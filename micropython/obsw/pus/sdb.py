@@ -24,7 +24,9 @@ equipment: name, node id, node definition file relative to the database file).
 
 ``filestores`` maps the path prefixes of file management (``SAT:/data/x``) to CFDP entity
 ids (the onboard one is the first, unless one says ``"local": true``); ``memories`` declares
-the memory areas service 6 may load, dump and check, by id, start address and size.
+the memory areas service 6 may load, dump and check, by id, start address and size, with
+their ``objects`` (id, name, offset, size: the object memory of service 6) and an optional
+``mirror`` file (a second copy written with the first, from which scrubbing repairs).
 
 A type is a name (``uint8`` .. ``uint64``, ``int8`` .. ``int64``, ``float32``, ``float64``,
 ``bool``, ``enum8``, ``enum16``, ``string`` for a 16-bit-length character string,
@@ -225,18 +227,45 @@ class FunctionDef:
 
 
 class OperationDef:
-    """An operation of a component: ``arguments`` are (name, unit) pairs (None: not given)."""
+    """An operation of a component: ``arguments`` are (name, unit) pairs (None: not given);
+    ``signature`` is its declared arguments as (name, type, unit), type None when not given,
+    or None when the database lists no ``arguments`` (any arguments then)."""
 
-    __slots__ = ("component", "name", "arguments")
+    __slots__ = ("component", "name", "arguments", "signature")
 
-    def __init__(self, component, name, arguments):
+    def __init__(self, component, name, arguments, signature=None):
         self.component = component
         self.name = name
         self.arguments = arguments
+        self.signature = signature
 
     @property
     def qualified(self):
         return "%s.%s" % (self.component, self.name)
+
+
+# -- operations: the activity signatures PLUTO procedures are checked against at load time
+
+
+def _operation(cname, op):
+    """An ``OperationDef`` from a component's ``operations`` entry: each argument is
+    ``{"name": n, "type": t, "unit": u}`` (type and unit optional; a type is checked here);
+    ``"arguments": []`` declares an operation that takes none."""
+    where = "operation %s.%s" % (cname, op["name"])
+    args = []
+    sig = []
+    seen = set()
+    for a in op.get("arguments", ()):
+        name = a["name"]
+        if name in seen:
+            raise SdbError("%s declares argument %s twice" % (where, name))
+        seen.add(name)
+        t = a.get("type")
+        if t is not None:
+            field_type(t, "%s, argument %s" % (where, name))
+        args.append((name, a.get("unit")))
+        sig.append((name, t, a.get("unit")))
+    return OperationDef(cname, op["name"], args, sig if "arguments" in op else None)
 
 
 class NodeDef:
@@ -321,10 +350,7 @@ class Sdb:
             for e in comp.get("events", []):
                 self._add_event(cname, e)
             for op in comp.get("operations", []):
-                args = [(a["name"], a.get("unit")) for a in op.get("arguments", ())]
-                self.operations["%s.%s" % (cname, op["name"])] = OperationDef(
-                    cname, op["name"], args
-                )
+                self.operations["%s.%s" % (cname, op["name"])] = _operation(cname, op)
         for p in doc.get("parameters", []):  # parameters of no component (process-local)
             self._add_parameter(
                 Parameter(
@@ -433,6 +459,8 @@ class Sdb:
                 "start": _int(m.get("start", 0), "start of memory %d" % mid),
                 "size": size,
                 "writable": bool(m.get("writable", False)),
+                "mirror": m.get("mirror"),
+                "objects": _memory_objects(m.get("objects", []), mid, size),
             }
 
     def filestore_entity(self, prefix):
@@ -549,3 +577,18 @@ def load(path):
         text = f.read()
     i = path.rfind("/")
     return loads(text, path[:i] if i > 0 else ("/" if i == 0 else ""))
+
+
+def _memory_objects(items, mid, size):
+    """The objects of memory ``mid`` (service 6 object memory): id -> (name, offset, size)."""
+    out = {}
+    for o in items:
+        oid = _int(o["id"], "object id in memory %d" % mid)
+        if oid == 0 or oid in out:
+            raise SdbError("object %d of memory %d: 0 or declared twice" % (oid, mid))
+        off = _int(o.get("offset", 0), "offset of object %d" % oid)
+        n = _int(o["size"], "size of object %d" % oid)
+        if n == 0 or off + n > size:
+            raise SdbError("object %d of memory %d outside its %d octets" % (oid, mid, size))
+        out[oid] = (o.get("name", "object%d" % oid), off, n)
+    return out

@@ -76,6 +76,10 @@ class FunctionalOnBoardMonitoring(OnBoardMonitoring):
     """The service 12 provider with functional monitoring (see the module text);
     ``fmon_capacity`` bounds the FMONs, ``max_pmons`` the PMONs of one."""
 
+    REPORTS = OnBoardMonitoring.REPORTS + (
+        TM_MON_FUNCTIONAL_MONITORING_REPORT,
+        TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT,
+    )
     HANDLERS = OnBoardMonitoring.HANDLERS + (
         (TC_MON_ENABLE_FUNCTIONAL_MONITORING_FUNCTION, "fmon_enable_function"),
         (TC_MON_DISABLE_FUNCTIONAL_MONITORING_FUNCTION, "fmon_disable_function"),

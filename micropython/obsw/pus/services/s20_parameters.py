@@ -13,12 +13,13 @@ asynchronously; a component's refusal fails the completion.
 Parameter definitions (TC[20,4] to TM[20,7]) say where a parameter's value lives. By default
 it is the component attribute the database names (definition kind 0). TC[20,4] redefines
 parameters as raw memory (memory ID and absolute address), TC[20,5] as object memory (memory
-ID and offset from the area's start), in the memory areas service 6 serves; the value is then
-the parameter's raw type encoded at that place, and every reader of the parameter pool
-(service 20, housekeeping, monitoring) reads it there. A definition naming an unknown
-parameter or memory fails the start with ``FAILURE_UNKNOWN_ID``; one that does not fit in its
-area with ``FAILURE_OUT_OF_BOUNDS`` (memory ID and address in the data); a parameter of
-variable size is refused. Definitions persist in the context store.
+ID, object ID and offset in the object; object 0 is the whole area), in the memory areas and
+objects service 6 serves; the value is then the parameter's raw type encoded at that place,
+and every reader of the parameter pool (service 20, housekeeping, monitoring) reads it there.
+A definition naming an unknown parameter, memory or object fails the start with
+``FAILURE_UNKNOWN_ID``; one that does not fit in its area or object with
+``FAILURE_OUT_OF_BOUNDS`` (memory ID and address, or memory ID, object ID and offset, in the
+data); a parameter of variable size is refused. Definitions persist in the context store.
 """
 
 from obsw.il.errors import CallTimeoutError, InteractionError, UnavailableError
@@ -60,10 +61,11 @@ IDS = Structure([("ids", Repeated(PARAMETER_COUNT, PARAMETER_ID))])
 # definition kinds in TM[20,7] (a mission choice: the standard reports either kind)
 DEFINITION_COMPONENT = 0  # the component attribute of the database
 DEFINITION_RAW_MEMORY = 1  # memory ID and absolute address
-DEFINITION_OBJECT_MEMORY = 2  # memory ID and offset from the area's start
+DEFINITION_OBJECT_MEMORY = 2  # memory ID, object ID and offset in the object
 DEFINITION_NAMES = {0: "component", 1: "raw memory", 2: "object memory"}
 
-MEMORY_ID = U16
+MEMORY_ID = U16  # as service 6 has them
+OBJECT_ID = U16
 ADDRESS = U32
 DEFINITION_KIND = E8
 RAW_DEFINITIONS = Structure(
@@ -82,7 +84,13 @@ OBJECT_DEFINITIONS = Structure(
         (
             "items",
             Repeated(
-                PARAMETER_COUNT, [("id", PARAMETER_ID), ("memory", MEMORY_ID), ("offset", ADDRESS)]
+                PARAMETER_COUNT,
+                [
+                    ("id", PARAMETER_ID),
+                    ("memory", MEMORY_ID),
+                    ("object", OBJECT_ID),
+                    ("offset", ADDRESS),
+                ],
             ),
         )
     ]
@@ -97,6 +105,7 @@ DEFINITION_REPORT = Structure(
                     ("id", PARAMETER_ID),
                     ("kind", DEFINITION_KIND),
                     ("memory", MEMORY_ID),
+                    ("object", OBJECT_ID),
                     ("address", ADDRESS),
                 ],
             ),
@@ -156,6 +165,7 @@ class ParameterManagement(Service):
 
     SERVICE = SERVICE_PARAMETER_MANAGEMENT
     NAME = "s20"
+    REPORTS = (TM_PARAM_VALUE_REPORT, TM_PARAM_DEFINITION_REPORT)
     HANDLERS = (
         (TC_PARAM_REPORT_VALUES, "report_values"),
         (TC_PARAM_SET_VALUES, "set_values"),
@@ -219,8 +229,9 @@ class ParameterManagement(Service):
 
     # -------------------------------------------------------------------------- definitions
 
-    def _definition(self, pid, memory, address):
-        """(kind-less) checked placement of ``pid`` at absolute ``address`` of ``memory``."""
+    def _locate(self, pid, kind, memory, obj, where):
+        """(parameter, area, offset in the area) of a checked definition: ``where`` is an
+        absolute address (raw memory) or an offset in object ``obj`` (object memory)."""
         p = self._known(pid)
         area = self.memories.get(memory)
         if area is None:
@@ -232,35 +243,54 @@ class ParameterManagement(Service):
                 "%s has no fixed octet size to place in memory" % p.qualified,
                 PARAMETER_ID.pack(pid),
             )
-        if address < area.start or address + (bits >> 3) > area.start + area.size:
+        n = bits >> 3
+        if kind == DEFINITION_RAW_MEMORY:
+            if where < area.start or where + n > area.start + area.size:
+                raise PusFailure(
+                    FAILURE_OUT_OF_BOUNDS,
+                    "%s at %d does not fit in memory %d" % (p.qualified, where, memory),
+                    MEMORY_ID.pack(memory) + ADDRESS.pack(where),
+                )
+            return p, area, where - area.start
+        base, size = 0, area.size
+        if obj:
+            o = getattr(area, "objects", {}).get(obj)
+            if o is None:
+                raise PusFailure(
+                    FAILURE_UNKNOWN_ID,
+                    "memory %d has no object %d" % (memory, obj),
+                    MEMORY_ID.pack(memory) + OBJECT_ID.pack(obj),
+                )
+            base, size = o[1], o[2]
+        if where + n > size:
             raise PusFailure(
                 FAILURE_OUT_OF_BOUNDS,
-                "%s at %d does not fit in memory %d" % (p.qualified, address, memory),
-                MEMORY_ID.pack(memory) + ADDRESS.pack(address),
+                "%s at %d does not fit in object %d of memory %d"
+                % (p.qualified, where, obj, memory),
+                MEMORY_ID.pack(memory) + OBJECT_ID.pack(obj) + ADDRESS.pack(where),
             )
-        return p, area
+        return p, area, base + where
 
     def _change(self, req, layout, kind):
         items = req.decode(layout)["items"]
         placed = []
         for i in items:
-            memory = i["memory"]
-            area = self.memories.get(memory)
-            address = i["address"] if kind == DEFINITION_RAW_MEMORY else None
-            if address is None:
-                address = i["offset"] + (area.start if area is not None else 0)
-            self._definition(i["id"], memory, address)
-            placed.append((i["id"], memory, address))
+            if kind == DEFINITION_RAW_MEMORY:
+                d = (i["id"], kind, i["memory"], 0, i["address"])
+            else:
+                d = (i["id"], kind, i["memory"], i["object"], i["offset"])
+            self._locate(*d)
+            placed.append(d)
         req.start()
-        for pid, memory, address in placed:
-            self._place(pid, kind, memory, address)
+        for d in placed:
+            self._place(*d)
         self.persist()
 
-    def _place(self, pid, kind, memory, address):
-        p, area = self._definition(pid, memory, address)
-        cell = _InMemory(area, address - area.start, p.type)
+    def _place(self, pid, kind, memory, obj, where):
+        p, area, offset = self._locate(pid, kind, memory, obj, where)
+        cell = _InMemory(area, offset, p.type)
         self.pool.provide(pid, cell.get, cell.set)
-        self.definitions[pid] = (kind, memory, address)
+        self.definitions[pid] = (kind, memory, obj, where)
 
     def change_raw_definitions(self, req):
         self._change(req, RAW_DEFINITIONS, DEFINITION_RAW_MEMORY)
@@ -277,10 +307,9 @@ class ParameterManagement(Service):
         req.start()
         items = []
         for pid in ids:
-            kind, memory, address = self.definitions.get(pid, (DEFINITION_COMPONENT, 0, 0))
-            if kind == DEFINITION_OBJECT_MEMORY:
-                address -= self.memories[memory].start
-            items.append({"id": pid, "kind": kind, "memory": memory, "address": address})
+            kind, memory, obj, where = self.definitions.get(pid, (DEFINITION_COMPONENT, 0, 0, 0))
+            row = {"id": pid, "kind": kind, "memory": memory, "object": obj, "address": where}
+            items.append(row)
         req.report(TM_PARAM_DEFINITION_REPORT, DEFINITION_REPORT.pack({"items": items}))
 
     def use_memories(self, areas):
@@ -291,12 +320,12 @@ class ParameterManagement(Service):
 
     def _apply_pending(self):
         left = []
-        for pid, kind, memory, address in self._pending:
-            if memory not in self.memories:
-                left.append((pid, kind, memory, address))
+        for d in self._pending:
+            if d[2] not in self.memories:
+                left.append(d)
                 continue
             try:
-                self._place(pid, kind, memory, address)
+                self._place(*d)
             except PusFailure:  # the database changed under a saved definition: drop it
                 if self.app is not None:
                     self.app.count("context_rejected")
@@ -357,21 +386,18 @@ class ParameterUser(ServiceUser):
         data = self.layout.pack({"items": self.raw_items(values, raw)})
         return self.request(apid, TC_PARAM_SET_VALUES, data)
 
-    def _definitions(self, message_type, layout, key, apid, items):
-        rows = [{"id": self._id(k), "memory": m, key: a} for k, m, a in items]
-        return self.request(apid, message_type, layout.pack({"items": rows}))
-
     def change_raw_definitions(self, apid, items):
         """TC[20,4]: ``items`` are (parameter, memory ID, absolute address)."""
-        return self._definitions(
-            TC_PARAM_CHANGE_RAW_MEMORY_DEFINITIONS, RAW_DEFINITIONS, "address", apid, items
-        )
+        rows = [{"id": self._id(k), "memory": m, "address": a} for k, m, a in items]
+        data = RAW_DEFINITIONS.pack({"items": rows})
+        return self.request(apid, TC_PARAM_CHANGE_RAW_MEMORY_DEFINITIONS, data)
 
     def change_object_definitions(self, apid, items):
-        """TC[20,5]: ``items`` are (parameter, memory ID, offset from the area's start)."""
-        return self._definitions(
-            TC_PARAM_CHANGE_OBJECT_MEMORY_DEFINITIONS, OBJECT_DEFINITIONS, "offset", apid, items
-        )
+        """TC[20,5]: ``items`` are (parameter, memory ID, object ID, offset in the object;
+        object 0: the whole area)."""
+        rows = [{"id": self._id(k), "memory": m, "object": o, "offset": a} for k, m, o, a in items]
+        data = OBJECT_DEFINITIONS.pack({"items": rows})
+        return self.request(apid, TC_PARAM_CHANGE_OBJECT_MEMORY_DEFINITIONS, data)
 
     def report_definitions(self, apid, keys=()):
         """TC[20,6] (no keys: every parameter); the reply is TM[20,7]."""

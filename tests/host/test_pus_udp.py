@@ -4,6 +4,8 @@ import argparse
 import json
 
 import pytest
+from obsw.pus.messages import FAILURE_OUT_OF_RANGE
+from obsw.pus.services.s20_parameters import RangeError
 from obsw.store import Store
 from obsw_host.commands import ground as ground_command
 from obsw_host.ports import app_port
@@ -59,8 +61,12 @@ def test_housekeeping_and_parameters(system):
     tx = ground.get_parameters("SolarPanel.speed", "pus.tc_received")
     assert tx.reply["values"]["SolarPanel.speed"] == 7.5
     assert tx.reply["values"]["pus.tc_received"] == 3  # this request included
-    tx = ground.set_parameter("SolarPanel.speed", 50.0)  # the panel refuses
-    assert tx.failure["stage"] == 4 and not tx.ok
+    with pytest.raises(RangeError):  # the database's range [0.1, 20]: refused on the ground
+        ground.set_parameter("SolarPanel.speed", 50.0)
+    data = ground.params.layout.pack({"items": [{"id": 2, "value": 50.0}]})
+    tx = ground.wait(ground.send(ground.apid, 20, 3, data))  # and on board, if sent anyway
+    assert (tx.failure["stage"], tx.failure["code"]) == (2, FAILURE_OUT_OF_RANGE)
+    assert panel.speed == 7.5
     tx = ground.set_parameter("SolarPanel.angle", 1.0)  # read-only
     assert tx.failure["stage"] == 2
 

@@ -9,6 +9,7 @@
     obsw ground hk listen --seconds 3       periodic reports as they come
     obsw ground params get SolarPanel.speed
     obsw ground params set SolarPanel.speed=7.5
+    obsw ground params definitions | define SolarPanel.speed 1 4096 [--object ID]
     obsw ground events disabled | enable NAME.. | disable NAME.. | listen
     obsw ground time rate 0 | listen
     obsw ground connection 10
@@ -24,6 +25,9 @@
     obsw ground list obcps | files [REPOSITORY]         from the on-board process
     obsw ground monitor add 1 SolarPanel.speed 0.5 10 --high-event monitoring.speed_high
     obsw ground monitor list | out-of-limits | enable 1 | disable 1 | delete 1
+    obsw ground fmon add 7 1 2 --failing 1 --event monitoring.speed_high
+    obsw ground fmon list | status | enable 7 | disable 7 | protect 7 | unprotect 7 | delete 7
+    obsw ground fmon enable-function | disable-function
     obsw ground action add monitoring.speed_high set SolarPanel.speed=5
     obsw ground action list | enable EVENT | disable EVENT | delete EVENT
     obsw ground sequence load warmup "0 ping" "2 function SolarPanel.set_angle angle=10"
@@ -39,6 +43,10 @@ Every ground client receives all TM the on-board process sends (events, verifica
 housekeeping), whichever client's TC caused it. ``--log FILE`` appends every TC and TM of the
 command (raw and decoded) to a session log. ``--json`` prints one JSON object per command (per
 packet for ``monitor``) instead of text; ``-v`` shows every packet.
+
+Parameter values are engineering values (calibrated, with their unit, or an enumeration's
+label; limits of ``monitor add`` too); ``--raw`` shows and takes raw values instead. A value
+outside a parameter's range is refused before anything is sent. ``--json`` carries raw values.
 """
 
 import argparse
@@ -65,6 +73,9 @@ def add_parser(sub):
     p.add_argument("--json", action="store_true", help="print JSON for scripts")
     p.add_argument("-v", "--verbose", action="store_true", help="print every packet")
     p.add_argument("--log", metavar="FILE", help="append every TC and TM to this session log")
+    p.add_argument(
+        "--raw", action="store_true", help="raw parameter values (default: engineering values)"
+    )
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
     from obsw_host.commands import cfdp, obcp
@@ -119,6 +130,7 @@ def add_parser(sub):
     x = pa.add_parser("set", help="TC[20,3] set values")
     x.add_argument("assignments", nargs="+", metavar="NAME=VALUE")
     x.set_defaults(func=_params_set)
+    _add_values_commands(s, pa)
 
     ev = s.add_parser("events", help="service 5 events").add_subparsers(dest="events")
     ev.required = True
@@ -301,7 +313,7 @@ def _monitor_live(args):
 
     seen = [0]
     with _ground(args) as g:
-        display = Display(g.sdb, _colour(args))
+        display = Display(g.sdb, _colour(args), getattr(args, "raw", False))
 
         def show(tm, decoded, tx):
             seen[0] += 1
@@ -379,7 +391,7 @@ def _run(args, fn):
             line = "%s (%s)" % (line.split(" data ")[0], detail)
         print("  " + line)
     for reply in tx.replies:
-        print(text.readable(reply, sdb))
+        print(text.readable(reply, sdb, getattr(args, "raw", False)))
     if not tx.done:
         print(_no_answer(args, tx, target))
     return 0 if tx.ok else 1
@@ -449,7 +461,7 @@ def _params_set(args):
         if not sep:
             raise UserError("parameter assignment %r" % a, expected="NAME=VALUE")
         values[_key(name)] = _value(value)
-    return _run(args, lambda g: g.set_parameters(values))
+    return _run(args, lambda g: g.set_parameters(values, raw=args.raw))
 
 
 def _events_disabled(args):
@@ -477,7 +489,7 @@ def _listen(args):
     service, subtype = args.listen
     n = 0
     with _ground(args) as g:
-        display = Display(g.sdb)
+        display = Display(g.sdb, raw=getattr(args, "raw", False))
         g.subscribe()
         print(
             "listening for TM[%s,%s] from %s:%d for %gs"
@@ -635,6 +647,7 @@ def _monitor_add(args):
             _key(args.high_event),
             repetitions=args.repetitions,
             interval=args.interval,
+            raw=args.raw,
         )
 
     return _run(args, go)
@@ -697,3 +710,65 @@ def _sequence_named(args):
         "unload": "unload_sequence",
     }[args.what]
     return _run(args, lambda g: getattr(g, method)(args.name))
+
+
+# ------------------------------------- parameter definitions (20), functional monitoring (12)
+
+
+def _add_values_commands(s, params):
+    x = params.add_parser("definitions", help="TC[20,6] where parameters live (all if none)")
+    x.add_argument("names", nargs="*")
+    x.set_defaults(func=_params_definitions)
+    x = params.add_parser("define", help="TC[20,4] place a parameter in a memory area")
+    x.add_argument("name")
+    x.add_argument("memory", type=int, help="memory ID (the database's memories)")
+    x.add_argument("address", type=int, help="absolute address (--object: offset in it)")
+    x.add_argument(
+        "--object", type=int, metavar="ID", help="TC[20,5]: in object ID (0: the whole area)"
+    )
+    x.set_defaults(func=_params_define)
+    fm = s.add_parser("fmon", help="service 12 functional monitoring").add_subparsers(dest="fm")
+    fm.required = True
+    x = fm.add_parser("add", help="TC[12,23] an FMON over PMONs (disabled)")
+    x.add_argument("fmon", type=int)
+    x.add_argument("pmons", type=int, nargs="+")
+    x.add_argument("--failing", type=int, default=1, help="minimum failing PMONs")
+    x.add_argument("--event", default="0", help="event raised when it fails")
+    x.set_defaults(func=_fmon_add)
+    fm.add_parser("list", help="TC[12,25]").set_defaults(func=_fmon_report, what="list")
+    fm.add_parser("status", help="TC[12,27]").set_defaults(func=_fmon_report, what="status")
+    for action in ("enable-function", "disable-function"):
+        fm.add_parser(action).set_defaults(func=_fmon_action, what=action)
+    for action in ("enable", "disable", "protect", "unprotect", "delete"):
+        x = fm.add_parser(action)
+        x.add_argument("ids", type=int, nargs="+")
+        x.set_defaults(func=_fmon_action, what=action)
+
+
+def _params_definitions(args):
+    return _run(args, lambda g: g.parameter_definitions([_key(n) for n in args.names]))
+
+
+def _params_define(args):
+    if args.object is None:
+        item = (_key(args.name), args.memory, args.address)
+    else:
+        item = (_key(args.name), args.memory, args.object, args.address)
+    return _run(args, lambda g: g.define_parameters([item], args.object is not None))
+
+
+def _fmon_add(args):
+    return _run(
+        args,
+        lambda g: g.add_functional_monitor(args.fmon, args.pmons, args.failing, _key(args.event)),
+    )
+
+
+def _fmon_report(args):
+    if args.what == "list":
+        return _run(args, lambda g: g.functional_monitors())
+    return _run(args, lambda g: g.functional_status())
+
+
+def _fmon_action(args):
+    return _run(args, lambda g: g.functional_request(args.what, getattr(args, "ids", ())))

@@ -31,7 +31,8 @@ from obsw.pus.services.s05_events import EventUser
 from obsw.pus.services.s08_functions import FunctionUser, functions
 from obsw.pus.services.s09_time import TimeUser
 from obsw.pus.services.s11_scheduling import TimeSchedulingUser
-from obsw.pus.services.s12_user import OnBoardMonitoringUser, limit_check
+from obsw.pus.services.s12_functional_user import FunctionalMonitoringUser, functional_check
+from obsw.pus.services.s12_user import limit_check
 from obsw.pus.services.s17_test import ServiceTestUser
 from obsw.pus.services.s19_event_action import EventActionUser
 from obsw.pus.services.s20_parameters import ParameterUser
@@ -108,9 +109,9 @@ class Ground:
             ids = lambda key: sdb.parameter(key).id  # noqa: E731
             self.hk = reg(HousekeepingUser(types, names, sdb.housekeeping))
             self.events = reg(EventUser(sdb.event))
-            self.params = reg(ParameterUser(types, names, ids))
+            self.params = reg(ParameterUser(types, names, ids, sdb.parameter))
             self.functions = reg(FunctionUser(functions(sdb)))
-            self.monitoring = reg(OnBoardMonitoringUser(types, ids))
+            self.monitoring = reg(FunctionalMonitoringUser(types, ids))
         else:
             self.hk = self.events = self.params = self.functions = self.monitoring = None
 
@@ -229,12 +230,14 @@ class Ground:
         """TC[20,1]; ``tx.reply['values']`` maps names to values."""
         return self._issue(self.params.report(self._apid(apid), keys), timeout)
 
-    def set_parameter(self, key, value, apid=None, timeout=None):
+    def set_parameter(self, key, value, apid=None, timeout=None, raw=False):
         """TC[20,3] for one parameter (name or ID)."""
-        return self.set_parameters({key: value}, apid, timeout)
+        return self.set_parameters({key: value}, apid, timeout, raw)
 
-    def set_parameters(self, values, apid=None, timeout=None):
-        return self._issue(self.params.set(self._apid(apid), values), timeout)
+    def set_parameters(self, values, apid=None, timeout=None, raw=False):
+        """TC[20,3]: engineering values (labels, calibrated numbers; ``raw``: raw values),
+        refused here (``RangeError``) when outside a parameter's range."""
+        return self._issue(self.params.set(self._apid(apid), values, raw), timeout)
 
     def _event_ids(self, keys):
         return [self.sdb.event(k).id for k in keys]
@@ -266,7 +269,7 @@ class Ground:
 
     def parameter_request(self, values, apid=None):
         """A TC[20,3] for on-board use (see ``request``)."""
-        items = [{"id": self.sdb.parameter(k).id, "value": v} for k, v in values.items()]
+        items = self.params.raw_items(values)
         return self.request(20, 3, self.params.layout.pack({"items": items}), apid)
 
     def perform(self, key, apid=None, timeout=None, **arguments):
@@ -328,18 +331,17 @@ class Ground:
         high_event=0,
         apid=None,
         timeout=None,
+        raw=False,
         **options,
     ):
-        """TC[12,5] for one limit check (events by name or ID; 0: none), then TC[12,1]."""
-        d = limit_check(
-            pmon,
-            parameter,
-            low,
-            high,
-            self._event_id(low_event),
-            self._event_id(high_event),
-            **options,
-        )
+        """TC[12,5] for one limit check (events by name or ID; 0: none), then TC[12,1].
+        ``low`` and ``high`` are engineering values (``raw``: raw ones), sent as raw limits
+        (``obsw.pus.calibration.Values.raw_limits``)."""
+        low_event, high_event = self._event_id(low_event), self._event_id(high_event)
+        low, high, swapped = self.sdb.parameter(parameter).raw_limits(low, high, raw)
+        if swapped:  # a falling calibration: the low raw limit is the high engineering one
+            low_event, high_event = high_event, low_event
+        d = limit_check(pmon, parameter, low, high, low_event, high_event, **options)
         tx = self._issue(self.monitoring.add(self._apid(apid), [d]), timeout)
         if not tx.ok:
             return tx
@@ -365,6 +367,46 @@ class Ground:
     def out_of_limits(self, apid=None, timeout=None):
         """TC[12,10]; ``tx.reply['items']`` are the parameters now out of limits."""
         return self._issue(self.monitoring.report_out_of_limits(self._apid(apid)), timeout)
+
+    # -------------------------------------------------------------------------- functional
+
+    def add_functional_monitor(self, fmon, pmons, failing=1, event=0, apid=None, timeout=None):
+        """TC[12,23]: FMON ``fmon`` fails when ``failing`` of ``pmons`` are out of limits and
+        raises ``event`` (name or ID); new FMONs are disabled."""
+        d = functional_check(fmon, pmons, failing, self._event_id(event))
+        return self._issue(self.monitoring.add_functional(self._apid(apid), [d]), timeout)
+
+    def functional_monitors(self, apid=None, timeout=None, ids=()):
+        """TC[12,25]; ``tx.reply['functional']`` are the FMON definitions (all if no ids)."""
+        return self._issue(self.monitoring.report_functional(self._apid(apid), ids), timeout)
+
+    def functional_status(self, apid=None, timeout=None):
+        """TC[12,27]; ``tx.reply['functional']`` gives each FMON's statuses."""
+        return self._issue(self.monitoring.report_functional_status(self._apid(apid)), timeout)
+
+    def functional_request(self, action, ids=(), apid=None, timeout=None):
+        """TC[12,17]-[12,24] by name: enable-function, disable-function (no IDs), enable,
+        disable, protect, unprotect, delete (FMON IDs)."""
+        user = self.monitoring
+        a = self._apid(apid)
+        if action in ("enable-function", "disable-function"):
+            fn = getattr(user, action.replace("-function", "") + "_functional_function")
+            return self._issue(fn(a), timeout)
+        fn = getattr(user, action + "_functional", None)
+        if fn is None or action in ("add", "report"):
+            raise ValueError("functional monitoring action %r unknown" % action)
+        return self._issue(fn(a, list(ids)), timeout)
+
+    def parameter_definitions(self, keys=(), apid=None, timeout=None):
+        """TC[20,6]; ``tx.reply['definitions']`` says where each parameter lives."""
+        return self._issue(self.params.report_definitions(self._apid(apid), keys), timeout)
+
+    def define_parameters(self, items, object_memory=False, apid=None, timeout=None):
+        """TC[20,4]: ``items`` are (parameter, memory ID, absolute address); or TC[20,5]
+        (``object_memory``): (parameter, memory ID, object ID, offset in the object)."""
+        user = self.params
+        fn = user.change_object_definitions if object_memory else user.change_raw_definitions
+        return self._issue(fn(self._apid(apid), items), timeout)
 
     def _event_id(self, key):
         return key if isinstance(key, int) else self.sdb.event(key).id

@@ -33,7 +33,7 @@ from obsw.pus.services.s06_memory import MemoryManagement, areas_from_sdb
 from obsw.pus.services.s08_functions import FunctionManagement, functions
 from obsw.pus.services.s09_time import TimeManagement
 from obsw.pus.services.s11_scheduling import TimeScheduling
-from obsw.pus.services.s12_monitoring import OnBoardMonitoring
+from obsw.pus.services.s12_functional import FunctionalOnBoardMonitoring
 from obsw.pus.services.s13_large_packets import LargePacketTransfer
 from obsw.pus.services.s14_forwarding import ForwardingControl
 from obsw.pus.services.s15_storage import Storage
@@ -98,7 +98,7 @@ SERVICES = (
     (20, (), lambda c: ParameterManagement(c.pool)),
     (8, (), lambda c: FunctionManagement(functions(c.sdb), c.node)),
     (11, (), lambda c: TimeScheduling()),
-    (12, (), lambda c: OnBoardMonitoring(c.pool, c.sdb.events)),
+    (12, (), lambda c: FunctionalOnBoardMonitoring(c.pool, c.sdb.events)),  # types 1-28
     (19, (), lambda c: EventAction(known=c.sdb.events)),
     (21, (), lambda c: RequestSequencing()),
     (22, ("position",), lambda c: PositionScheduling(c.pool, c.position.qualified)),
@@ -230,6 +230,9 @@ class Onboard:
                 continue
             if all(getattr(context, n, None) is not None for n in needs):
                 self.app.register(build(context))
+        memory, parameters = self.app.services.get(6), self.app.services.get(20)
+        if memory is not None and parameters is not None:
+            parameters.use_memories(memory.areas)  # service 20 places parameters in them
 
     def _own_parameters(self):
         counters = self.app.counters

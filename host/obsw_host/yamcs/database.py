@@ -33,6 +33,7 @@ class Param:
         self.range = extra.get("range")
         self.limits = extra.get("limits")
         self.calibration = extra.get("calibration")
+        self.labels = extra.get("labels")  # {raw value: label} of an enumeration, or None
         self.description = extra.get("description")
 
 
@@ -117,6 +118,7 @@ def from_sdb(db, ids):
             "range": p.range,
             "limits": p.limits,
             "calibration": p.calibration,
+            "labels": p.labels,
             "description": p.description,
         }
         params[pid] = Param(pid, p.qualified, _pair(p.type_spec), p.unit, p.writable, extra)

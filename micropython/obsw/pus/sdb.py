@@ -84,10 +84,13 @@ def field_type(spec, where="type"):
 
 
 class Parameter:
-    """An attribute of a component as a PUS parameter. ``extras`` are the optional entries for
-    mission control, kept as given: ``range`` ([low, high] a set may use), ``limits``
-    (``{"warning": [low, high], "critical": [low, high]}``), ``calibration``
-    (``{"polynomial": [c0, c1, ..]}`` or ``{"spline": [[raw, eng], ..]}``), ``description``."""
+    """An attribute of a component as a PUS parameter. ``type`` is the raw value (what packets
+    carry); ``unit`` the engineering unit, ``raw_unit`` the raw one. ``extras`` are the optional
+    entries, kept as given and checked by ``obsw.pus.calibration``: ``range`` ([low, high] a set
+    may use, engineering units), ``limits`` (``{"warning": [low, high], "critical": [low,
+    high]}``, engineering units), ``calibration`` (``{"polynomial": [c0, c1, ..]}`` or
+    ``{"spline": [[raw, eng], ..]}``), ``enumeration`` (labels of raw values),
+    ``description``. ``values`` converts raw <-> engineering."""
 
     def __init__(
         self, id, component, name, type_spec, unit=None, writable=False, default=None, extras=None
@@ -104,7 +107,38 @@ class Parameter:
         self.range = extras.get("range")
         self.limits = extras.get("limits")
         self.calibration = extras.get("calibration")
+        self.raw_unit = extras.get("raw_unit")
         self.description = extras.get("description")
+        self.values = None  # obsw.pus.calibration.Values, for an entry that has any of them
+        for key in _VALUE_ENTRIES:
+            if extras.get(key) is not None:
+                self.values = _values(self.type, extras, "parameter " + self.qualified)
+                break
+
+    @property
+    def labels(self):
+        """{raw value: label} of an enumeration, or None."""
+        return None if self.values is None else self.values.labels
+
+    def engineering(self, raw):
+        """The engineering value of raw value ``raw`` (a label for an enumeration)."""
+        return raw if self.values is None else self.values.engineering(raw)
+
+    def to_raw(self, eng):
+        """The raw value of an engineering value or label (CalibrationError if none)."""
+        return eng if self.values is None else self.values.to_raw(eng)
+
+    def out_of_range(self, raw):
+        """None if raw value ``raw`` is within the parameter's range, else why not."""
+        return None if self.values is None else self.values.out_of_range(raw)
+
+    def raw_limits(self, low, high, raw=False):
+        """(raw low, raw high, swapped) of a limit check from engineering limits (``raw``:
+        raw limits, checked against the type); see ``obsw.pus.calibration.Values``."""
+        values = self.values if self.values is not None else _values(self.type, {}, "")
+        if raw:
+            return values.raw_limits_of(low, high) + (False,)
+        return values.raw_limits(low, high)
 
     @property
     def qualified(self):
@@ -112,6 +146,20 @@ class Parameter:
 
     def __repr__(self):
         return "Parameter(%d, %s, %s)" % (self.id, self.qualified, self.type.name)
+
+
+_VALUE_ENTRIES = ("calibration", "enumeration", "range", "limits")
+
+
+def _values(ftype, extras, what):
+    # imported here, not at the top: a database with no calibration, label, range or limits
+    # (a small board's) does not pay the module's heap
+    from obsw.pus.calibration import CalibrationError, Values
+
+    try:
+        return Values(ftype, extras, what)
+    except CalibrationError as e:
+        raise SdbError(str(e)) from None
 
 
 class EventDef:

@@ -34,7 +34,7 @@ PERIOD = 0.01  # the OBC's activity loop cycle in the benchmark
 
 def bench_sdb(structures, folder):
     """The sample database with ``structures`` HK structures reported every cycle."""
-    from obsw_host.pus.demo import SDB_PATH
+    from obsw_host.sample import SDB_PATH
 
     with open(SDB_PATH) as f:
         doc = json.load(f)

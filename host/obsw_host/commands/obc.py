@@ -1,10 +1,13 @@
-"""`obsw obc serve [CONFIG]`: the onboard computer of a mission configuration file.
+"""`obsw obc serve [MISSION]`: the onboard computer of a mission folder (or its mission file).
 
-Without CONFIG it runs the sample spacecraft: every PUS service (1-23) on UDP 5010, the CFDP
-entity on 5100, the OBCP engine, the SpaceCAN master with the CPDU nodes (simulated on
-virtual buses), and the sample solar panel, in processes started and watched by the platform
-manager. `--process NAME` runs one process of the configuration (what the platform manager
-starts); `obsw obc config [CONFIG]` prints the configuration as the OBC understands it.
+MISSION is a mission folder or its file; without it, $OBSW_MISSION or a mission.json in the
+working folder or above (the sample is `examples/sample`). The whole folder is checked first
+(`obsw mission check`): a mistake stops the start with one line per problem, exit status 2,
+before any process starts. Then every PUS service on its UDP port, the CFDP entity, the OBCP
+engine, the SpaceCAN master and the mission's components run in the processes the mission
+file names, started and watched by the platform manager. `--process NAME` runs one process of
+the mission (what the platform manager starts); `obsw obc config [MISSION]` prints the
+configuration as the OBC understands it.
 """
 
 import argparse
@@ -22,12 +25,14 @@ def add_parser(sub):
     add_serve_arguments(x)
     x.set_defaults(func=serve)
     c = s.add_parser("config", help="print the mission configuration as understood")
-    c.add_argument("config", nargs="?", help="mission configuration JSON (default: the sample)")
+    c.add_argument("config", nargs="?", help="mission folder or file (default: $OBSW_MISSION, "
+                   "or a mission.json here or above)")  # fmt: skip
     c.set_defaults(func=show)
 
 
 def add_serve_arguments(x):
-    x.add_argument("config", nargs="?", help="mission configuration JSON (default: the sample)")
+    x.add_argument("config", nargs="?", help="mission folder or file (default: $OBSW_MISSION, "
+                   "or a mission.json here or above)")  # fmt: skip
     x.add_argument("--state", help="folder for context, files and packet stores (default: the "
                    "configuration's 'state', or a folder under the temp directory)")  # fmt: skip
     x.add_argument("--il-dir", help="interaction layer name directory (default STATE/il)")
@@ -36,10 +41,13 @@ def add_serve_arguments(x):
     x.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
-def load(args):
+def load(args, checked=False):
+    """The mission configuration of ``args``; with ``checked`` the whole folder is checked
+    first (``MissionError`` lists every problem)."""
+    from obsw_host import mission
     from obsw_host.obc.config import load as load_config
 
-    config = load_config(args.config)
+    config = mission.load(args.config).config if checked else load_config(args.config)
     if getattr(args, "state", None):
         config.state = os.path.abspath(args.state)
         config.il_directory = os.path.join(config.state, "il")
@@ -54,6 +62,8 @@ def load(args):
 
 
 def serve(args):
+    from obsw_host.errors import UserError
+    from obsw_host.mission import MissionError
     from obsw_host.obc.config import ConfigError
 
     def out(text):
@@ -61,7 +71,7 @@ def serve(args):
             print(text, file=sys.stderr, flush=True)
 
     try:
-        config = load(args)
+        config = load(args, checked=not args.process)  # the platform manager checks, once
         if args.process:
             from obsw_host.obc.assembly import ObcProcess
 
@@ -72,7 +82,11 @@ def serve(args):
             out("%s: processes %s, state in %s (Ctrl-C stops)" % (
                 config.name, ", ".join(config.processes), config.state))  # fmt: skip
             PlatformManager(config, out=out).serve()
-    except (ConfigError, KeyError) as e:
+    except MissionError as e:
+        for problem in e.problems:  # one line each: FILE: $.path: what; expected ...
+            print(problem, file=sys.stderr)
+        return 2
+    except (ConfigError, UserError, KeyError) as e:
         print("obsw obc: %s" % e, file=sys.stderr)
         return 2
     except KeyboardInterrupt:
@@ -81,11 +95,12 @@ def serve(args):
 
 
 def show(args):
+    from obsw_host.errors import UserError
     from obsw_host.obc.config import ConfigError
 
     try:
         config = load(args)
-    except ConfigError as e:
+    except (ConfigError, UserError) as e:
         print("obsw obc: %s" % e, file=sys.stderr)
         return 2
     print(json.dumps({

@@ -61,7 +61,7 @@ class ObcProcess:
         self.units = []
         if "pus" in kinds:
             self.units.append(("pus", PusUnit(config, self.sdb, kinds, out)))
-        elif "solar_panel" in kinds:
+        elif config.plugins(kinds):
             self.units.append(("components", ComponentUnit(config, kinds, out)))
         if "spacecan" in kinds:
             self.units.append(("spacecan", SpaceCanUnit(config, out)))

@@ -1,131 +1,18 @@
-"""The mission configuration: one JSON file that says what the onboard computer runs.
+"""The mission configuration as the OBC processes read it (kept here for its importers; the
+mission folder, its checks and its defaults live in ``obsw_host.mission``)."""
 
-Every path in it is relative to the file. Top level:
-
-- ``name``: the spacecraft's name; ``sdb``: the spacecraft database; ``host``: the address
-  every UDP service binds (default loopback, ``obsw_host.net.DEFAULT_HOST``); ``state``: the
-  folder for the context store, the onboard filestore and the packet stores;
-  ``il_directory``: the interaction layer's name directory (default: a folder under ``state``).
-- ``processes``: process name -> list of component kinds it runs (``pus``, ``cfdp``,
-  ``obcp``, ``spacecan``, ``frames``, ``solar_panel``); one process or several. ``cfdp`` and
-  ``obcp`` run with ``pus`` (services 23 and 18 use them directly).
-- one section per component kind with its options (``pus``, ``cfdp``, ``obcp``, ``spacecan``,
-  ``frames``), and ``platform`` for the platform manager (heartbeat period, restart deadline,
-  failures allowed in a window before the OBC asks to be power-cycled).
-
-``load(path)`` returns a ``MissionConfig``; anything wrong raises ``ConfigError`` naming the
-key and what was expected.
-"""
-
-import json
-import os
-
-from obsw_host.net import DEFAULT_HOST
-
-KINDS = ("pus", "cfdp", "obcp", "spacecan", "frames", "solar_panel")
-WITH_PUS = ("cfdp", "obcp")
-SAMPLE = os.path.join(os.path.dirname(__file__), "data", "spacecraft.json")
-
-_PLATFORM = {
-    "heartbeat": 0.5,  # seconds between heartbeats
-    "deadline": 3.0,  # a component silent this long is hung: killed and restarted
-    "start_timeout": 20.0,  # a component's first heartbeat may take this long
-    "max_failures": 3,  # this many deaths or hangs within `window` seconds ...
-    "window": 60.0,
-    "power_cycle": {"component": "CpduN", "line": 0, "off_ms": 500},  # ... power-cycle the OBC
-}
-
-
-class ConfigError(ValueError):
-    """A mission configuration that cannot be used: ``key`` says where."""
-
-    def __init__(self, key, message):
-        super().__init__("%s: %s" % (key, message))
-        self.key = key
-
-
-def parse_json(text, where):
-    """The one place a configuration's JSON is parsed."""
-    try:
-        return json.loads(text)
-    except ValueError as e:
-        raise ConfigError(where, "not valid JSON (%s)" % e) from None
-
-
-class MissionConfig:
-    """A loaded mission configuration (see the module text)."""
-
-    def __init__(self, doc, path):
-        if not isinstance(doc, dict):
-            raise ConfigError(path, "expected a JSON object")
-        self.doc = doc
-        self.path = os.path.abspath(path)
-        self.dir = os.path.dirname(self.path)
-        self.name = str(doc.get("name", os.path.splitext(os.path.basename(path))[0]))
-        self.host = str(doc.get("host", DEFAULT_HOST))
-        self.sdb_path = self.resolve(self._str("sdb"))
-        self.state = self.resolve(doc.get("state", "state"))
-        il = doc.get("il_directory")
-        self.il_directory = self.resolve(il) if il else os.path.join(self.state, "il")
-        self.processes = self._processes()
-        platform = dict(_PLATFORM)
-        platform.update(self.section("platform"))
-        self.platform = platform
-
-    def _str(self, key):
-        v = self.doc.get(key)
-        if not isinstance(v, str) or not v:
-            raise ConfigError(key, "expected a path, got %r" % (v,))
-        return v
-
-    def _processes(self):
-        procs = self.doc.get("processes")
-        if not isinstance(procs, dict) or not procs:
-            raise ConfigError("processes", "expected process name -> [component kinds]")
-        where = {}
-        for name, kinds in procs.items():
-            if not isinstance(kinds, list) or not kinds:
-                raise ConfigError("processes.%s" % name, "expected a list of component kinds")
-            for k in kinds:
-                if k not in KINDS:
-                    raise ConfigError(
-                        "processes.%s" % name, "unknown component %r (one of %s)" % (k, KINDS)
-                    )
-                if k in where:
-                    raise ConfigError(
-                        "processes.%s" % name, "%r already runs in %r" % (k, where[k])
-                    )
-                where[k] = name
-        for k in WITH_PUS:
-            if k in where and where.get("pus") != where[k]:
-                raise ConfigError("processes", "%r must run in the process of 'pus'" % k)
-        self.where = where
-        return {name: list(kinds) for name, kinds in procs.items()}
-
-    def resolve(self, path):
-        """``path`` relative to the configuration file (absolute paths stay as they are)."""
-        return os.path.normpath(os.path.join(self.dir, os.path.expanduser(str(path))))
-
-    def section(self, kind):
-        s = self.doc.get(kind, {})
-        if not isinstance(s, dict):
-            raise ConfigError(kind, "expected an object")
-        return s
-
-    def runs(self, kind):
-        """True if some process runs component ``kind``."""
-        return kind in self.where
-
-    def process_of(self, kind):
-        return self.where.get(kind)
+from obsw_host.mission import locate
+from obsw_host.mission.config import (  # noqa: F401 (re-exported)
+    KINDS,
+    WITH_PUS,
+    ConfigError,
+    MissionConfig,
+    parse_json,
+    read,
+)
 
 
 def load(path=None):
-    """The configuration at ``path`` (default: the shipped sample spacecraft)."""
-    path = path or SAMPLE
-    try:
-        with open(path) as f:
-            text = f.read()
-    except OSError as e:
-        raise ConfigError(path, "cannot read (%s)" % e.strerror) from None
-    return MissionConfig(parse_json(text, path), path)
+    """The configuration of mission ``path`` (a folder or its file), else the one ``locate``
+    finds ($OBSW_MISSION, a mission.json here or above); never the sample by default."""
+    return read(locate(path))

@@ -16,6 +16,7 @@ import time
 from obsw.il.node import Node
 
 from obsw_host.il.transport import SocketTransport
+from obsw_host.mission import components as plugins
 
 PLAYBACK_PORT = 5000  # the frame processor's playback input (UDP 4999 + 1)
 
@@ -85,16 +86,10 @@ class PusUnit:
         self.out = out
         opts = config.section("pus")
         state = config.state
-        components = []
-        if "solar_panel" in kinds:
-            from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
-
-            components.append((SOLAR_PANEL, SolarPanel()))
+        components = plugins.build(config, config.plugins(kinds))  # the mission's own
         self.interfaces = [itf for itf, _ in components]
-        if config.runs("solar_panel") and "solar_panel" not in kinds:
-            from obsw_host.solar_panel import SOLAR_PANEL
-
-            self.interfaces.append(SOLAR_PANEL)
+        elsewhere = [n for n in config.plugins() if n not in kinds]
+        self.interfaces += plugins.interfaces(config, elsewhere)
         self.interfaces += equipment_interfaces(config) if config.runs("spacecan") else []
         playback_to = None
         tm_to = None
@@ -397,15 +392,13 @@ class FramesUnit:
 
 
 class ComponentUnit:
-    """Sample equipment components served on their own node (when not with the PUS process)."""
+    """The mission's own components served on their own node (when not with the PUS process)."""
 
     def __init__(self, config, kinds, out=print):
         self.node = Node("obc-components")
         self.transport = SocketTransport(self.node, config.il_directory)
-        if "solar_panel" in kinds:
-            from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
-
-            self.node.provide(SOLAR_PANEL, SolarPanel())
+        for itf, impl in plugins.build(config, config.plugins(kinds)):
+            self.node.provide(itf, impl)
         self._thread = None
 
     def start(self):

@@ -468,6 +468,7 @@ class Sdb:
 
 
 _KNOWN = (
+    "$schema",  # the JSON Schema editors check the file with
     "mission",
     "apids",
     "components",

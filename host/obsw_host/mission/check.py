@@ -20,8 +20,8 @@ from obsw.spacecan.nodedef import NodeDefinition, NodeDefinitionError
 from obsw_host.mission import components as plugins
 from obsw_host.mission import defaults
 from obsw_host.mission.config import KINDS, WITH_PUS, ConfigError, MissionConfig
-from obsw_host.mission.errors import Problem, did_you_mean, json_path, short
-from obsw_host.mission.schema import read_json, validate
+from obsw_host.mission.errors import Problem, did_you_mean, short
+from obsw_host.mission.schema import json_type, read_json, validate
 
 _INT_BOUNDS = {
     "uint8": (0, 0xFF),
@@ -80,6 +80,7 @@ class _Checker:
         self.folder = os.path.dirname(os.path.abspath(mission_file))
         self.problems = []
         self.interfaces = {}  # component name -> Interface (plug-ins and nodes)
+        self.unresolved = set()  # components whose module is at fault (said once, there)
 
     def add(self, file, path, text):
         self.problems.append(Problem(file, path, text))
@@ -123,6 +124,7 @@ class _Checker:
                 itf, _, _ = plugins.load(name, spec, self.folder)
             except plugins.PluginError as e:
                 self.add(self.file, ["components", name, "module"], str(e))
+                self.unresolved.add(name)
                 continue
             self.interfaces[name] = itf
 
@@ -225,7 +227,7 @@ class _Checker:
                 self.add(f, ["apids"], "no APID for pus; expected apids.pus (the PUS "
                          "application process), or pus.apid in the mission file")  # fmt: skip
         elif _is_int(mission_pus) and isinstance(apids, dict) and _is_int(apids.get("pus")):
-            if apids["pus"] != mission_pus:
+            if apids["pus"] != mission_pus and 0 <= apids["pus"] <= 0x7FF:
                 self.add(self.file, ["pus", "apid"], "APID %d differs from the database's "
                          "apids.pus %d; expected the same APID (or leave pus.apid out)"
                          % (mission_pus, apids["pus"]))  # fmt: skip
@@ -324,7 +326,7 @@ class _Checker:
         d = p.get("default")
         if "default" in p and numeric and not _is_num(d):
             self.add(f, path + ["default"], "%s is %s; expected a number of type %s"
-                     % (short(d), type(d).__name__, t))  # fmt: skip
+                     % (short(d), json_type(d), t))  # fmt: skip
         elif _is_num(d) and rng and not rng[0] <= d <= rng[1]:
             self.add(f, path + ["default"], "%s outside the range %s; expected a value within "
                      "the range" % (short(d), short(rng)))  # fmt: skip
@@ -393,11 +395,15 @@ class _Checker:
             if not isinstance(name, str) or not _is_int(nid) or not isinstance(rel, str):
                 continue
             if name in names or nid in ids:
-                dup = ("name", name, names) if name in names else ("node_id", nid, ids)
-                self.add(where, path + [dup[0]], "%s is also node %s's; expected each node "
-                         "name and id once" % (short(dup[1]), dup[2][dup[1]]))  # fmt: skip
+                key, value = ("name", name) if name in names else ("node_id", nid)
+                self.add(
+                    where,
+                    path + [key],
+                    "%s %s is also node %s's; expected each node "
+                    "name and id once" % (key, short(value), names.get(name) or ids[nid]),
+                )
                 continue
-            names[name], ids[nid] = json_path(path), json_path(path)
+            names[name], ids[nid] = name, name
             full = os.path.normpath(os.path.join(base, rel))
             if not os.path.isfile(full):
                 self.add(where, path + ["definition"], "file %s not found; expected a SpaceCAN "
@@ -418,7 +424,8 @@ class _Checker:
             self.doc.get("platform"), dict) else None  # fmt: skip
         if isinstance(pc, dict) and isinstance(pc.get("component"), str):
             comp = pc["component"]
-            if "spacecan" in getattr(self, "where", {}) and comp not in self.nodes:
+            usable = len(self.nodes) == len(nodes)  # a node at fault says so itself
+            if "spacecan" in getattr(self, "where", {}) and usable and comp not in self.nodes:
                 self.add(self.file, ["platform", "power_cycle", "component"], "no node %s; "
                          "expected a SpaceCAN node (%s)%s" % (short(comp), ", ".join(
                              self.nodes) or "none", did_you_mean(comp, self.nodes)))  # fmt: skip
@@ -454,6 +461,8 @@ class _Checker:
                 continue
             names.add(name)
             comp, op = name.split(".", 1)
+            if comp in self.unresolved:
+                continue
             if comp not in ops:
                 self.add(
                     f,
@@ -510,6 +519,7 @@ class _Checker:
                 local = p
         cfdp = self.doc.get("cfdp") if isinstance(self.doc.get("cfdp"), dict) else {}
         peers = cfdp.get("peers") if isinstance(cfdp.get("peers"), dict) else {}
+        entities = {fs.get("entity"): fs.get("prefix") for _, fs in _dicts(doc.get("filestores"))}
         for eid in peers:
             if eid.isdigit() and entities and int(eid) not in entities:
                 self.add(self.file, ["cfdp", "peers", eid], "entity %s is no filestore's; "
@@ -559,6 +569,12 @@ class _Resolver:
         return (e[KIND], None, None)
 
 
+def _once(problems):
+    """``problems`` without repeats (a file two entries name is checked once)."""
+    seen = set()
+    return [p for p in problems if not (p in seen or seen.add(p))]
+
+
 def check(mission_file):
     """(Mission or None, problems) of the mission whose file is ``mission_file``."""
     c = _Checker(mission_file)
@@ -566,7 +582,7 @@ def check(mission_file):
         return None, c.problems
     c.database()
     if c.problems:
-        return None, c.problems
+        return None, _once(c.problems)
     try:  # what the OBC itself will read: the net under the checks above
         config = MissionConfig(c.doc, mission_file)
         sdb = sdb_module.load(c.sdb_file)

@@ -14,6 +14,7 @@ import sys
 import time
 
 import pytest
+from obsw_host.sample import MISSION_DIR
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 README = os.path.join(ROOT, "README.md")
@@ -83,8 +84,14 @@ def ports_free(ports=(5010, 5100)):
     return True
 
 
+# the reader's session names its mission once, as the docs say (`export OBSW_MISSION=...`)
+ENV = dict(os.environ, OBSW_MISSION=MISSION_DIR)
+
+
 def run(argv, cwd, timeout=COMMAND_TIMEOUT):
-    return subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        argv, cwd=cwd, capture_output=True, text=True, timeout=timeout, env=ENV
+    )
 
 
 def test_every_obc_example_of_the_readme(tmp_path, capsys):
@@ -110,6 +117,7 @@ def test_every_obc_example_of_the_readme(tmp_path, capsys):
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         start_new_session=True,
+        env=ENV,
     )
     try:
         end = time.monotonic() + 60.0

@@ -27,6 +27,7 @@ from obsw.il.node import Node
 from obsw.spacecan.controller import Controller
 from obsw.spacecan.equipment import Equipment
 from obsw.spacecan.master import MASTER, SpaceCanMaster
+from obsw.reconfig.node import definition_dict
 from obsw.spacecan.nodedef import NodeDefinition
 from obsw.spacecan.responder import Responder
 
@@ -34,13 +35,11 @@ from obsw_host.spacecan.adapter import CanAdapter
 
 # The reconfiguration module's CPDU as seen on SpaceCAN: the one definition the firmware also
 # uses (``obsw.reconfig.node``; nominal controller node 10, redundant 11).
-CPDU_NODE_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "cpdu_node.json")
 
 
 def cpdu_node():
-    """The CPDU node definition (a fresh dict from ``CPDU_NODE_PATH``)."""
-    with open(CPDU_NODE_PATH) as f:
-        return json.load(f)
+    """The CPDU node definition (a fresh dict, the firmware's own)."""
+    return definition_dict()
 
 
 CPDU_NAME = "CpduN"

@@ -89,9 +89,7 @@ ENV = dict(os.environ, OBSW_MISSION=MISSION_DIR)
 
 
 def run(argv, cwd, timeout=COMMAND_TIMEOUT):
-    return subprocess.run(
-        argv, cwd=cwd, capture_output=True, text=True, timeout=timeout, env=ENV
-    )
+    return subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=timeout, env=ENV)
 
 
 def test_every_obc_example_of_the_readme(tmp_path, capsys):

@@ -18,12 +18,16 @@ TEMPLATE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "templat
 NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
 
 
+def _escaped(key, value):
+    """``"key": "value"`` as a replacement text for ``re.sub`` (backslashes doubled)."""
+    return ("%s: %s" % (json.dumps(key), json.dumps(value))).replace("\\", "\\\\")
+
+
 def _rewrite(path, changes):
     with open(path, encoding="utf-8") as f:
         text = f.read()
     for key, value in changes.items():  # keep the template's layout: replace values in place
-        text = re.sub(r'("%s": )"[^"]*"' % re.escape(key), lambda m: m.group(1) + json.dumps(
-            value), text, count=1)  # fmt: skip
+        text = re.sub(r'"%s": "[^"]*"' % re.escape(key), _escaped(key, value), text, count=1)
     with open(path, "w", encoding="utf-8") as f:
         f.write(text)
 

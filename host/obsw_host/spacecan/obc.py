@@ -16,7 +16,6 @@ within one process only, so that is how a test or demo gets a node to talk to).
 """
 
 import argparse
-import json
 import os
 import select
 import signal
@@ -24,10 +23,10 @@ import sys
 
 from obsw.il.interface import check_unique_ids
 from obsw.il.node import Node
+from obsw.reconfig.node import definition_dict
 from obsw.spacecan.controller import Controller
 from obsw.spacecan.equipment import Equipment
 from obsw.spacecan.master import MASTER, SpaceCanMaster
-from obsw.reconfig.node import definition_dict
 from obsw.spacecan.nodedef import NodeDefinition
 from obsw.spacecan.responder import Responder
 

@@ -46,7 +46,10 @@ class MissionConfig:
         self.format = doc.get("format", 1)
         self.name = str(doc.get("name", os.path.splitext(os.path.basename(path))[0]))
         self.host = str(doc.get("host", defaults.top("host")))
-        self.sdb_path = self.resolve(doc.get("sdb") or defaults.top("sdb"))
+        sdb = doc.get("sdb", defaults.top("sdb"))
+        if not isinstance(sdb, str) or not sdb:
+            raise ConfigError("sdb", "expected a path, got %r" % (sdb,))
+        self.sdb_path = self.resolve(sdb)
         self.state = self.resolve(doc.get("state", "state"))
         il = doc.get("il_directory")
         self.il_directory = self.resolve(il) if il else os.path.join(self.state, "il")

@@ -199,6 +199,7 @@ class _Checker:
             return None
         self.sdb_doc = doc
         self._apids(f, doc)
+        self._scid(f, doc)
         params = self._parameters(f, doc)
         self._events(f, doc)
         self._housekeeping(f, doc, params)
@@ -231,6 +232,19 @@ class _Checker:
                 self.add(self.file, ["pus", "apid"], "APID %d differs from the database's "
                          "apids.pus %d; expected the same APID (or leave pus.apid out)"
                          % (mission_pus, apids["pus"]))  # fmt: skip
+
+    def _scid(self, f, doc):
+        """The spacecraft id is named once: the mission file's frames.scid, if given, agrees."""
+        mine = self.doc.get("frames") if isinstance(self.doc.get("frames"), dict) else {}
+        theirs = doc.get("frames") if isinstance(doc.get("frames"), dict) else {}
+        a, b = mine.get("scid"), theirs.get("scid")
+        if _is_int(a) and _is_int(b) and a != b and 0 <= b <= 1023:
+            self.add(
+                self.file,
+                ["frames", "scid"],
+                "spacecraft id %d differs from the "
+                "database's frames.scid %d; expected the same (or leave it out)" % (a, b),
+            )
 
     def _parameters(self, f, doc):
         """Parameter ids and names given twice; returns qualified name and id -> type."""

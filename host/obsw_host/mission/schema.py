@@ -16,6 +16,7 @@ _PATTERNS = {  # what a pattern means, in words
     "^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$": "a name of up to 64 letters, digits, '_', '.' and '-'",
     "^[0-9]+$": "an entity id in decimal digits",
     "^[^:/]+$": "a prefix without ':' or '/' (SAT)",
+    "^[^\\s:]+:[0-9]{1,5}$": "HOST:PORT",
 }
 _REQUIRED = re.compile(r"^'(.*)' is a required property")
 _validators = {}

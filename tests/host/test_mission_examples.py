@@ -3,6 +3,7 @@ and runs; the second example (examples/aurora, every id different from the sampl
 magnetorquer plug-in in a process of its own) passes the check and runs as far as the system
 follows a mission today: ping, parameters of the plug-in, service 8 functions, its procedure."""
 
+import fnmatch
 import json
 import os
 import signal
@@ -85,6 +86,23 @@ def test_the_template_node_is_the_firmware_cpdu():
         assert json.load(f) == definition_dict()
 
 
+def test_the_package_ships_the_template_and_the_schemas():
+    """Every file of the template and the schemas matches the package data of pyproject.toml
+    (what a `pip install` user gets for `obsw mission new` and for editors)."""
+    tomllib = pytest.importorskip("tomllib")
+    with open(os.path.join(ROOT, "pyproject.toml"), "rb") as f:
+        patterns = tomllib.load(f)["tool"]["setuptools"]["package-data"]["obsw_host"]
+    package = os.path.join(ROOT, "host", "obsw_host")
+    mission = os.path.join(package, "mission")
+    files = []
+    for top in ("template", "schema"):
+        for folder, _, names in os.walk(os.path.join(mission, top)):
+            files += [os.path.relpath(os.path.join(folder, n), package) for n in names
+                      if not n.endswith(".pyc")]  # fmt: skip
+    assert len(files) >= 7
+    assert [f for f in files if not any(fnmatch.fnmatch(f, p) for p in patterns)] == []
+
+
 def test_mission_new_passes_the_check_and_runs(tmp_path):
     r = obsw("mission", "new", "pico-1", cwd=str(tmp_path))
     assert r.returncode == 0, r.stderr
@@ -165,5 +183,6 @@ def test_aurora_runs_from_its_folder(tmp_path):
         out = obc.stop()
     assert "CFDP entity 9" in out and "APID 42" in out
     assert "CpduA=node 20, CpduB=node 21" in out
+    assert "frame processor: UART A" in out and "TM in on udp 4899" in out
     assert "event Magnetorquer.degaussed" in out
     assert "Traceback" not in out

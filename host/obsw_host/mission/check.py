@@ -81,6 +81,9 @@ class _Checker:
         self.problems = []
         self.interfaces = {}  # component name -> Interface (plug-ins and nodes)
         self.unresolved = set()  # components whose module is at fault (said once, there)
+        self.where = {}  # kind or component -> the process that runs it
+        self.nodes = {}  # SpaceCAN node name -> node id, of the definitions that load
+        self.sdb_file = self.procedures = None
 
     def add(self, file, path, text):
         self.problems.append(Problem(file, path, text))
@@ -223,7 +226,7 @@ class _Checker:
             seen[apid] = role
         pus = self.doc.get("pus") if isinstance(self.doc.get("pus"), dict) else {}
         mission_pus = pus.get("apid")
-        if "pus" in getattr(self, "where", {}) and "apid" not in pus:
+        if "pus" in self.where and "apid" not in pus:
             if not isinstance(apids, dict) or "pus" not in apids:
                 self.add(f, ["apids"], "no APID for pus; expected apids.pus (the PUS "
                          "application process), or pus.apid in the mission file")  # fmt: skip
@@ -439,7 +442,7 @@ class _Checker:
         if isinstance(pc, dict) and isinstance(pc.get("component"), str):
             comp = pc["component"]
             usable = len(self.nodes) == len(nodes)  # a node at fault says so itself
-            if "spacecan" in getattr(self, "where", {}) and usable and comp not in self.nodes:
+            if "spacecan" in self.where and usable and comp not in self.nodes:
                 self.add(self.file, ["platform", "power_cycle", "component"], "no node %s; "
                          "expected a SpaceCAN node (%s)%s" % (short(comp), ", ".join(
                              self.nodes) or "none", did_you_mean(comp, self.nodes)))  # fmt: skip

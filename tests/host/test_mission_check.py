@@ -111,6 +111,11 @@ def _default_type(d):
     attribute(d, "SolarPanel", "speed")["default"] = "fast"
 
 
+def _obcp_alone(d):
+    d["processes"]["obc"].remove("obcp")
+    d["processes"]["x"] = ["obcp"]
+
+
 def _twice(folder):
     path = os.path.join(folder, "sdb.json")
     with open(path) as f:
@@ -195,6 +200,15 @@ MISTAKES = [
     ("component module not found",
      mission(lambda d: _set(d["components"]["SolarPanel"], "module", "components/panel.py")),
      "mission.json", "$.components.SolarPanel.module"),
+    ("component class not in its module",
+     mission(lambda d: _set(d["components"]["SolarPanel"], "class", "Panel")),
+     "mission.json", "$.components.SolarPanel.class: obsw_host.solar_panel has no class Panel"),
+    ("kind in two processes",
+     mission(lambda d: _set(d["processes"], "spare", ["spacecan"])),
+     "mission.json", "$.processes.spare[0]: \"spacecan\" already runs in process \"obc\""),
+    ("obcp away from pus",
+     mission(_obcp_alone),
+     "mission.json", "$.processes.x: runs obcp without pus"),
     ("missing database file", mission(lambda d: _set(d, "sdb", "db.json")), "mission.json",
      "$.sdb: file \"db.json\" not found"),
     ("power cycle through no node",

@@ -126,7 +126,7 @@ class _Checker:
             try:
                 itf, _, _ = plugins.load(name, spec, self.folder)
             except plugins.PluginError as e:
-                self.add(self.file, ["components", name, "module"], str(e))
+                self.add(self.file, ["components", name, e.key], str(e))
                 self.unresolved.add(name)
                 continue
             self.interfaces[name] = itf

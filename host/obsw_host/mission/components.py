@@ -16,7 +16,12 @@ from obsw.il.interface import Interface
 
 
 class PluginError(ValueError):
-    """A component plug-in that cannot be used: the message says what was expected."""
+    """A component plug-in that cannot be used: the message says what was expected; ``key``
+    is the entry's key at fault (``module`` or ``class``)."""
+
+    def __init__(self, message, key="module"):
+        super().__init__(message)
+        self.key = key
 
 
 def import_module(spec, folder):
@@ -69,7 +74,7 @@ def load(name, spec, folder):
     cls = getattr(module, cls_name, None)
     if not isinstance(cls, type):
         raise PluginError("%s has no class %s; expected the class implementing %s"
-                          % (spec["module"], cls_name, name))  # fmt: skip
+                          % (spec["module"], cls_name, name), "class")  # fmt: skip
     return itf, cls, dict(spec.get("options") or {})
 
 

@@ -104,7 +104,8 @@ def show(args):
         print("obsw obc: %s" % e, file=sys.stderr)
         return 2
     print(json.dumps({
-        "name": config.name, "path": config.path, "sdb": config.sdb_path, "host": config.host,
+        "format": config.format, "name": config.name, "path": config.path,
+        "sdb": config.sdb_path, "host": config.host, "components": config.components,
         "state": config.state, "il_directory": config.il_directory,
         "processes": config.processes, "platform": config.platform,
     }, indent=2))  # fmt: skip

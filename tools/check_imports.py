@@ -7,7 +7,8 @@ import ast
 import pathlib
 import sys
 
-# What the MicroPython ports the project targets provide (see CONVENTIONS.md).
+# What the MicroPython ports the project targets provide (docs/conventions.md, "The MicroPython
+# subset").
 MICROPYTHON_MODULES = {
     "array",
     "asyncio",

@@ -19,6 +19,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 BOARD = "OBSW_RECONFIG"
 
@@ -152,6 +153,7 @@ MPY_ARCHS = (
     "xtensa", "xtensawin", "rv32imc", "rv64imc",
 )  # fmt: skip
 PYBOARD_ARCH = "armv7emsp"
+BACK_ON_USB = 20.0  # seconds a board may take to come back as a serial port after DFU
 
 
 def arch_of(mpy):
@@ -210,17 +212,23 @@ def deploy(port=None, runner=subprocess.call, out_dir=None, march=None):
 
 
 def flash(firmware, port=None, runner=subprocess.call):
-    """mpremote bootloader, then dfu-util with the firmware (a .dfu file)."""
+    """mpremote bootloader, then dfu-util with the firmware (a .dfu file). Every tool is
+    found before the board enters DFU mode, so a missing one leaves the board running."""
     if not os.path.isfile(firmware):
         raise BoardError("no firmware file %r: run `obsw board build` first" % firmware)
-    _run(_mpremote(port) + ["bootloader"], runner)
     dfu = _tool("DFU_UTIL", "dfu-util")
     if dfu is None:
-        raise BoardError(
-            "dfu-util not found (apt install dfu-util); the board now waits in DFU mode"
-        )
-    _run([dfu, "-a", "0", "-d", "0483:df11", "-D", firmware], runner)
-    _run(_mpremote(port) + ["cp", os.path.join(board_dir(), "main.py"), ":main.py"], runner)
+        raise BoardError("dfu-util not found: apt install dfu-util (the board was left running)")
+    _run(_mpremote(port) + ["bootloader"], runner)
+    # ":leave" starts the new firmware once written, as MicroPython's own `make deploy` does
+    _run([dfu, "-a", "0", "-d", "0483:df11", "-D", firmware, "-s", ":leave"], runner)
+    main = _mpremote(port) + ["cp", os.path.join(board_dir(), "main.py"), ":main.py"]
+    print("$ " + " ".join(main), flush=True)
+    deadline = time.monotonic() + BACK_ON_USB
+    while runner(main):  # the board is not back on USB yet: try again for a while
+        if time.monotonic() > deadline:
+            raise BoardError("the board did not come back on USB within %d s" % BACK_ON_USB)
+        time.sleep(1.0)
 
 
 def repl(port=None, runner=subprocess.call):

@@ -1,10 +1,10 @@
 """Heap allocated per SpaceCAN frame the reconfiguration module handles (not a timing test).
 
 Garbage on a board is paid for by collections that stall the main loop, so the bytes each frame
-allocates are a budget: these figures are the ones the README states (MicroPython unix port,
-64-bit; gc.mem_alloc() around a few frames with the collector off). A change that allocates
-more per frame fails here; one that allocates less should lower the figures here and in the
-README. CPython has no gc.mem_alloc, so there the test is skipped and says why.
+allocates are a budget (docs/reconfiguration.md; MicroPython unix port, 64-bit; gc.mem_alloc()
+around a few frames with the collector off). A change that allocates more per frame fails here;
+one that allocates less should lower the figures here. CPython has no gc.mem_alloc, so there
+the test is skipped and says why.
 """
 
 import gc
@@ -15,7 +15,7 @@ from obsw.reconfig.models import ModelHal
 from obsw.reconfig.node import NODE_NOMINAL, definition
 from obsw.spacecan.controller import Controller
 
-# bytes per frame, the README's table "Reconfiguration module CPU budget"
+# bytes per frame on the 64-bit unix port (the Cortex-M figures: docs/benchmarks/board.md)
 LIMITS = {
     "idle poll": 0,
     "heartbeat": 64,

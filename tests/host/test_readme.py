@@ -1,11 +1,14 @@
-"""Every shell and Python example of README.md runs as written, in order, against the sample
-spacecraft, from a copy of examples/ (the samples the examples use are shipped there).
+"""Every shell and Python example of README.md and of the documentation (docs/**/*.md) runs as
+written, in order, page by page, against the sample spacecraft, from a copy of examples/ (the
+samples the examples use are shipped there).
 
 Each shell block is one terminal: a line ending in ``&`` starts a server, which must print its
 ready line (bound) before the next line runs, and stays up for the Python blocks that follow
-until the next shell block. A line's expected exit status is 0 unless its comment says
-``exit N``. Lines that need hardware, or that are whole suites run elsewhere, are listed in
-SKIP with the reason. Ports move with OBSW_PORT_BASE (PUS) and a substitution (CFDP).
+until the next shell block. A shell block whose first line is ``# from the top folder`` runs
+there (the copy of examples/ sits next to links to the rest of the tree). A line's expected
+exit status is 0 unless its comment says ``exit N``. Lines that need hardware or root, or that
+are whole suites run elsewhere, are listed in SKIP with the reason. Ports move with
+OBSW_PORT_BASE (PUS) and a substitution (CFDP).
 """
 
 import os
@@ -33,13 +36,44 @@ SKIP = {  # a piece of the line -> why it does not run here
     "obsw board build": "the firmware stage of tools/test builds every image",
     "obsw board": "the cortex-m stage of tools/test runs the board tools against the QEMU board",
     "obsw yamcs run": "runs Yamcs until Ctrl-C (the yamcs stage runs it)",
-    "tools/upy/run.py": "a core test file on the unix port, as tools/test runs them all",
+    "tools/bootstrap": "the tests run in the .venv it made",
+    "sudo ": "needs root on the machine it sets up (a Raspberry Pi, a Pyboard's host)",
+    "dfu-util": "needs a Pyboard in DFU mode",
+    "can0": "needs CAN hardware (the Raspberry Pi's can0, can1)",
+    "tests/fuzz/run.py --inputs 1000000": "the long fuzz run takes hours",
+    "mkdocs serve": "serves the site until Ctrl-C (tools/test builds it)",
 }
+TOP_FOLDER = "# from the top folder"  # a shell block that starts so runs from the top folder
+RAN_AT_LEAST = 100  # examples run over all pages
+# every skip names where it is covered or what it needs; most are the hardware guides' lines
+# (docs/pyboard.md, docs/raspberry-pi.md: root, a Pyboard, CAN interfaces)
+SKIPPED_AT_MOST = 60
 
 
-def blocks():
-    text = (ROOT / "README.md").read_text()
+def pages():
+    """README.md, then every page of the documentation, as paths relative to the top."""
+    docs = sorted(p.relative_to(ROOT) for p in (ROOT / "docs").rglob("*.md"))
+    return [pathlib.Path("README.md")] + docs
+
+
+def blocks(page):
+    text = (ROOT / page).read_text()
     return [(m.group(1), m.group(2)) for m in re.finditer(r"```(sh|python)\n(.*?)```", text, re.S)]
+
+
+def shell_lines(body):
+    """(command, expected exit status, skip reason or None) of every line of a shell block."""
+    out = []
+    for line in body.splitlines():
+        command, expected = _command(line)
+        if command:
+            reason = next((why for piece, why in SKIP.items() if piece in command), None)
+            out.append((command, expected, reason))
+    return out
+
+
+def lines(page):
+    return [line for kind, body in blocks(page) if kind == "sh" for line in shell_lines(body)]
 
 
 def free_base():
@@ -104,9 +138,13 @@ def _command(line):
     return parts[0].strip(), int(m.group(1)) if m else 0
 
 
-def test_every_readme_example_runs(tmp_path):
+@pytest.mark.parametrize("page", [p for p in pages() if blocks(p)], ids=str)
+def test_every_example_runs(page, tmp_path):
     work = tmp_path / "examples"
     shutil.copytree(ROOT / "examples", work, ignore=shutil.ignore_patterns("__pycache__"))
+    for entry in ROOT.iterdir():  # the rest of the tree, for blocks run from the top folder
+        if entry.name not in ("examples", ".git", "build"):
+            (tmp_path / entry.name).symlink_to(entry)
     base = free_base()
     venv_bin = os.path.dirname(sys.executable)
     env = dict(
@@ -124,7 +162,7 @@ def test_every_readme_example_runs(tmp_path):
     ports = {"5100": str(base + 100), "5101": str(base + 101)}
     servers, ran, skipped = [], 0, []
     try:
-        for kind, body in blocks():
+        for kind, body in blocks(page):
             if kind == "python":
                 res = subprocess.run(
                     [sys.executable, "-c", body],
@@ -134,24 +172,25 @@ def test_every_readme_example_runs(tmp_path):
                     text=True,
                     timeout=BOUND,
                 )
-                assert res.returncode == 0, "python block failed:\n%s\n%s" % (body, res.stderr)
+                assert res.returncode == 0, "%s: python block failed:\n%s\n%s" % (
+                    page,
+                    body,
+                    res.stderr,
+                )
                 ran += 1
                 continue
             for server in servers:
                 server.stop()
             servers = []
-            for line in body.splitlines():
-                command, expected = _command(line)
-                if not command:
-                    continue
-                reason = next((why for piece, why in SKIP.items() if piece in command), None)
+            cwd = tmp_path if body.startswith(TOP_FOLDER) else work
+            for command, expected, reason in shell_lines(body):
                 if reason:
                     skipped.append((command, reason))
                     continue
                 for old, new in ports.items():
                     command = command.replace(old, new)
                 if command.endswith("&"):
-                    server = Server(command[:-1].strip(), env, work)
+                    server = Server(command[:-1].strip(), env, cwd)
                     servers.append(server)
                     assert server.ready.wait(BOUND), "no ready line from %r" % command
                     assert server.proc.poll() is None, "%r ended: %s" % (command, server.output)
@@ -160,12 +199,13 @@ def test_every_readme_example_runs(tmp_path):
                 res = subprocess.run(
                     ["bash", "-c", command],
                     env=env,
-                    cwd=work,
+                    cwd=cwd,
                     capture_output=True,
                     text=True,
                     timeout=BOUND,
                 )
-                assert res.returncode == expected, "%r: exit %d\n%s\n%s" % (
+                assert res.returncode == expected, "%s: %r: exit %d\n%s\n%s" % (
+                    page,
                     command,
                     res.returncode,
                     res.stdout[-2000:],
@@ -175,12 +215,18 @@ def test_every_readme_example_runs(tmp_path):
     finally:
         for server in servers:
             server.stop()
-    print("README: %d examples ran, %d skipped: %s" % (ran, len(skipped), skipped))
-    assert ran >= 40
-    assert len(skipped) <= 19  # every one names where it is covered or what it needs
+    print("%s: %d examples ran, %d skipped: %s" % (page, ran, len(skipped), skipped))
+
+
+def test_examples_are_many_and_every_skip_has_a_reason():
+    found = [(page, line) for page in pages() for line in lines(page)]
+    skipped = [(page, command, why) for page, (command, _, why) in found if why]
+    python = sum(kind == "python" for page in pages() for kind, _ in blocks(page))
+    assert len(found) - len(skipped) + python >= RAN_AT_LEAST
+    assert len(skipped) <= SKIPPED_AT_MOST, skipped
 
 
 @pytest.mark.parametrize("name", ["node.json", "proc.pluto", "system.json", "turn.plt"])
 def test_sample_files_are_shipped(name):
     assert (ROOT / "examples" / name).is_file()
-    assert name in (ROOT / "README.md").read_text()
+    assert any(name in (ROOT / page).read_text() for page in pages())

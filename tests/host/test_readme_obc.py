@@ -1,4 +1,4 @@
-"""Every shell example of the README's PUS and OBC sections, run as written against one
+"""Every shell example of the documentation's PUS, OBCP and OBC pages, run as written against one
 `obsw obc serve` with the sample spacecraft (default ports on 127.0.0.1). An example ending
 in a comment `# exit N` must exit with N, one saying `exit 1 if none came` (a listener) with
 0 or 1, every other one with 0. Bounded: each command has
@@ -17,28 +17,9 @@ import pytest
 from obsw_host.sample import MISSION_DIR
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-README = os.path.join(ROOT, "README.md")
-SECTIONS = (
-    "### Monitoring & control (PUS services)",
-    "### Onboard automation (PUS services 8, 11, 12, 19, 21, 22)",
-    "### PLUTO procedures",
-    "### The onboard computer",
-)
+PAGES = ("docs/pus.md", "docs/obcp.md", "docs/obc.md")  # the pages whose examples need the OBC
 SERVER = "obsw obc serve"  # the OBC itself: started once, here (no other server is started)
 COMMAND_TIMEOUT = 30.0
-
-
-def sections(text):
-    """The README's text under each of SECTIONS (up to the next heading of that level)."""
-    out = {}
-    for title in SECTIONS:
-        start = text.find(title + "\n")
-        assert start >= 0, "README has no section %r" % title
-        end = text.find("\n### ", start + len(title))
-        end2 = text.find("\n## ", start + len(title))
-        ends = [e for e in (end, end2) if e >= 0]
-        out[title] = text[start : min(ends) if ends else len(text)]
-    return out
 
 
 def examples(text):
@@ -92,12 +73,11 @@ def run(argv, cwd, timeout=COMMAND_TIMEOUT):
     return subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=timeout, env=ENV)
 
 
-def test_every_obc_example_of_the_readme(tmp_path, capsys):
-    with open(README) as f:
-        text = f.read()
+def test_every_obc_example_of_the_docs(tmp_path, capsys):
     cases = []
-    for body in sections(text).values():
-        cases += examples(body)
+    for page in PAGES:
+        with open(os.path.join(ROOT, page)) as f:
+            cases += examples(f.read())
     assert any(c.startswith(SERVER) for c, _ in cases), "no `obsw obc serve` example"
     commands = [(c, e) for c, e in cases if " serve" not in c]
     assert len(commands) >= 20
@@ -143,6 +123,6 @@ def test_every_obc_example_of_the_readme(tmp_path, capsys):
             server.wait(5.0)
     with capsys.disabled():
         print(
-            "\n  README OBC examples: %d commands against obsw obc serve in %.1f s"
+            "\n  docs OBC examples: %d commands against obsw obc serve in %.1f s"
             % (len(commands), time.monotonic() - t0)
         )

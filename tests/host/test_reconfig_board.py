@@ -3,6 +3,8 @@ that record their arguments (no board is touched)."""
 
 import os
 import stat
+import subprocess
+import sys
 import tempfile
 
 import pytest
@@ -124,10 +126,34 @@ def test_flash_repl_and_test(fakes, tmp_path):
     assert run(["board", "test", "--port", "u0"]) == 0
     c = calls()
     assert c[0] == "mpremote bootloader"
-    assert c[1] == "dfu-util -a 0 -d 0483:df11 -D %s" % fw
+    assert c[1] == "dfu-util -a 0 -d 0483:df11 -D %s -s :leave" % fw  # starts the firmware
     assert c[2].startswith("mpremote cp") and c[2].endswith(":main.py")
     assert c[3] == "mpremote repl"
     tests = c[4:]
     assert len(tests) == len(board.BOARD_TESTS)
     assert all(t.startswith("mpremote connect u0 cp") and " exec " in t for t in tests)
     assert run(["board", "flash", str(tmp / "missing.dfu")]) == 2
+
+
+def test_flash_without_dfu_util_leaves_the_board_running(tmp_path):
+    """Through the real command: no dfu-util on the PATH is one line and exit 2, before
+    mpremote is asked to put the board into DFU mode."""
+    log = tmp_path / "calls.log"
+    bindir = tmp_path / "bin"
+    bindir.mkdir()
+    fake = bindir / "mpremote"
+    fake.write_text('#!/bin/sh\necho "mpremote $*" >> "%s"\n' % log)
+    fake.chmod(fake.stat().st_mode | stat.S_IEXEC)
+    fw = tmp_path / "firmware.dfu"
+    fw.write_bytes(b"DfuSe")
+    env = {k: v for k, v in os.environ.items() if k not in ("MPREMOTE", "DFU_UTIL")}
+    env["PATH"] = str(bindir)  # nothing else: no dfu-util wherever the machine keeps one
+    obsw = os.path.join(os.path.dirname(sys.executable), "obsw")
+    r = subprocess.run(
+        [obsw, "board", "flash", str(fw)], env=env, capture_output=True, text=True, timeout=60
+    )
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert r.stdout.strip().splitlines() == [
+        "obsw board: dfu-util not found: apt install dfu-util (the board was left running)"
+    ]
+    assert not log.exists()  # mpremote never ran: the board did not enter DFU mode

@@ -51,7 +51,7 @@ def bench_sdb(structures, folder):
 
 def source_obsw(target, rate, seconds, folder, apid=10):
     """Child: the on-board PUS process reporting ``rate`` HK packets per second."""
-    from obsw import sdb as sdb_module
+    from obsw.pus import sdb as sdb_module
     from obsw_host.pus.onboard import Onboard
     from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 

@@ -18,6 +18,12 @@ ENV = dict(os.environ, PATH=BIN + os.pathsep + os.environ.get("PATH", ""))
 ENV.pop("OBSW_MISSION", None)
 
 
+WAIT_FOR_OUTCOME = (
+    "for i in $(seq 40); do obsw obcp --sdb missions/my-sat/sdb.json status"
+    " | grep -q 'last outcome' && break; sleep 0.25; done"
+)
+
+
 def sh_lines(name):
     with open(os.path.join(DOCS, name)) as f:
         text = f.read()
@@ -84,15 +90,16 @@ def test_the_guide_runs_from_an_empty_folder(workdir):
     for line in sh_lines("fly-your-own-spacecraft.md"):
         script.append(line)
         if " activate " in line:  # a reader looks at the status once the procedure ran
-            script.append("for i in $(seq 40); do obsw obcp --sdb sdb.json status | grep -q "
-                          "'last outcome' && break; sleep 0.25; done")  # fmt: skip
+            script.append(WAIT_FOR_OUTCOME)
         if line.startswith("obsw obc serve"):
             script.append("for i in $(seq 60); do obsw ground --timeout 0.5 ping >/dev/null "
                           "2>&1 && break; sleep 0.5; done")  # fmt: skip
+    script.append("kill %1 && wait")  # the reader's Ctrl-C
     t0 = time.monotonic()
     r = run("\n".join(script), str(workdir))
     assert r.returncode == 0, (r.stdout[-3000:], r.stderr[-3000:])
     assert "ok (my-sat;" in r.stdout
+    assert (workdir / "missions" / "my-sat" / "components" / "magnetorquer.py").is_file()
     assert "alive" in r.stdout
     assert "last outcome confirmed" in r.stdout
     assert time.monotonic() - t0 < 120

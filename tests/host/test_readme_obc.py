@@ -85,6 +85,7 @@ def test_every_obc_example_of_the_docs(tmp_path, capsys):
 
     for name in ("turn.plt",):
         (tmp_path / name).write_text(DEMO_PROCEDURE)
+    os.symlink(MISSION_DIR, tmp_path / "sample")  # the pages run from examples/: `sample` there
     state = tmp_path / "state"
     t0 = time.monotonic()
     end = t0 + 300.0

@@ -27,6 +27,7 @@ from obsw.pluto.names import (
     COMPONENT,
     KIND,
     PARAMS,
+    SIGNATURE,
     UNIT,
     Catalog,
     ParameterError,
@@ -171,6 +172,12 @@ class IlSystem(System):
         if e[KIND] == "parameter":
             return ("parameter", e[CODE] or "?", e[UNIT])
         return (e[KIND], None, None)
+
+    def signature(self, path):
+        """The arguments the database declares for activity ``path``: [(name, type code,
+        unit)], or None (the load-time checker then takes any arguments)."""
+        e = self._find(path)
+        return e[SIGNATURE] if e is not None and e[KIND] == "activity" else None
 
     def get(self, path):
         target = self.target(path)

@@ -177,18 +177,45 @@ class FunctionDef:
 
 
 class OperationDef:
-    """An operation of a component: ``arguments`` are (name, unit) pairs (None: not given)."""
+    """An operation of a component: ``arguments`` are (name, unit) pairs (None: not given);
+    ``signature`` is its declared arguments as (name, type, unit), type None when not given,
+    or None when the database lists no ``arguments`` (any arguments then)."""
 
-    __slots__ = ("component", "name", "arguments")
+    __slots__ = ("component", "name", "arguments", "signature")
 
-    def __init__(self, component, name, arguments):
+    def __init__(self, component, name, arguments, signature=None):
         self.component = component
         self.name = name
         self.arguments = arguments
+        self.signature = signature
 
     @property
     def qualified(self):
         return "%s.%s" % (self.component, self.name)
+
+
+# -- operations: the activity signatures PLUTO procedures are checked against at load time
+
+
+def _operation(cname, op):
+    """An ``OperationDef`` from a component's ``operations`` entry: each argument is
+    ``{"name": n, "type": t, "unit": u}`` (type and unit optional; a type is checked here);
+    ``"arguments": []`` declares an operation that takes none."""
+    where = "operation %s.%s" % (cname, op["name"])
+    args = []
+    sig = []
+    seen = set()
+    for a in op.get("arguments", ()):
+        name = a["name"]
+        if name in seen:
+            raise SdbError("%s declares argument %s twice" % (where, name))
+        seen.add(name)
+        t = a.get("type")
+        if t is not None:
+            field_type(t, "%s, argument %s" % (where, name))
+        args.append((name, a.get("unit")))
+        sig.append((name, t, a.get("unit")))
+    return OperationDef(cname, op["name"], args, sig if "arguments" in op else None)
 
 
 class NodeDef:
@@ -273,10 +300,7 @@ class Sdb:
             for e in comp.get("events", []):
                 self._add_event(cname, e)
             for op in comp.get("operations", []):
-                args = [(a["name"], a.get("unit")) for a in op.get("arguments", ())]
-                self.operations["%s.%s" % (cname, op["name"])] = OperationDef(
-                    cname, op["name"], args
-                )
+                self.operations["%s.%s" % (cname, op["name"])] = _operation(cname, op)
         for p in doc.get("parameters", []):  # parameters of no component (process-local)
             self._add_parameter(
                 Parameter(

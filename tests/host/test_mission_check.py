@@ -111,6 +111,12 @@ def _default_type(d):
     attribute(d, "SolarPanel", "speed")["default"] = "fast"
 
 
+def _dup_operation_argument(d):
+    component(d, "SolarPanel")["operations"] = [
+        {"name": "set_angle", "arguments": [{"name": "angle"}, {"name": "angle"}]}
+    ]
+
+
 def _obcp_alone(d):
     d["processes"]["obc"].remove("obcp")
     d["processes"]["x"] = ["obcp"]
@@ -209,6 +215,8 @@ MISTAKES = [
     ("obcp away from pus",
      mission(_obcp_alone),
      "mission.json", "$.processes.x: runs obcp without pus"),
+    ("operation argument given twice", sdb(_dup_operation_argument), "sdb.json",
+     "$.components[0].operations[0].arguments[1].name: argument \"angle\" given twice"),
     ("missing database file", mission(lambda d: _set(d, "sdb", "db.json")), "mission.json",
      "$.sdb: file \"db.json\" not found"),
     ("power cycle through no node",

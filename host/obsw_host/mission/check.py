@@ -448,12 +448,28 @@ class _Checker:
                              self.nodes) or "none", did_you_mean(comp, self.nodes)))  # fmt: skip
 
     def _operations(self, doc):
-        """Component name -> {operation: parameter names or None (not declared)}."""
+        """Component name -> {operation: parameter names}; operations and their arguments
+        declared twice in the database are problems."""
         ops = {}
-        for _, comp in _dicts(doc.get("components")):
-            for _, op in _dicts(comp.get("operations")):
-                args = [a.get("name") for _, a in _dicts(op.get("arguments"))]
-                ops.setdefault(comp.get("name"), {})[op.get("name")] = args
+        for ci, comp in _dicts(doc.get("components")):
+            for oi, op in _dicts(comp.get("operations")):
+                at = ["components", ci, "operations", oi]
+                mine = ops.setdefault(comp.get("name"), {})
+                if op.get("name") in mine:
+                    self.add(self.sdb_file, at + ["name"], "operation %s declared twice; "
+                             "expected each operation once" % short(op.get("name")))  # fmt: skip
+                    continue
+                args = []
+                for ai, a in _dicts(op.get("arguments")):
+                    if a.get("name") in args:
+                        self.add(
+                            self.sdb_file,
+                            at + ["arguments", ai, "name"],
+                            "argument %s "
+                            "given twice; expected each argument once" % short(a["name"]),
+                        )
+                    args.append(a.get("name"))
+                mine[op.get("name")] = args
         for name, itf in self.interfaces.items():
             for op in itf.operations:
                 ops.setdefault(name, {})[op.name] = list(op.params)

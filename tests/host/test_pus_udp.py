@@ -77,8 +77,9 @@ def test_structures_periodic_reports_and_context(system):
     assert ground.hk_properties([9]).reply["items"] == [{"sid": 9, "enabled": True, "interval": 3}]
     assert ground.disable_hk([9]).ok
     assert ground.delete_hk([9]).ok
-    saved = onboard.app.store.load("s03")
-    assert [s[0] for s in saved] == [1, 2]
+    saved = onboard.app.store.load("s03")  # both structure sets and functional reporting
+    assert [s[0] for s in saved["hk"]] == [1, 2]
+    assert saved["diag"] == saved["functional"] == []
 
 
 def test_events_from_the_panel(system):

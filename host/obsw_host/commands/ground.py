@@ -28,6 +28,9 @@
     obsw ground action list | enable EVENT | disable EVENT | delete EVENT
     obsw ground sequence load warmup "0 ping" "2 function SolarPanel.set_angle angle=10"
     obsw ground sequence status | content warmup | activate warmup | abort warmup | unload warmup
+    obsw ground memory dump|load|check|load-file|check-object|abort-dumps|scrub|protect ..
+    obsw ground store copy|diag ..   obsw ground sequence file|load-file ..
+    obsw ground position orbit N     (commands of services 6, 15, 21, 22: see their --help)
 
 A request to schedule, sequence or run as an action is ``ping``, ``function NAME
 [ARG=VALUE..]`` or ``set NAME=VALUE..``; activities are named SOURCE:APID:SEQ.
@@ -67,6 +70,10 @@ def add_parser(sub):
 
     obcp.add_to_ground(s)
     cfdp.add_parser(s)  # obsw ground cfdp put|get|status|serve
+    from obsw_host.commands import ground_memory, ground_services
+
+    ground_services.add_to_ground(s)  # obsw ground device|diag|functional|forward (2, 3, 14)
+    ground_memory.add_to_ground(s)  # obsw ground memory ..|store ..
 
     _add_operator(s)
     s.add_parser("ping", help="TC[17,1] are-you-alive").set_defaults(func=_ping)
@@ -101,6 +108,7 @@ def add_parser(sub):
     x = hk.add_parser("listen", help="print periodic reports")
     x.add_argument("--seconds", type=float, default=3.0)
     x.set_defaults(func=_listen, listen=(3, 25))
+    ground_services.add_to_hk(hk)  # obsw ground hk append
 
     pa = s.add_parser("params", help="service 20 parameters").add_subparsers(dest="params")
     pa.required = True
@@ -129,9 +137,9 @@ def add_parser(sub):
     x = ti.add_parser("rate", help="TC[9,1] report every 2**EXPONENT s")
     x.add_argument("exponent", type=int)
     x.set_defaults(func=_time_rate)
-    x = ti.add_parser("listen", help="print time reports")
+    x = ti.add_parser("listen", help="print time reports (CUC TM[9,2] or CDS TM[9,3])")
     x.add_argument("--seconds", type=float, default=3.0)
-    x.set_defaults(func=_listen, listen=(9, 2))
+    x.set_defaults(func=_listen, listen=(9, None))
 
 
 def _add_automation(s):
@@ -166,6 +174,10 @@ def _add_automation(s):
         x = sp.add_parser("delete", help="delete activities")
         x.add_argument("ids", nargs="+", metavar="SOURCE:APID:SEQ")
         x.set_defaults(func=_sched_delete, service=svc)
+        if svc == "position":
+            from obsw_host.commands import ground_memory
+
+            ground_memory.add_to_position(sp)  # obsw ground position orbit N
 
     mo = s.add_parser(
         "monitor",
@@ -215,6 +227,9 @@ def _add_automation(s):
     x.add_argument("steps", nargs="+")
     x.set_defaults(func=_sequence_load)
     se.add_parser("status").set_defaults(func=_sequence_status)
+    from obsw_host.commands import ground_memory
+
+    ground_memory.add_to_sequence(se)  # obsw ground sequence file|load-file
     for action in ("content", "activate", "abort", "unload"):
         x = se.add_parser(action)
         x.add_argument("name")

@@ -114,6 +114,7 @@ class PusUnit:
             tm_to=tm_to,
             playback_to=playback_to,
             components=components,
+            time_code=opts.get("time_code", "cuc"),  # ST[09] reports: "cuc" (9,2) or "cds" (9,3)
         )
         self.app = self.onboard.app
         self.cfdp = None

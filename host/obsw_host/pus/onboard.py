@@ -84,6 +84,7 @@ class Onboard:
         max_tasks=16,
         components=(),
         time_exponent=None,
+        time_code="cuc",
     ):
         self.sdb = sdb
         self.apid = apid if apid is not None else sdb.apid("pus")
@@ -132,7 +133,7 @@ class Onboard:
             app.playback = self._playback
         app.register(Housekeeping(self.pool, sdb.housekeeping))
         app.register(EventReporting(known=sdb.events))
-        app.register(TimeManagement(time_exponent))
+        app.register(TimeManagement(time_exponent, time_code))
         app.register(ServiceTest())
         app.register(ParameterManagement(self.pool))
         app.register(FunctionManagement(functions(sdb), self.node))

@@ -481,6 +481,7 @@ class Generator:
         )
         self.obcp_commands(pus)
         self.file_commands(pus)
+        self.memory_storage_commands(pus)
 
     def obcp_commands(self, pus):
         def obcp():
@@ -534,6 +535,126 @@ class Generator:
             ],
             "TC[23,14] copy a file (by CFDP between SAT: and GROUND:)",
         )
+
+    # ------------------------------------------------------------------ services 6, 15, 21, 22
+    def memory_storage_commands(self, pus):
+        """Service 6 (the loads that carry their data in the TC are the CLI's: XTCE loads
+        from files), 15 (copy by time window, diagnostic storage control), 21 (sequences by
+        reference) and 22 (orbit number)."""
+
+        def u(name, pair):
+            return ("arg", name, argument_type("", pair))
+
+        def path(name):
+            return ("arg", name, argument_type("", (8, 0)))
+
+        one = ("fixed", "n", 1, 8)
+
+        def mem():  # each command gets its own argument type elements
+            return u("memory", U16)
+
+        def obj():
+            return u("object", U16)
+
+        def rng(first="address"):
+            return [u(first, U32), u("length", U32)]
+
+        def files():
+            return [path("repository"), path("file")]
+
+        self.command(pus, "memory_abort_dumps", M.TC_MEM_ABORT_ALL_DUMPS, (), "TC[6,12]")
+        for name, mt in (
+            ("memory_scrub_enable", M.TC_MEM_ENABLE_SCRUBBING),
+            ("memory_scrub_disable", M.TC_MEM_DISABLE_SCRUBBING),
+            ("memory_protect", M.TC_MEM_ENABLE_WRITE_PROTECTION),
+            ("memory_unprotect", M.TC_MEM_DISABLE_WRITE_PROTECTION),
+        ):
+            self.command(pus, name, mt, [mem()], "TC[%d,%d]" % mt)
+        for name, mt, fields in (
+            ("memory_dump", M.TC_MEM_DUMP_RAW, lambda: [mem(), one] + rng()),
+            ("memory_check", M.TC_MEM_CHECK_RAW, lambda: [mem(), one] + rng()),
+            (
+                "memory_dump_object",
+                M.TC_MEM_DUMP_OBJECT,
+                lambda: [mem(), obj(), one] + rng("offset"),
+            ),
+            (
+                "memory_check_object",
+                M.TC_MEM_CHECK_OBJECT,
+                lambda: [mem(), obj(), one] + rng("offset"),
+            ),
+            ("memory_check_whole_object", M.TC_MEM_CHECK_OBJECT_WHOLE, lambda: [mem(), obj()]),
+            (
+                "memory_load_file",
+                M.TC_MEM_LOAD_RAW_BY_REFERENCE,
+                lambda: [mem(), one, u("address", U32)] + files() + [u("crc", U16)],
+            ),
+            (
+                "memory_dump_file",
+                M.TC_MEM_DUMP_RAW_TO_FILE,
+                lambda: [mem(), one] + rng() + files(),
+            ),
+            (
+                "memory_load_object_file",
+                M.TC_MEM_LOAD_OBJECT_BY_REFERENCE,
+                lambda: [mem(), obj(), one, u("offset", U32)] + files() + [u("crc", U16)],
+            ),
+            (
+                "memory_dump_object_file",
+                M.TC_MEM_DUMP_OBJECT_TO_FILE,
+                lambda: [mem(), obj(), one] + rng("offset") + files(),
+            ),
+        ):
+            self.command(pus, name, mt, fields(), "TC[%d,%d]" % mt)
+        whole = [
+            self.header_param("memory_id", 16),
+            self.header_param("memory_object_id", 16),
+            self.header_param("memory_object_length", 32),
+            self.header_param("memory_object_checksum", 16),
+        ]
+        self.report("memory_whole_object_report", M.TM_MEM_CHECK_OBJECT_WHOLE_REPORT, whole)
+        self.report("memory_object_dump", M.TM_MEM_DUMP_OBJECT_REPORT, whole[:2])
+        self.report("memory_object_check", M.TM_MEM_CHECK_OBJECT_REPORT, whole[:2])
+        # ST[15]: time tags as the CUC coarse (seconds) and fine (1/65536 s) parts
+        windows = {0: "from_to", 1: "after", 2: "before"}
+        self.command(
+            pus,
+            "store_copy",
+            M.TC_STORE_COPY_BY_TIME_WINDOW,
+            [
+                ("arg", "window", argument_type("", E8, labels=windows)),
+                u("tag1_seconds", U32),
+                ("fixed", "tag1_fraction", 0, 16),
+                u("tag2_seconds", U32),
+                ("fixed", "tag2_fraction", 0, 16),
+                u("source", U16),
+                u("target", U16),
+            ],
+            "TC[15,24] copy the packets of a time window into an empty store",
+        )
+        for name, mt in (
+            ("store_diag_add", M.TC_STORE_ADD_DIAG_STRUCTURES),
+            ("store_diag_delete", M.TC_STORE_DELETE_DIAG_STRUCTURES),
+        ):
+            fields = [u("store", U16), one, ("fixed", "apid", self.apid, 16)]
+            fields += [("fixed", "sid_count", 1, 8), u("sid", U16)]
+            self.command(pus, name, mt, fields, "TC[%d,%d]" % mt)
+        self.command(
+            pus, "store_diag_report", M.TC_STORE_REPORT_DIAG_STRUCTURES, [u("store", U16)]
+        )
+        self.report(
+            "store_diag_report",
+            M.TM_STORE_DIAG_STRUCTURES_REPORT,
+            [self.header_param("store_id", 16)],
+        )
+        # ST[21] sequences from files, ST[22] the orbit number
+        for name, mt in (
+            ("sequence_load_file", M.TC_SEQUENCE_LOAD_BY_REFERENCE),
+            ("sequence_load_file_activate", M.TC_SEQUENCE_LOAD_AND_ACTIVATE),
+        ):
+            fields = [("arg", "sequence", argument_type("", (8, 8)))]
+            self.command(pus, name, mt, fields + files())
+        self.command(pus, "position_set_orbit", M.TC_POS_SCHED_SET_ORBIT_NUMBER, [u("orbit", U32)])
 
     def parameter_commands(self):
         for pid in sorted(self.sc.params):
@@ -631,7 +752,119 @@ class Generator:
         self.parameter_commands()
         self.monitor_commands()
         self.function_commands()
+        self.services_2_3_9_14()
         return self.root.element()
+
+    # ------------------------------------------------------------------ services 2, 3, 9, 14
+    def services_2_3_9_14(self):
+        """Reports and commands of device access, diagnostics, functional reporting, time and
+        diagnostic forwarding: one item per command (N = 1), the first item of a report."""
+        r = self.root
+        exponent = self.header_param("time_rate_exponent", 8)
+        status = self.header_param("time_reference_status", 8)
+        cuc = [self.header_param("cuc_coarse", 32), self.header_param("cuc_fine", 16)]
+        cds = [self.header_param("cds_day", 16), self.header_param("cds_ms_of_day", 32)]
+        self.report("cuc_time_report", M.TM_TIME_CUC_REPORT, [exponent] + cuc + [status])
+        self.report("cds_time_report", M.TM_TIME_CDS_REPORT, [exponent] + cds + [status])
+        diag_sid = self.header_param("diag_structure_id", 16)
+        self.report("diag_report", M.TM_HK_DIAG_REPORT, [diag_sid])
+        n = self.header_param("register_count", 8)
+        address = self.header_param("register_address", 32)
+        value = self.header_param("register_value", 32)
+        self.report("register_dump", M.TM_DEVICE_REGISTER_DUMP_REPORT, [n, address, value])
+        for name, msg_type in (
+            ("diag_structure_report", M.TM_HK_DIAG_STRUCTURE_REPORT),
+            ("diag_properties_report", M.TM_HK_DIAG_PERIODIC_PROPERTIES_REPORT),
+            ("functional_reporting_report", M.TM_HK_FUNCTIONAL_REPORTING_REPORT),
+            ("forward_diag_report", M.TM_FWD_DIAG_STRUCTURES_REPORT),
+        ):
+            self.report(name, msg_type)
+
+        pus = r.child("PUS")
+        one8, one16 = ("fixed", "n", 1, 8), ("fixed", "n", 1, 16)
+        none16 = ("fixed", "nfa", 0, 16)
+        pids = {pid: _label(p.qualified) for pid, p in self.sc.params.items()}
+
+        def arg(name, pair, valid=None, labels=None):
+            return ("arg", name, argument_type("", pair, valid=valid, labels=labels))
+
+        self.command(
+            pus,
+            "time_rate",
+            M.TC_TIME_SET_REPORT_RATE,
+            [arg("exponent", U8, (0, 16))],
+            "TC[9,1] a report every 2**exponent s",
+        )
+        self.command(
+            pus,
+            "device_on_off",
+            M.TC_DEVICE_ON_OFF,
+            [one8, arg("address", U16)],
+            "TC[2,1] on/off device command",
+        )
+        self.command(
+            pus,
+            "device_register_load",
+            M.TC_DEVICE_REGISTER_LOAD,
+            [one8, arg("address", U32), arg("value", U32)],
+            "TC[2,2] register load",
+        )
+        self.command(
+            pus,
+            "device_register_dump",
+            M.TC_DEVICE_REGISTER_DUMP,
+            [one8, arg("address", U32)],
+            "TC[2,5] register dump",
+        )
+        self.command(
+            pus,
+            "device_cpdu",
+            M.TC_DEVICE_CPDU,
+            [one8, arg("line", U16), arg("duration_ms", U16)],
+            "TC[2,4] CPDU command",
+        )
+        for name, msg_type in (
+            ("diag_enable", M.TC_HK_ENABLE_DIAG_REPORTS),
+            ("diag_disable", M.TC_HK_DISABLE_DIAG_REPORTS),
+            ("diag_one_shot", M.TC_HK_ONE_SHOT_DIAG),
+            ("diag_delete", M.TC_HK_DELETE_DIAG_STRUCTURES),
+            ("diag_structures", M.TC_HK_REPORT_DIAG_STRUCTURES),
+            ("diag_properties", M.TC_HK_REPORT_DIAG_PERIODIC_PROPERTIES),
+        ):
+            self.command(pus, name, msg_type, [one16, arg("sid", U16)])
+        self.command(
+            pus,
+            "diag_interval",
+            M.TC_HK_MODIFY_DIAG_INTERVAL,
+            [one16, arg("sid", U16), arg("interval", U16, (1, 65535))],
+        )
+        for name, msg_type in (
+            ("hk_append", M.TC_HK_APPEND_HK_PARAMETERS),
+            ("diag_append", M.TC_HK_APPEND_DIAG_PARAMETERS),
+        ):
+            self.command(
+                pus,
+                name,
+                msg_type,
+                [arg("sid", U16), one16, arg("parameter", U16, labels=pids), none16],
+            )
+        for name, msg_type in (
+            ("functional_apply", M.TC_HK_APPLY_FUNCTIONAL_REPORTING),
+            ("functional_delete", M.TC_HK_DELETE_FUNCTIONAL_REPORTING),
+            ("functional_report", M.TC_HK_REPORT_FUNCTIONAL_REPORTING),
+        ):
+            self.command(pus, name, msg_type, [one16, arg("definition", U16)])
+        for name, msg_type in (
+            ("forward_diag_add", M.TC_FWD_ADD_DIAG_STRUCTURES),
+            ("forward_diag_delete", M.TC_FWD_DELETE_DIAG_STRUCTURES),
+        ):
+            self.command(
+                pus,
+                name,
+                msg_type,
+                [one8, arg("apid", U16, (0, 2047)), ("fixed", "n2", 1, 8), arg("sid", U16)],
+            )
+        self.command(pus, "forward_diag_report", M.TC_FWD_REPORT_DIAG_STRUCTURES)
 
 
 def _drop_condition(container, ref):

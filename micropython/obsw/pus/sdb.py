@@ -24,7 +24,9 @@ equipment: name, node id, node definition file relative to the database file).
 
 ``filestores`` maps the path prefixes of file management (``SAT:/data/x``) to CFDP entity
 ids (the onboard one is the first, unless one says ``"local": true``); ``memories`` declares
-the memory areas service 6 may load, dump and check, by id, start address and size.
+the memory areas service 6 may load, dump and check, by id, start address and size, with
+their ``objects`` (id, name, offset, size: the object memory of service 6) and an optional
+``mirror`` file (a second copy written with the first, from which scrubbing repairs).
 
 A type is a name (``uint8`` .. ``uint64``, ``int8`` .. ``int64``, ``float32``, ``float64``,
 ``bool``, ``enum8``, ``enum16``, ``string`` for a 16-bit-length character string,
@@ -409,6 +411,8 @@ class Sdb:
                 "start": _int(m.get("start", 0), "start of memory %d" % mid),
                 "size": size,
                 "writable": bool(m.get("writable", False)),
+                "mirror": m.get("mirror"),
+                "objects": _memory_objects(m.get("objects", []), mid, size),
             }
 
     def filestore_entity(self, prefix):
@@ -526,3 +530,18 @@ def load(path):
         text = f.read()
     i = path.rfind("/")
     return loads(text, path[:i] if i > 0 else ("/" if i == 0 else ""))
+
+
+def _memory_objects(items, mid, size):
+    """The objects of memory ``mid`` (service 6 object memory): id -> (name, offset, size)."""
+    out = {}
+    for o in items:
+        oid = _int(o["id"], "object id in memory %d" % mid)
+        if oid == 0 or oid in out:
+            raise SdbError("object %d of memory %d: 0 or declared twice" % (oid, mid))
+        off = _int(o.get("offset", 0), "offset of object %d" % oid)
+        n = _int(o["size"], "size of object %d" % oid)
+        if n == 0 or off + n > size:
+            raise SdbError("object %d of memory %d outside its %d octets" % (oid, mid, size))
+        out[oid] = (o.get("name", "object%d" % oid), off, n)
+    return out

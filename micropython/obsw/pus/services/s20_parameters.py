@@ -58,6 +58,7 @@ class ParameterManagement(Service):
     """The service 20 provider, on a ``ParameterPool``."""
 
     SERVICE = SERVICE_PARAMETER_MANAGEMENT
+    REPORTS = (TM_PARAM_VALUE_REPORT,)
     HANDLERS = (
         (TC_PARAM_REPORT_VALUES, "report_values"),
         (TC_PARAM_SET_VALUES, "set_values"),

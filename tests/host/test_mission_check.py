@@ -117,6 +117,13 @@ def _dup_operation_argument(d):
     ]
 
 
+def _object_outside(d):
+    d["memories"][0]["objects"] = [
+        {"id": 1, "name": "header", "size": 64},
+        {"id": 2, "name": "table", "offset": 65000, "size": 1024},
+    ]
+
+
 def _obcp_alone(d):
     d["processes"]["obc"].remove("obcp")
     d["processes"]["x"] = ["obcp"]
@@ -217,6 +224,8 @@ MISTAKES = [
      "mission.json", "$.processes.x: runs obcp without pus"),
     ("operation argument given twice", sdb(_dup_operation_argument), "sdb.json",
      "$.components[0].operations[0].arguments[1].name: argument \"angle\" given twice"),
+    ("memory object outside its area", sdb(_object_outside), "sdb.json",
+     "$.memories[0].objects[1]: octets 65000..66023 outside the memory's 65536"),
     ("missing database file", mission(lambda d: _set(d, "sdb", "db.json")), "mission.json",
      "$.sdb: file \"db.json\" not found"),
     ("power cycle through no node",

@@ -17,10 +17,7 @@ PROJECT_DEFINED = {(15, 7)}  # messages.py names it; the standard does not defin
 
 # Types other branches are completing (services 6, 12, 15, 20, 21, 22): expected to fail here
 # until their branches merge.
-ELSEWHERE = (
-    {(12, s) for s in range(17, 29)}
-    | {(20, s) for s in range(4, 8)}
-)
+ELSEWHERE = {(12, s) for s in range(17, 29)} | {(20, s) for s in range(4, 8)}
 
 
 @pytest.fixture(scope="module")

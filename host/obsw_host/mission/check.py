@@ -566,6 +566,22 @@ class _Checker:
                          "name once" % short(name if name in mnames else mid))  # fmt: skip
             mids.add(mid)
             mnames.add(name)
+            self._objects(f, ["memories", i], m)
+
+    def _objects(self, f, path, m):
+        """Objects of a memory area: ids once, each within the area."""
+        size = m.get("size") if _is_int(m.get("size")) else None
+        ids = set()
+        for j, o in _dicts(m.get("objects")):
+            oid, off, n = o.get("id"), o.get("offset", 0), o.get("size")
+            at = path + ["objects", j]
+            if _is_int(oid) and oid in ids:
+                self.add(f, at + ["id"], "object %d declared twice; expected each id once" % oid)
+                continue
+            ids.add(oid)
+            if size and _is_int(off) and _is_int(n) and off + n > size:
+                self.add(f, at, "octets %d..%d outside the memory's %d; expected offset + size "
+                         "within the area" % (off, off + n - 1, size))  # fmt: skip
 
     # -------------------------------------------------------------------- procedures
 

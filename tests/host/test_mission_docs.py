@@ -54,6 +54,15 @@ def test_every_schema_key_is_in_the_page():
             assert "| `%s` |" % key in page, key
 
 
+def test_the_schema_defaults_are_the_obcs():
+    """The defaults an editor shows (the schema's) are the ones the OBC uses (obc.defaults)."""
+    from obsw_host.mission import defaults
+    from obsw_host.obc import defaults as obc_defaults
+
+    for name, values in obc_defaults.SECTIONS.items():
+        assert defaults.section(name) == values, name
+
+
 @pytest.fixture
 def workdir(tmp_path):
     os.symlink(os.path.join(ROOT, "examples"), tmp_path / "examples")

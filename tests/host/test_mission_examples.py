@@ -133,7 +133,7 @@ def test_aurora_differs_from_the_sample_and_passes_the_check():
     a, s = load(AURORA), load(sample.MISSION_DIR)
     assert a.name != s.name and a.sdb.mission != s.sdb.mission
     assert set(a.sdb.apids.values()).isdisjoint(s.sdb.apids.values())
-    assert a.sdb.scid != s.config.section("frames")["scid"]
+    assert a.sdb.scid != s.config.doc["frames"]["scid"]
     assert a.sdb.tm_vcs != s.sdb.tm_vcs
     assert set(a.sdb.filestores).isdisjoint(s.sdb.filestores)
     assert set(a.sdb.filestores.values()).isdisjoint(s.sdb.filestores.values())
@@ -147,7 +147,7 @@ def test_aurora_differs_from_the_sample_and_passes_the_check():
     assert any(p.calibration and "polynomial" in p.calibration for p in a.sdb.parameters.values())
     assert any(p.calibration and "spline" in p.calibration for p in a.sdb.parameters.values())
     assert any(p.limits for p in a.sdb.parameters.values())
-    assert a.config.components["Magnetorquer"]["module"] == "components/magnetorquer.py"
+    assert a.config.doc["components"]["Magnetorquer"]["module"] == "components/magnetorquer.py"
     assert a.config.process_of("Magnetorquer") not in (None, a.config.process_of("pus"))
     assert os.listdir(os.path.join(AURORA, "procedures")) == ["detumble.plt"]
 

@@ -43,6 +43,7 @@ RUNS = {
     "reconfig": ("reconfig.py", {}, "Reconfiguration module logic (host)"),
     "board": ("board.py", {}, "Reconfiguration module CPU budget (Cortex-M, QEMU)"),
     "chain": ("chain.py", {}, "The end-to-end chain"),
+    "obc_start": ("obc_start.py", {}, "OBC cold start"),
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
 }
 # benchmarks whose figures do not depend on the host's load (instructions counted under QEMU)

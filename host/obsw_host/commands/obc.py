@@ -1,20 +1,33 @@
 """`obsw obc serve [MISSION]`: the onboard computer of a mission folder (or its mission file).
 
 MISSION is a mission folder or its file; without it, $OBSW_MISSION or a mission.json in the
-working folder or above (the sample is `examples/sample`). The whole folder is checked first
-(`obsw mission check`): a mistake stops the start with one line per problem, exit status 2,
-before any process starts. Then every PUS service on its UDP port, the CFDP entity, the OBCP
+working folder or above (the sample spacecraft is `examples/sample`). The whole folder is
+checked first (`obsw mission check`): a mistake stops the start with one line per problem,
+exit status 2, before any process starts. Then the PUS services, the CFDP entity, the OBCP
 engine, the SpaceCAN master and the mission's components run in the processes the mission
-file names, started and watched by the platform manager. `--process NAME` runs one process of
-the mission (what the platform manager starts); `obsw obc config [MISSION]` prints the
-configuration as the OBC understands it.
+file names, started and watched by the platform manager. Its state lives in the mission's
+state folder (default `$XDG_STATE_HOME/obsw/<mission>`), locked while it runs: a second `obsw
+obc serve` of the same mission refuses. `obsw obc reset [MISSION]` clears that folder; `obsw obc
+config [MISSION]`
+prints the configuration and its topology as the OBC understands them. `--process NAME` runs
+one process of the configuration (what the platform manager starts).
 """
 
 import argparse
 import json
 import os
 import sys
-import tempfile
+
+from obsw_host.errors import UserError
+from obsw_host.mission import locate
+from obsw_host.obc.config import ConfigError
+from obsw_host.obc.config import load as load_config
+from obsw_host.obc.state import StateLock, StateLocked, default_state
+from obsw_host.obc.state import reset as reset_state
+from obsw_host.obc.topology import Topology
+
+EXIT_REFUSED = 2
+MISSION_HELP = "mission folder or file (default: $OBSW_MISSION, or a mission.json here or above)"
 
 
 def add_parser(sub):
@@ -24,91 +37,133 @@ def add_parser(sub):
     x = s.add_parser("serve", help="run the onboard computer until Ctrl-C")
     add_serve_arguments(x)
     x.set_defaults(func=serve)
-    c = s.add_parser("config", help="print the mission configuration as understood")
-    c.add_argument("config", nargs="?", help="mission folder or file (default: $OBSW_MISSION, "
-                   "or a mission.json here or above)")  # fmt: skip
+    c = s.add_parser("config", help="print the mission configuration and topology as understood")
+    c.add_argument("config", nargs="?", help=MISSION_HELP)
+    c.add_argument("--state", help="the state folder (default: the mission's)")
     c.set_defaults(func=show)
+    r = s.add_parser("reset", help="clear the mission's state folder (refused while it runs)")
+    r.add_argument("config", nargs="?", help=MISSION_HELP)
+    r.add_argument("--state", help="the state folder (default: the mission's)")
+    r.set_defaults(func=reset)
 
 
 def add_serve_arguments(x):
-    x.add_argument("config", nargs="?", help="mission folder or file (default: $OBSW_MISSION, "
-                   "or a mission.json here or above)")  # fmt: skip
+    x.add_argument("config", nargs="?", help=MISSION_HELP)
     x.add_argument("--state", help="folder for context, files and packet stores (default: the "
-                   "configuration's 'state', or a folder under the temp directory)")  # fmt: skip
+                   "configuration's 'state', or $XDG_STATE_HOME/obsw/<mission>)")  # fmt: skip
     x.add_argument("--il-dir", help="interaction layer name directory (default STATE/il)")
     x.add_argument("--process", help="run only this process of the configuration")
     x.add_argument("--parent", type=int, help=argparse.SUPPRESS)
     x.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
-def load(args, checked=False):
-    """The mission configuration of ``args``; with ``checked`` the whole folder is checked
-    first (``MissionError`` lists every problem)."""
-    from obsw_host import mission
-    from obsw_host.obc.config import load as load_config
-
-    config = mission.load(args.config).config if checked else load_config(args.config)
+def load(args):
+    config = load_config(args.config)
     if getattr(args, "state", None):
         config.state = os.path.abspath(args.state)
         config.il_directory = os.path.join(config.state, "il")
     elif "state" not in config.doc:
-        config.state = os.path.join(
-            tempfile.gettempdir(), "obsw-%s-%d" % (config.name, os.getuid())
-        )
-        config.il_directory = os.path.join(config.state, "il")
+        config.state = default_state(config.name)
+        if "il_directory" not in config.doc:
+            config.il_directory = os.path.join(config.state, "il")
     if getattr(args, "il_dir", None):
         config.il_directory = os.path.abspath(args.il_dir)
     return config
 
 
-def serve(args):
-    from obsw_host.errors import UserError
-    from obsw_host.mission import MissionError
-    from obsw_host.obc.config import ConfigError
+def check_mission(path):
+    """The problems of the whole mission folder at ``path`` (``obsw mission check``)."""
+    from obsw_host.mission.check import check  # jsonschema and the PLUTO checker: parent only
 
+    return check(locate(path))[1]
+
+
+def _refuse(text):
+    print("obsw obc: %s" % text, file=sys.stderr, flush=True)
+    return EXIT_REFUSED
+
+
+def serve(args):
     def out(text):
         if not args.quiet:
             print(text, file=sys.stderr, flush=True)
 
     try:
-        config = load(args, checked=not args.process)  # the platform manager checks, once
+        if not args.process:  # the platform manager checks the whole folder, once
+            problems = check_mission(args.config)
+            if problems:
+                for problem in problems:  # one line each: FILE: $.path: what; expected ...
+                    print(problem, file=sys.stderr, flush=True)
+                return EXIT_REFUSED
+        config = load(args)
+        topology = Topology(config)
         if args.process:
-            from obsw_host.obc.assembly import ObcProcess
+            return _serve_process(topology, args, out)
+        topology.check()  # component modules import, before anything starts
+    except (ConfigError, UserError) as e:
+        return _refuse(e)
+    from obsw_host.obc.platform import PlatformManager
 
-            ObcProcess(config, args.process, out=out).serve(parent=args.parent)
-        else:
-            from obsw_host.obc.platform import PlatformManager
+    try:
+        lock = StateLock(config.state).acquire()
+    except StateLocked as e:
+        return _refuse(e)
+    try:
+        out("%s: processes %s, state in %s (Ctrl-C stops)" % (
+            config.name, ", ".join(config.processes), config.state))  # fmt: skip
+        if not PlatformManager(topology, out=out).serve():
+            return _refuse("every process stopped: the OBC cannot run this mission")
+    except KeyboardInterrupt:
+        pass
+    finally:
+        lock.release()
+    return 0
 
-            out("%s: processes %s, state in %s (Ctrl-C stops)" % (
-                config.name, ", ".join(config.processes), config.state))  # fmt: skip
-            PlatformManager(config, out=out).serve()
-    except MissionError as e:
-        for problem in e.problems:  # one line each: FILE: $.path: what; expected ...
-            print(problem, file=sys.stderr)
-        return 2
-    except (ConfigError, UserError, KeyError) as e:
-        print("obsw obc: %s" % e, file=sys.stderr)
-        return 2
+
+def _serve_process(topology, args, out):
+    """One process of the topology. One that cannot be built says why in one line: status 2
+    for a configuration error (final: the platform manager does not restart it), else 1."""
+    from obsw_host.obc.assembly import ObcProcess
+
+    try:
+        process = ObcProcess(topology, args.process, out=out)
+    except ConfigError as e:
+        return _refuse("process %s: %s" % (args.process, e))
+    except Exception as e:  # one line, not a traceback; the platform manager counts it
+        print("obsw obc: process %s cannot start: %s: %s" % (
+            args.process, type(e).__name__, e), file=sys.stderr, flush=True)  # fmt: skip
+        return 1
+    try:
+        process.serve(parent=args.parent)
     except KeyboardInterrupt:
         pass
     return 0
 
 
 def show(args):
-    from obsw_host.errors import UserError
-    from obsw_host.obc.config import ConfigError
-
     try:
         config = load(args)
-    except (ConfigError, UserError) as e:
-        print("obsw obc: %s" % e, file=sys.stderr)
-        return 2
+        topology = Topology(config)
+    except ConfigError as e:
+        return _refuse(e)
     print(json.dumps({
-        "format": config.format, "name": config.name, "path": config.path,
-        "sdb": config.sdb_path, "host": config.host, "components": config.components,
+        "name": config.name, "path": config.path, "sdb": config.sdb_path, "host": config.host,
         "state": config.state, "il_directory": config.il_directory,
         "processes": config.processes, "platform": config.platform,
+        "topology": topology.describe(),
     }, indent=2))  # fmt: skip
+    return 0
+
+
+def reset(args):
+    try:
+        config = load(args)
+        removed = reset_state(config.state)
+    except ConfigError as e:
+        return _refuse(e)
+    except StateLocked as e:
+        return _refuse("%s: not reset" % e)
+    print(("removed %s" if removed else "nothing to remove at %s") % config.state)
     return 0
 
 

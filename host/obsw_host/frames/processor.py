@@ -163,7 +163,10 @@ class FrameProcessorHost:
     def step(self, timeout=0.05):
         """Wait up to ``timeout`` for input, process it, write due telemetry to both links."""
         inputs = self.links + [self.tm] + list(self.vc_inputs)
-        readable, _, _ = select.select(inputs, [], [], timeout)
+        waiting = [link for link in self.links if getattr(link, "queue", None) and link.pending()]
+        readable, writable, _ = select.select(inputs, waiting, [], timeout)
+        for link in writable:  # a queued link's UART drained: write what waits
+            link.flush()
         now = self.clock()
         for i, link in enumerate(self.links):
             if link in readable:

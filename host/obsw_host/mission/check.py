@@ -17,11 +17,12 @@ from obsw.pus import sdb as sdb_module
 from obsw.spacecan.equipment import equipment_interface
 from obsw.spacecan.nodedef import NodeDefinition, NodeDefinitionError
 
-from obsw_host.mission import components as plugins
 from obsw_host.mission import defaults
-from obsw_host.mission.config import KINDS, WITH_PUS, ConfigError, MissionConfig
 from obsw_host.mission.errors import Problem, did_you_mean, short
 from obsw_host.mission.schema import json_type, read_json, validate
+from obsw_host.obc.config import ConfigError, MissionConfig
+from obsw_host.obc.plugins import Component, PluginError
+from obsw_host.obc.registry import KINDS, WITH_PUS
 
 _INT_BOUNDS = {
     "uint8": (0, 0xFF),
@@ -124,9 +125,12 @@ class _Checker:
             if not isinstance(spec, dict) or not isinstance(spec.get("module"), str):
                 continue
             try:
-                itf, _, _ = plugins.load(name, spec, self.folder)
-            except plugins.PluginError as e:
-                self.add(self.file, ["components", name, e.key], str(e))
+                itf, _ = Component(name, spec, self.folder).check()
+            except PluginError as e:
+                text = str(e)[len(e.key) + 2 :]
+                if "; expected" not in text:
+                    text += "; expected a module with the Interface %s and its class" % name
+                self.add(self.file, ["components", name, e.key.rsplit(".", 1)[1]], text)
                 self.unresolved.add(name)
                 continue
             self.interfaces[name] = itf

@@ -1,7 +1,7 @@
-"""The mission's defaults, in one place: the ``default`` annotations of the shipped JSON Schemas.
+"""The shipped JSON Schemas and their ``default`` annotations, as an editor shows them.
 
-``section("platform")`` is ``{"heartbeat": 0.5, ...}``: what the OBC uses for a key the mission
-file leaves out, as an editor shows it from the schema.
+``section("platform")`` is ``{"heartbeat": 0.5, ...}``; a test keeps these equal to what the
+OBC uses for a key the mission file leaves out (``obsw_host.obc.defaults``).
 """
 
 import json

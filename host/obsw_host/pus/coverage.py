@@ -12,9 +12,8 @@ import os
 import shutil
 import tempfile
 
-from obsw.pus import sdb as sdb_module
-
 from obsw_host.obc import config as obc_config
+from obsw_host.obc.topology import Topology
 from obsw_host.obc.units import PusUnit
 from obsw_host.pus.standard import MESSAGE_TYPES, SERVICE_NAMES
 
@@ -27,13 +26,14 @@ def obc_services(config_path=None):
     config.doc = copy.deepcopy(config.doc)
     if "cfdp" in config.doc:
         config.doc["cfdp"]["port"] = 0
-    kinds = config.processes[config.process_of("pus")]
+    topology = Topology(config)
+    process = topology.process_of("pus")
     state = tempfile.mkdtemp(prefix="obsw-coverage-")
     config.state = state
     config.il_directory = os.path.join(state, "il")
     os.makedirs(config.il_directory)
     try:
-        unit = PusUnit(config, sdb_module.load(config.sdb_path), kinds, out=lambda *a: None)
+        unit = PusUnit(topology, process, out=lambda *a: None)
         try:
             return dict(unit.app.services)
         finally:

@@ -139,7 +139,7 @@ def _twice(folder):
 
 # (name, how the folder is spoiled, file of the line, text the line must contain)
 MISTAKES = [
-    ("duplicate component", sdb(_dup_component), "sdb.json", "$.components[2].name"),
+    ("duplicate component", sdb(_dup_component), "sdb.json", "component SolarPanel declared twice"),
     ("duplicate attribute", sdb(_dup_attribute), "sdb.json", "SolarPanel.angle declared twice"),
     ("duplicate parameter id",
      sdb(lambda d: _set(attribute(d, "CpduN", "health"), "parameter", 20)),
@@ -215,7 +215,7 @@ MISTAKES = [
      "mission.json", "$.components.SolarPanel.module"),
     ("component class not in its module",
      mission(lambda d: _set(d["components"]["SolarPanel"], "class", "Panel")),
-     "mission.json", "$.components.SolarPanel.class: obsw_host.solar_panel has no class Panel"),
+     "mission.json", "$.components.SolarPanel.class: obsw_host.solar_panel has no class 'Panel'"),
     ("kind in two processes",
      mission(lambda d: _set(d["processes"], "spare", ["spacecan"])),
      "mission.json", "$.processes.spare[0]: \"spacecan\" already runs in process \"obc\""),

@@ -139,7 +139,8 @@ def _twice(folder):
 
 # (name, how the folder is spoiled, file of the line, text the line must contain)
 MISTAKES = [
-    ("duplicate component", sdb(_dup_component), "sdb.json", "component SolarPanel declared twice"),
+    ("duplicate component", sdb(_dup_component), "sdb.json",
+     "component SolarPanel declared twice"),
     ("duplicate attribute", sdb(_dup_attribute), "sdb.json", "SolarPanel.angle declared twice"),
     ("duplicate parameter id",
      sdb(lambda d: _set(attribute(d, "CpduN", "health"), "parameter", 20)),

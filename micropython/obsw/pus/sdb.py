@@ -22,7 +22,8 @@ PLUTO's checker), ``position_scheduling`` (service 22's position parameter), ``f
 (``tm_vcs``: the TM virtual channel plan, role -> VC ID, and ``scid``; ``tc_vc``, ``maps`` and
 ``cfdp_vc`` are kept in ``frames`` for the mission's ids), ``pus`` (the packet layout and the
 ground's source id, read by ``obsw.pus.config.from_sdb``) and ``nodes`` (SpaceCAN equipment:
-name, node id, node definition file relative to the database file).
+name, node id, node definition file relative to the database file) and ``services`` (the
+mission's own PUS services, types 128..255: ``obsw.pus.sdb_services``).
 
 ``filestores`` maps the path prefixes of file management (``SAT:/data/x``) to CFDP entity
 ids (the onboard one is the first, unless one says ``"local": true``); ``memories`` declares
@@ -309,6 +310,7 @@ class Sdb:
         self.frames = {}  # the frames plan as given (scid, tc_vc, maps, tm_vcs, cfdp_vc)
         self.pus = {}  # the PUS section as given: packet layout and source id (obsw.pus.config)
         self.nodes = {}  # SpaceCAN equipment name -> NodeDef
+        self.services = {}  # mission service type (128..255) -> sdb_services.ServiceDef
         self.base = base  # the folder relative paths start from
         self._params_by_name = {}
         self._events_by_name = {}
@@ -390,6 +392,31 @@ class Sdb:
         self._load_files(doc)
         self._load_functions(doc)
         self._load_spacecraft(doc)
+        if doc.get("services"):
+            self._load_services(doc["services"])
+
+    def _load_services(self, items):
+        # imported here, not at the top: a database with no mission service (a small
+        # board's) does not pay the module's heap
+        from obsw.pus.sdb_services import load_services, signatures
+
+        self.services = load_services(items)
+        for name, sig in signatures(self.services).items():
+            if name not in self.operations:  # the request declares the activity's signature
+                comp, op = name.split(".", 1)
+                args = [(a[0], a[2]) for a in sig]
+                self.operations[name] = OperationDef(comp, op, args, sig)
+
+    def service(self, key):
+        """The mission ServiceDef with this type or name."""
+        s = self.services.get(key) if isinstance(key, int) else None
+        if s is None:
+            for candidate in self.services.values():
+                if candidate.name == key:
+                    s = candidate
+        if s is None:
+            raise KeyError("no mission service %r in the spacecraft database" % (key,))
+        return s
 
     def _load_functions(self, doc):
         for f in doc.get("functions", []):
@@ -571,6 +598,7 @@ _KNOWN = (
     "frames",
     "nodes",
     "pus",
+    "services",
 )
 
 

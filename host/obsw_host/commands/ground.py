@@ -14,6 +14,7 @@
     obsw ground time rate 0 | listen
     obsw ground connection 10
     obsw ground function SolarPanel.set_angle angle=15          service 8
+    obsw ground service mtq dipole x=0.1 y=0 z=0    a mission service (types 128..255)
     obsw ground schedule insert --in 10 function SolarPanel.set_angle angle=20
     obsw ground schedule insert --at 2030-01-01T00:00:00Z ping
     obsw ground schedule list | summary | shift 30 | delete 0:10:5 | enable | disable | reset
@@ -21,7 +22,7 @@
     obsw ground position list
     obsw ground monitor [--log session.log] [--seconds N] [--count N]   live TM view
     obsw ground replay session.log          a session log, decoded again
-    obsw ground list parameters|functions|events|hk    from the database
+    obsw ground list parameters|functions|events|hk|services    from the database
     obsw ground list obcps | files [REPOSITORY]         from the on-board process
     obsw ground monitor add 1 SolarPanel.speed 0.5 10 --high-event monitoring.speed_high
     obsw ground monitor list | out-of-limits | enable 1 | disable 1 | delete 1
@@ -37,7 +38,8 @@
     obsw ground position orbit N     (commands of services 6, 15, 21, 22: see their --help)
 
 A request to schedule, sequence or run as an action is ``ping``, ``function NAME
-[ARG=VALUE..]`` or ``set NAME=VALUE..``; activities are named SOURCE:APID:SEQ.
+[ARG=VALUE..]``, ``service NAME REQUEST [ARG=VALUE..]`` or ``set NAME=VALUE..``;
+activities are named SOURCE:APID:SEQ.
 
 Every ground client receives all TM the on-board process sends (events, verification,
 housekeeping), whichever client's TC caused it. ``--log FILE`` appends every TC and TM of the
@@ -160,6 +162,14 @@ def _add_automation(s):
     x.add_argument("name", help="function name or ID")
     x.add_argument("arguments", nargs="*", metavar="ARG=VALUE")
     x.set_defaults(func=_function)
+    x = s.add_parser(
+        "service",
+        help="a request of a mission service (types 128..255; `list services` names them)",
+    )
+    x.add_argument("service", help="mission service name or type")
+    x.add_argument("request", help="request name or subtype")
+    x.add_argument("arguments", nargs="*", metavar="ARG=VALUE")
+    x.set_defaults(func=_service)
 
     for svc, name, tag in (("schedule", "time-based", "--in"), ("position", "position-based", "")):
         sp = s.add_parser(
@@ -257,7 +267,7 @@ def _add_operator(s):
     x = s.add_parser("list", help="parameters, functions, events, hk, obcps, files")
     x.add_argument(
         "kind",
-        choices=("parameters", "functions", "events", "hk", "obcps", "files"),
+        choices=("parameters", "functions", "events", "hk", "services", "obcps", "files"),
         help="what to list (obcps and files ask the on-board process)",
     )
     x.add_argument(
@@ -559,9 +569,12 @@ def _request(g, words):
         return g.function_request(_key(words[1]), **args)
     if kind == "set" and len(words) >= 2:
         return g.parameter_request(_assignments(words[1:]))
+    if kind == "service" and len(words) >= 3:
+        return _mission_call(g.service_request, words[1], words[2], words[3:])
     raise UserError(
         "request %r" % " ".join(words),
-        expected="ping | function NAME [ARG=VALUE..] | set NAME=VALUE..",
+        expected="ping | function NAME [ARG=VALUE..] | service NAME REQUEST [ARG=VALUE..] | "
+        "set NAME=VALUE..",
     )
 
 
@@ -579,6 +592,26 @@ def _function(args):
         return g.perform(_key(args.name), **values)
 
     return _run(args, go)
+
+
+def _mission_call(method, service, request, words):
+    """``method(service, request, **arguments)`` with mistakes in the names, types or ranges
+    of the arguments said as the user's."""
+    from obsw.pus.services.mission import MissionArgumentError
+
+    values = {str(k): v for k, v in _assignments(words).items()}
+    try:
+        return method(_key(service), _key(request), **values)
+    except KeyError as e:
+        raise UserError(str(e.args[0]) if e.args else str(e)) from None
+    except MissionArgumentError as e:
+        raise UserError(str(e)) from None
+
+
+def _service(args):
+    return _run(
+        args, lambda g: _mission_call(g.call_service, args.service, args.request, args.arguments)
+    )
 
 
 def _sched_insert(args):

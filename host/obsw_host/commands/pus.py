@@ -3,7 +3,8 @@
 `obsw pus coverage [CONFIG]` lists every message type of ECSS-E-ST-70-41C services 1-23, by
 service, and whether the OBC of mission CONFIG (a mission folder or its file; default:
 $OBSW_MISSION, or a mission.json here or above) serves it, from the service tables its PUS
-application process registers. `--missing` lists only the types not served; `--json` prints
+application process registers, then the mission's own services (types 128..255) apart.
+`--missing` lists only the types not served; `--json` prints
 the whole report for scripts.
 """
 
@@ -40,4 +41,13 @@ def coverage_cmd(args):
             mark = "served" if t["served"] else "MISSING"
             print("  %-10s %-7s %s" % (t["type"], mark, t["title"]))
     print("%d of %d message types served" % (report["served"], report["total"]))
+    if report["mission_services"]:
+        print("mission services (types 128..255, apart from the standard's):")
+    for s in report["mission_services"]:
+        print("ST[%d] %-33s %3d of %3d" % (s["service"], s["name"], s["served"], s["total"]))
+        for t in s["types"]:
+            if args.missing and t["served"]:
+                continue
+            mark = "served" if t["served"] else "MISSING"
+            print("  %-10s %-7s %s" % (t["type"], mark, t["name"]))
     return 0

@@ -212,6 +212,7 @@ class _Checker:
         self._housekeeping(f, doc, params)
         self._nodes(f, doc)
         self._functions(f, doc)
+        self._services(f, doc)
         self._files(f, doc)
         pos = doc.get("position_scheduling")
         if isinstance(pos, dict) and "parameter" in pos:
@@ -532,6 +533,70 @@ class _Checker:
                         "%s takes no argument %s; expected one of %s%s"
                         % (name, an, ", ".join(params), did_you_mean(an, params)),
                     )
+
+    # -- mission services (types 128..255): ids once, operations and events of the component
+
+    def _services(self, f, doc):
+        ops = self._operations(doc)
+        types, names = {}, set()
+        for i, svc in _dicts(doc.get("services")):
+            at = ["services", i]
+            t, name, comp = svc.get("type"), svc.get("name"), svc.get("component")
+            if _is_int(t) and t in types:
+                self.add(f, at + ["type"], "service type %d is also %s's; expected each type "
+                         "once" % (t, types[t]))  # fmt: skip
+            types.setdefault(t, name)
+            if name in names:
+                self.add(f, at + ["name"], "service %s declared twice; expected each name once"
+                         % short(name))  # fmt: skip
+            names.add(name)
+            subtypes = {}
+            for kind in ("requests", "reports"):
+                for j, m in _dicts(svc.get(kind)):
+                    sub = m.get("subtype")
+                    if _is_int(sub) and sub in subtypes:
+                        self.add(f, at + [kind, j, "subtype"], "subtype %d is also %s's; "
+                                 "expected each subtype of a service once, requests and "
+                                 "reports together" % (sub, subtypes[sub]))  # fmt: skip
+                    subtypes.setdefault(sub, m.get("name"))
+            reports = [m.get("subtype") for _, m in _dicts(svc.get("reports"))]
+            for j, r in _dicts(svc.get("requests")):
+                if "report" in r and r["report"] not in reports:
+                    self.add(f, at + ["requests", j, "report"], "no report subtype %s in "
+                             "service %s; expected one of %s" % (r["report"], short(name),
+                             ", ".join(str(x) for x in reports) or "none"))  # fmt: skip
+            if isinstance(comp, str) and comp not in self.unresolved:
+                self._service_component(f, at, svc, comp, ops)
+
+    def _service_component(self, f, at, svc, comp, ops):
+        if comp not in ops:
+            self.add(f, at + ["component"], "no component %s with operations; expected a "
+                     "component of mission.json's components, a node, or one declaring "
+                     "operations%s" % (comp, did_you_mean(comp, ops)))  # fmt: skip
+            return
+        for j, r in _dicts(svc.get("requests")):
+            op = r.get("operation")
+            if not isinstance(op, str):
+                continue
+            if op not in ops[comp]:
+                self.add(f, at + ["requests", j, "operation"], "%s has no operation %s; "
+                         "expected one of %s%s" % (comp, op, ", ".join(sorted(ops[comp])),
+                                                   did_you_mean(op, ops[comp])))  # fmt: skip
+                continue
+            params = ops[comp][op]
+            given = [a.get("name") for _, a in _dicts(r.get("arguments"))]
+            if params is not None and given != list(params):
+                self.add(f, at + ["requests", j, "arguments"], "%s.%s takes (%s); expected the "
+                         "request's arguments in that order, got (%s)" % (comp, op,
+                         ", ".join(params), ", ".join(str(g) for g in given)))  # fmt: skip
+        itf = self.interfaces.get(comp)
+        events = [e.name for e in itf.events] if itf is not None else None
+        for j, r in _dicts(svc.get("reports")):
+            ev = r.get("event")
+            if isinstance(ev, str) and events is not None and ev not in events:
+                self.add(f, at + ["reports", j, "event"], "%s has no event %s; expected one "
+                         "of %s%s" % (comp, ev, ", ".join(events) or "none",
+                                      did_you_mean(ev, events)))  # fmt: skip
 
     def _files(self, f, doc):
         prefixes, entities, local = {}, {}, None

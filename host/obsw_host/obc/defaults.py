@@ -8,6 +8,7 @@ PUS = {
     "period": 0.1,  # seconds per activity cycle
     "playback_rate": 64,  # packets per second service 15 plays back
     "device_timeout": 5.0,  # seconds service 2 waits for a device
+    "service_timeout": 5.0,  # seconds a mission service (128..255) waits for its component
     "follow_period": 0.25,  # seconds between looks for components that (re)appeared
     "time_code": "cuc",  # ST[09] time reports: "cuc" (TM[9,2]) or "cds" (TM[9,3])
 }

@@ -1,13 +1,14 @@
 """What a spacecraft database offers an operator, as rows for tables or JSON.
 
-``catalog(sdb, kind)`` lists ``parameters``, ``functions``, ``events`` or ``hk`` (housekeeping
-structures); ``table(rows)`` lays rows out as aligned text columns.
+``catalog(sdb, kind)`` lists ``parameters``, ``functions``, ``events``, ``hk`` (housekeeping
+structures) or ``services`` (the mission's own, types 128..255: one row per request and
+report); ``table(rows)`` lays rows out as aligned text columns.
 """
 
 from obsw.pus.services.s05_events import SEVERITY_NAMES
 from obsw.pus.services.s08_functions import functions
 
-KINDS = ("parameters", "functions", "events", "hk")
+KINDS = ("parameters", "functions", "events", "hk", "services")
 
 
 def _type(spec):
@@ -98,11 +99,48 @@ def housekeeping(sdb):
     return out
 
 
+def _field_text(f):
+    text = "%s: %s" % (f.name, _type(f.type_spec))
+    if f.unit:
+        text += " " + f.unit
+    if f.range is not None:
+        text += " " + _bounds(f.range)
+    return text
+
+
+def services(sdb):
+    """The mission services' requests (TC) and reports (TM), one row each."""
+    out = []
+    for stype in sorted(sdb.services):
+        s = sdb.services[stype]
+        messages = list(s.requests.values()) + list(s.reports.values())
+        for m in sorted(messages, key=lambda m: m.subtype):
+            if m.kind == "request":
+                does = s.operation(m)
+                if m.report is not None:
+                    does += " -> " + s.reports[m.report].name
+            else:
+                does = "on %s.%s" % (s.component, m.event) if m.event else "reply"
+            out.append(
+                {
+                    "type": "%s[%d,%d]"
+                    % ("TC" if m.kind == "request" else "TM", stype, m.subtype),
+                    "name": m.qualified,
+                    "does": does,
+                    "fields": ", ".join(_field_text(f) for f in m.fields),
+                }
+            )
+    return out
+
+
 def catalog(sdb, kind):
     """Rows (dicts) of ``kind``, one of KINDS."""
-    return {"parameters": parameters, "functions": function_rows, "events": events}.get(
-        kind, housekeeping
-    )(sdb)
+    return {
+        "parameters": parameters,
+        "functions": function_rows,
+        "events": events,
+        "services": services,
+    }.get(kind, housekeeping)(sdb)
 
 
 def table(rows, columns=None):

@@ -12,6 +12,8 @@ import os
 import shutil
 import tempfile
 
+from obsw.pus.sdb_services import FIRST_MISSION_TYPE
+
 from obsw_host.obc import config as obc_config
 from obsw_host.obc.topology import Topology
 from obsw_host.obc.units import PusUnit
@@ -86,7 +88,46 @@ def coverage(services):
         "served": sum(s["served"] for s in out),
         "total": sum(s["total"] for s in out),
         "services": out,
+        "mission_services": mission_services(services),
     }
+
+
+def mission_services(services):
+    """The mission's own services (types 128..255) the OBC registers, apart from the
+    standard's: each request (TC) and report (TM) its database declares, and whether the
+    provider serves it."""
+    out = []
+    for number in sorted(n for n in services if n >= FIRST_MISSION_TYPE):
+        provider = services[number]
+        definition = getattr(provider, "definition", None)
+        types = []
+        for kind, table in (("TC", "requests"), ("TM", "reports")):
+            for sub, m in sorted(getattr(definition, table, {}).items()):
+                if kind == "TC":
+                    served = provider.handler(sub) is not None
+                else:
+                    served = (number, sub) in provider.REPORTS
+                types.append(
+                    {
+                        "type": "%s[%d,%d]" % (kind, number, sub),
+                        "subtype": sub,
+                        "kind": kind,
+                        "name": m.name,
+                        "served": served,
+                    }
+                )
+        types.sort(key=lambda t: t["subtype"])
+        out.append(
+            {
+                "service": number,
+                "name": getattr(definition, "name", ""),
+                "provider": type(provider).__name__,
+                "served": sum(1 for t in types if t["served"]),
+                "total": len(types),
+                "types": types,
+            }
+        )
+    return out
 
 
 def markdown(report):

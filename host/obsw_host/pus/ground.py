@@ -7,6 +7,7 @@
         ground.set_parameter("SolarPanel.speed", 7.5)
         ground.get_parameters("SolarPanel.speed")   # {'SolarPanel.speed': 7.5}
         ground.perform("SolarPanel.set_angle", angle=15.0)          # service 8
+        ground.call_service("mtq", "dipole", x=0.1, y=0.0, z=0.0)   # a mission service
         act = ground.function_request("SolarPanel.set_angle", angle=20.0)
         ground.schedule_in(5.0, act)          # service 11; act.ok once it has run on board
         ground.add_limit_monitor(1, "SolarPanel.speed", 0.5, 10.0,
@@ -26,6 +27,7 @@ import socket
 
 from obsw.il.clock import REAL_CLOCK
 from obsw.pus.config import DEFAULT, from_sdb
+from obsw.pus.services.mission import MissionServiceUser
 from obsw.pus.services.s03_housekeeping import HousekeepingUser
 from obsw.pus.services.s05_events import EventUser
 from obsw.pus.services.s08_functions import FunctionUser, functions
@@ -114,6 +116,9 @@ class Ground:
             self.monitoring = reg(FunctionalMonitoringUser(types, ids))
         else:
             self.hk = self.events = self.params = self.functions = self.monitoring = None
+        self.mission_services = {}  # mission service name -> its user (types 128..255)
+        for definition in sdb.services.values() if sdb is not None else ():
+            self.mission_services[definition.name] = reg(MissionServiceUser(definition))
 
     # -------------------------------------------------------------------------- I/O
 
@@ -271,6 +276,26 @@ class Ground:
         """A TC[20,3] for on-board use (see ``request``)."""
         items = self.params.raw_items(values)
         return self.request(20, 3, self.params.layout.pack({"items": items}), apid)
+
+    def mission_service(self, key):
+        """The user of mission service ``key`` (its name or type)."""
+        definition = self.sdb.service(key) if self.sdb is not None else None
+        if definition is None:
+            raise KeyError("no mission service %r: the ground has no database" % (key,))
+        return self.mission_services[definition.name]
+
+    def service_request(self, service, request, apid=None, **arguments):
+        """A request of a mission service for on-board use (see ``request``); its arguments
+        are checked against their types and ranges (MissionArgumentError)."""
+        user = self.mission_service(service)
+        r = user.definition.request(request)
+        return self.request(r.service.type, r.subtype, user.pack(request, arguments), apid)
+
+    def call_service(self, service, request, apid=None, timeout=None, **arguments):
+        """Send request ``request`` of mission service ``service`` (names or numbers) with
+        named arguments, checked first; ``tx.reply`` is its report decoded by name."""
+        user = self.mission_service(service)
+        return self._issue(user.send(self._apid(apid), request, arguments), timeout)
 
     def perform(self, key, apid=None, timeout=None, **arguments):
         """TC[8,1]: perform function ``key`` (ID or name) with named arguments."""

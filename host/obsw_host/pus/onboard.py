@@ -2,9 +2,10 @@
 
 ``Onboard(sdb)`` builds the application process with the services of ``SERVICES`` (the one
 service table of the PUS process) whose needs are met: 1, 3, 5, 8, 9, 11, 12, 17, 19, 20, 21,
-and 22 when the database names a ``position_scheduling`` parameter; the OBC's PUS unit gives
-what the others need (``needs``: a filestore for 6, 15 and 23, the OBCP engine for 18, the
-OBC itself for 2, 4, 13 and 14). A parameter pool and an event manager on an interaction
+and 22 when the database names a ``position_scheduling`` parameter, and one ``MissionService``
+per mission service (types 128..255) the database declares (``service_table``); the OBC's PUS
+unit gives what the others need (``needs``: a filestore for 6, 15 and 23, the OBCP engine for
+18, the OBC itself for 2, 4, 13 and 14). A parameter pool and an event manager on an interaction
 layer node follow the components (also those that start later or restart), and TCs are
 served from UDP. TM goes to every ground client that sent a TC or
 subscribed (``obsw_host.pus.tm_fanout``), and to ``tm_to`` if given; each TM is logged
@@ -25,6 +26,7 @@ from obsw.pus.app import ApplicationProcess
 from obsw.pus.config import from_sdb
 from obsw.pus.events import EventManager
 from obsw.pus.parameters import ParameterPool
+from obsw.pus.services.mission import MissionService
 from obsw.pus.services.s02_device_access import DeviceAccess
 from obsw.pus.services.s03_housekeeping import Housekeeping
 from obsw.pus.services.s04_statistics import ParameterStatistics
@@ -138,6 +140,20 @@ SERVICES = (
 )
 
 
+# -- mission services (types 128..255): one row of the table per service the database declares
+
+
+def _mission_row(definition):
+    timeout = lambda c: float(c.option("service_timeout", 5))  # noqa: E731
+    return (definition.type, (), lambda c: MissionService(definition, c.node, timeout(c)))
+
+
+def service_table(sdb, table=SERVICES):
+    """The PUS process's service table: ``table`` (the standard's services) and a row for
+    each mission service ``sdb`` declares (``obsw.pus.sdb_services``)."""
+    return tuple(table) + tuple(_mission_row(d) for d in sdb.services.values())
+
+
 class _Protocol(asyncio.DatagramProtocol):
     def __init__(self, onboard):
         self.onboard = onboard
@@ -223,8 +239,11 @@ class Onboard:
             setattr(self.context, k, v)
         self.register_services(self.context)
 
-    def register_services(self, context, table=SERVICES):
-        """Build and register every service of ``table`` whose needs ``context`` meets."""
+    def register_services(self, context, table=None):
+        """Build and register every service of ``table`` (default: ``service_table``, the
+        standard's and the mission's) whose needs ``context`` meets."""
+        if table is None:
+            table = service_table(context.sdb)
         for number, needs, build in table:
             if number in self.app.services:
                 continue

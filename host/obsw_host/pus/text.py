@@ -311,6 +311,21 @@ def _parameter(sdb, key):
         return None
 
 
+def mission_report(v, sdb=None):
+    """A report of a mission service: its name, then each field with its unit."""
+    units = {}
+    try:
+        report = sdb.service(v["service"]).message(v["report"])
+        units = {f.name: f.unit for f in report.fields}
+    except (AttributeError, KeyError):
+        pass  # no database, or another one: the names alone
+    lines = ["%s.%s" % (v["service"], v["report"])]
+    for k, x in v["fields"].items():
+        unit = units.get(k)
+        lines.append("%s = %s%s" % (k, _number(x), " " + unit if unit else ""))
+    return "\n".join(lines)
+
+
 def value_text(sdb, key, raw_value, raw=False):
     """A parameter's value as an operator reads it: engineering value and unit, the raw value
     in parentheses when it differs (``raw``: the raw value and its raw unit only)."""
@@ -381,6 +396,8 @@ def readable(value, sdb=None, raw=False):
         return str(v)
     if v == {"alive": True}:
         return "alive"
+    if set(v) == {"service", "report", "fields"} and isinstance(v["fields"], dict):
+        return mission_report(v, sdb)
     if isinstance(v.get("values"), dict):
         lines = ["structure %s" % v["sid"]] if "sid" in v else []
         for k, x in v["values"].items():

@@ -82,6 +82,7 @@ class Spacecraft:
         self.functions = functions  # id -> Function
         self.structures = structures  # [Structure]
         self.filestores = filestores  # prefix -> CFDP entity id
+        self.services = {}  # mission services (types 128..255): type -> sdb_services.ServiceDef
 
     def apid(self, name, default=None):
         return self.apids.get(name, default)
@@ -134,7 +135,7 @@ def from_sdb(db, ids):
         Structure(h["sid"], h["interval"], list(h["parameters"]), h["enabled"])
         for h in db.housekeeping
     ]
-    return Spacecraft(
+    sc = Spacecraft(
         db.mission,
         dict(db.apids),
         params,
@@ -144,6 +145,8 @@ def from_sdb(db, ids):
         dict(db.filestores),
         ids,
     )
+    sc.services = dict(db.services)  # the mission's own services: type -> ServiceDef
+    return sc
 
 
 def load(path=None):

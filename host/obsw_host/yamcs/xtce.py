@@ -11,7 +11,8 @@
 - the telecommands: an abstract ``pus_tc`` whose verifiers follow the service 1 reports
   (acceptance, start, completion, by APID and sequence count), services 3, 5, 8 (one command
   per function with its typed arguments), 11, 12 (a limit check for each parameter with
-  limits), 17, 18, 20 (one set command per writable parameter, its range checked) and 23.
+  limits), 17, 18, 20 (one set command per writable parameter, its range checked) and 23;
+- the mission's own services (types 128..255): a command per request, a container per report.
 """
 
 import xml.etree.ElementTree as ET
@@ -881,7 +882,36 @@ class Generator:
         self.functional_monitoring()
         self.parameter_definitions()
         self.services_2_3_9_14()
+        self.mission_services()
         return self.root.element()
+
+    # ------------------------------------------------------------------ services 128..255
+    def mission_services(self):
+        """The mission's own services (``services`` of the database): one command per request
+        in a sub-system named after the service (``/MISSION/mtq/dipole``), its arguments typed
+        with their units and ranges; one container per report (``mtq_dipole_report``)."""
+        for stype in sorted(getattr(self.sc, "services", None) or {}):
+            svc = self.sc.services[stype]
+            system = self.root.child(_label(svc.name))
+            for sub in sorted(svc.requests):
+                req = svc.requests[sub]
+                fields = []
+                for f in req.fields:
+                    atype = argument_type("", (f.type.ptc, f.type.pfc), f.unit, valid=f.range)
+                    fields.append(("arg", _label(f.name), atype))
+                what = "TC[%d,%d] %s: %s" % (stype, sub, req.qualified, svc.operation(req))
+                self.command(system, _label(req.name), (stype, sub), fields, what)
+            for sub in sorted(svc.reports):
+                rep = svc.reports[sub]
+                refs = []
+                for f in rep.fields:
+                    pname = "%s_%s" % (_label(rep.name), _label(f.name))
+                    refs.append(
+                        system.parameter(
+                            pname, parameter_type("", (f.type.ptc, f.type.pfc), f.unit)
+                        )
+                    )
+                self.report(_label(rep.qualified), (stype, sub), refs)
 
     # ------------------------------------------------------------------ services 2, 3, 9, 14
     def services_2_3_9_14(self):

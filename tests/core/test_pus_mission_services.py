@@ -7,6 +7,9 @@ from obsw.il.clock import SimClock
 from obsw.il.errors import ComponentError
 from obsw.il.interface import Event, Interface, Operation
 from obsw.il.node import Node
+from obsw.pluto.il_system import IlSystem
+from obsw.pluto.interp import Procedure, load
+from obsw.pluto.lexer import PlutoError
 from obsw.pus.messages import FAILURE_ILLEGAL_SUBTYPE
 from obsw.pus.sdb import Sdb, SdbError
 from obsw.pus.services.mission import MissionArgumentError, MissionService, MissionServiceUser
@@ -248,6 +251,48 @@ class TestUser(unittest.TestCase):
     def test_pack_is_the_declared_layout(self):
         _, _, user, _, _ = make()
         self.assertEqual(user.pack("take_picture", {"exposure": 258, "gain": -1}), b"\x01\x02\xff")
+
+
+def procedure(main):
+    return (
+        "procedure main initiate and confirm step S main %s end main end step; "
+        "end main end procedure" % main
+    )
+
+
+class TestPluto(unittest.TestCase):
+    """A request of a mission service is an activity a procedure initiates by its names."""
+
+    def run_procedure(self, src):
+        clock = SimClock(1000.0)
+        node = Node("obc", clock)
+        camera = Camera()
+        node.provide(CAMERA, camera)
+        system = IlSystem(node, database(), timeout=0.5, activity_timeout=5.0)
+        p = Procedure(load(src, system), system, None, poll=0.5)
+        p.start(clock.now())
+        for _ in range(100):
+            node.poll()
+            w = p.run(clock.now())
+            if p.state != "running" or w is None or w.deadline is None:
+                break
+            clock.advance(max(0.0, w.deadline - clock.now()))
+        return p, camera
+
+    def test_initiate_a_request_by_its_service_and_name(self):
+        p, camera = self.run_procedure(procedure(
+            "initiate and confirm take picture of payload "
+            "with arguments exposure := 20 ms, gain := 1 end with;"
+        ))  # fmt: skip
+        self.assertEqual(p.outcome, "confirmed")
+        self.assertEqual(camera.calls, [("take_picture", 20, 1)])
+
+    def test_the_requests_signature_is_checked_at_load_time(self):
+        with self.assertRaises(PlutoError):
+            self.run_procedure(procedure(
+                "initiate and confirm take picture of payload "
+                "with arguments exposure := 20 ms, iso := 1 end with;"
+            ))  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -109,7 +109,8 @@ class Catalog:
 
     def add_sdb(self, sdb):
         """A spacecraft database: an ``obsw.pus.sdb.Sdb`` or its JSON document (a dict, parsed
-        by that one parser)."""
+        by that one parser). A request of a mission service is an activity under its own
+        names too (``dipole of mtq`` is ``Magnetorquer.set_dipole``)."""
         if isinstance(sdb, dict):
             from obsw.pus.sdb import Sdb
 
@@ -129,6 +130,13 @@ class Catalog:
         for e in sdb.events.values():
             if e.component:
                 self.add("event", e.component, e.name)
+        for svc in sdb.services.values():  # a mission service's request is an activity too
+            for r in svc.requests.values():
+                sig = [(f.name, argument_code(f.type_spec), _unit(f.unit)) for f in r.fields]
+                params = [(f.name, f.unit) for f in r.fields]
+                entry = ["activity", svc.component, r.operation, None, None, params, sig]
+                self.entries[(norm(svc.name), norm(r.name))] = entry
+        self._paths = {}
 
     def find(self, path):
         """The entry a PLUTO path names, or None."""

@@ -214,6 +214,17 @@ class TestProvider(unittest.TestCase):
         self.assertEqual(failure(tx), (4, FAILURE_EXECUTION, b"\x05"))
         self.assertEqual(provider.unfit_reports, 1)
 
+    def test_random_application_data_gets_a_verdict_never_an_exception(self):
+        loop, _, _, camera, _ = make()
+        seed = 12345
+        for _ in range(200):
+            seed = (seed * 1103515245 + 12345) & 0x7FFFFFFF  # the same bytes on both ports
+            data = bytes([(seed >> (i % 24)) & 0xFF for i in range(seed % 7)])
+            subtype = 1 + seed % 6
+            tx = loop.run_async(lambda s=subtype, d=data: loop.ground.send(APID, 140, s, d))
+            self.assertTrue(tx.done)
+        self.assertEqual(loop.app.counters.get("handler_errors", 0), 0)
+
     def test_no_interaction_layer_fails_the_start(self):
         loop, _, user, _, _ = make(with_node=False)
         tx = loop.run_async(lambda: user.send(APID, "calibrate", {}))

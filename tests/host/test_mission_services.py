@@ -113,6 +113,7 @@ def test_aurora_service_140_end_to_end(tmp_path):
         # the component refuses while disabled: the completion fails with its reason
         r = obsw(*ground, "service", "mtq", "dipole", "x=0.1", "y=0", "z=0")
         assert r.returncode == 1 and "completion failure: component error" in r.stdout, r.stdout
+        assert "(request mtq.dipole)" in r.stdout, r.stdout
         assert obsw(*ground, "function", "Magnetorquer.enable").returncode == 0
         r = obsw(*ground, "service", "mtq", "dipole", "x=0.1", "y=0", "z=0")
         assert r.returncode == 0, r.stdout + r.stderr

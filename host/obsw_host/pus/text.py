@@ -448,4 +448,18 @@ def failure_detail(tx, sdb=None):
         pid = int.from_bytes(bytes(data), "big")
         p = _parameter(sdb, pid)
         return "parameter %s" % (p.qualified if p is not None else pid)
+    if tx.tc.service in sdb.services and data and len(data) == 1:
+        return _mission_failure(sdb.services[tx.tc.service], tx.tc.subtype, failure, data[0])
     return ""
+
+
+def _mission_failure(service, subtype, failure, index):
+    """A mission service's failure data: the argument out of range (acceptance, its index),
+    else the request's subtype."""
+    request = service.requests.get(subtype)
+    if request is None:
+        return ""
+    if failure.get("stage") == 1 and index < len(request.fields):
+        f = request.fields[index]
+        return "argument %s of %s, range %s" % (f.name, request.qualified, list(f.range or ()))
+    return "request %s" % request.qualified

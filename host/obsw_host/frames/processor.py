@@ -40,14 +40,20 @@ def sdb_events(sdb):
     return sdb.apid("frames"), tuple(ids)
 
 
-def security_options(key_path, sdb, state_path=None):
+def security_options(key_path, sdb, state_path=None, segment_header=True):
     """The FrameProcessorHost options that authenticate TC frames with the key file at
     ``key_path`` and report rejections as the events of ``sdb`` (a spacecraft database)."""
     from obsw_host.frames import keys
 
-    security, state = keys.load(key_path, state_path)
+    security, tm_security, state = keys.load_all(key_path, state_path, segment_header)
     event_apid, event_ids = sdb_events(sdb)
-    return {"security": security, "state": state, "event_apid": event_apid, "event_ids": event_ids}
+    return {
+        "security": security,
+        "tm_security": tm_security,
+        "state": state,
+        "event_apid": event_apid,
+        "event_ids": event_ids,
+    }
 
 
 class _Clock:

@@ -66,7 +66,9 @@ class FrameProcessor:
     TC security: with ``security`` (an ``obsw.frames.sdls.TcSecurity``) every frame but a
     control command is verified after duplicate removal and before FARM-1; a rejected frame is
     counted (``tc_rejected``, and by outcome in ``security.counters``) and each of
-    ``rejected_listeners`` is called with (outcome, VC ID, SPI, sequence number).
+    ``rejected_listeners`` is called with (outcome, VC ID, SPI, sequence number). With
+    ``tm_security`` (an ``obsw.frames.sdls_gcm.TmSecurity``) the TM frames of the VCs it has
+    SAs for are encrypted and authenticated (SDLS AES-GCM).
     """
 
     def __init__(
@@ -88,6 +90,7 @@ class FrameProcessor:
         dedup_window=2.0,
         clcw_period=1.0,
         security=None,
+        tm_security=None,
     ):
         self.scid = scid
         self.route = route
@@ -117,7 +120,9 @@ class FrameProcessor:
             if tm_default_vcid is None:
                 tm_default_vcid = plan["realtime"]
         self.tm_plan = plan
-        self.mux = TmMultiplexer(scid, tm_frame_length, tm_channels, self._ocf)
+        self.mux = TmMultiplexer(
+            scid, tm_frame_length, tm_channels, self._ocf, security=tm_security
+        )
         self.tm_vc_of_apid = tm_vc_of_apid or {}
         if tm_default_vcid is None:
             tm_default_vcid = self.mux.channels[-1].vcid if tm_channels else 0

@@ -102,6 +102,9 @@ class SecurityAssociation:
     the sequence numbers of both ends (``sn_sent`` sending, ``window`` receiving; ``window`` and
     ``ahead`` as in ReplayWindow)."""
 
+    algorithm = "hmac-sha256"
+    link = "tc"  # or "tm" (GCM SAs of TM virtual channels)
+
     def __init__(
         self,
         spi,

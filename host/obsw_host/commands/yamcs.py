@@ -46,6 +46,10 @@ def _instance_options(x):
         help="PUS packets over TCP, or TC/TM frames with CLTUs and COP-1 over UDP",
     )
     x.add_argument("--http-port", type=int, default=HTTP_PORT, help="web and API port")
+    x.add_argument(
+        "--keys",
+        help="SDLS key file (frames mode): TC and TM protected with Yamcs' AES-256-GCM SDLS",
+    )
     for name, port in PORTS.items():
         x.add_argument(
             "--%s-port" % name.replace("_", "-"),
@@ -75,19 +79,30 @@ def xtce(args):
 
 
 def config(args):
+    from obsw.frames.sdls_keys import KeyFileError
+
     from obsw_host.yamcs import database
     from obsw_host.yamcs.instance import write_instance
 
-    mdb = write_instance(
-        args.dir,
-        database.load(args.sdb),
-        args.mode,
-        ports=_ports(args),
-        http_port=args.http_port,
-    )
+    try:
+        mdb = write_instance(
+            args.dir,
+            database.load(args.sdb),
+            args.mode,
+            ports=_ports(args),
+            http_port=args.http_port,
+            keys=args.keys,
+        )
+    except KeyFileError as e:
+        print("obsw yamcs config: %s" % e, file=sys.stderr)
+        return 2
     print(
         "Yamcs instance 'obsw' (%s links) in %s, mission database %s" % (args.mode, args.dir, mdb)
     )
+    if args.keys and args.mode == "frames":
+        print(
+            "SDLS: AES-256-GCM on TC and TM from %s, keys in %s/etc/sdls" % (args.keys, args.dir)
+        )
     return 0
 
 
@@ -137,9 +152,12 @@ def run(args):
         args.mode,
         tm_frames_port=ports["tm_frames"],
         ports=ports,
+        keys=args.keys if args.mode == "frames" else None,
     )
     try:
-        write_instance(folder, database.load(sdb_path), args.mode, ports, args.http_port)
+        write_instance(
+            folder, database.load(sdb_path), args.mode, ports, args.http_port, keys=args.keys
+        )
         sat.start()
         yamcs = server.Yamcs(folder, args.http_port)
         yamcs.start(timeout=120)

@@ -286,11 +286,12 @@ def cfdp_sql(apid):
 
 
 def write_instance(
-    folder, spacecraft, mode="packets", ports=None, http_port=HTTP_PORT, instances=None
+    folder, spacecraft, mode="packets", ports=None, http_port=HTTP_PORT, instances=None, keys=None
 ):
     """Write a Yamcs server for ``spacecraft`` into ``folder``: one instance named ``obsw`` with
     ``mode`` links on ``ports``, or the ``instances`` given as {name: (mode, ports)} (one
-    server, several instances). Returns the MDB path."""
+    server, several instances). Returns the MDB path. With ``keys`` (an SDLS key file), the
+    ``frames`` instances protect TC and TM with Yamcs' SDLS (``obsw_host.yamcs.sdls``)."""
     instances = instances or {INSTANCE: (mode, ports)}
     etc = os.path.join(folder, "etc")
     mdb = os.path.join(folder, "mdb")
@@ -313,6 +314,10 @@ def write_instance(
         config = instance_config(
             spacecraft, mode_, dict(PORTS, **(ports_ or {})), "mdb/" + mdb_name, ground, sat
         )
+        if keys is not None and mode_ == "frames":
+            from obsw_host.yamcs.sdls import secure_links
+
+            secure_links(config["dataLinks"], keys, etc)
         cfdp = config["services"][-1]["args"]
         cfdp["incomingBucket"] = name + "_down"
         cfdp["localEntities"][0]["bucket"] = name + "_down"  # where files to it land

@@ -185,15 +185,21 @@ pus_accelerator = speedups  # the PUS codec's name for it
 
 def aes_ecb(key):
     """AES encryption in ECB mode under ``key`` (16, 24 or 32 octets): a function that takes a
-    multiple of 16 octets and returns as many. MicroPython: ``cryptolib.aes`` (the boards
-    enable it); CPython: ``cryptography``. ImportError where the interpreter has neither."""
-    if MICROPYTHON:
-        import cryptolib
+    multiple of 16 octets and returns as many. MicroPython: ``cryptolib.aes``; CPython:
+    ``cryptography``; where neither is (an image built without cryptolib), AES in Python
+    (``obsw.frames.aes``), the same octets much slower."""
+    try:
+        if MICROPYTHON:
+            import cryptolib
 
-        return cryptolib.aes(bytes(key), 1).encrypt
-    from cryptography.hazmat.primitives.ciphers import Cipher, algorithms, modes
+            return cryptolib.aes(bytes(key), 1).encrypt
+        from cryptography.hazmat.primitives.ciphers import Cipher, algorithms, modes
 
-    return Cipher(algorithms.AES(bytes(key)), modes.ECB()).encryptor().update
+        return Cipher(algorithms.AES(bytes(key)), modes.ECB()).encryptor().update
+    except ImportError:
+        from obsw.frames.aes import Aes
+
+        return Aes(key).encrypt
 
 
 def gcm_accelerator(key):

@@ -4,6 +4,7 @@ import binascii
 import unittest
 
 from obsw import compat
+from obsw.frames.aes import Aes
 from obsw.frames.gcm import AesGcm, GcmAuthError, GcmError
 
 try:
@@ -151,6 +152,19 @@ class TestPaths(unittest.TestCase):
             data = _os.urandom(n)
             aad = _os.urandom(n % 23)
             self.assertEqual(AesGcm(key).encrypt(iv, data, aad), _pure(key).encrypt(iv, data, aad))
+
+    def test_python_aes_gives_fips197_vectors_and_agrees(self):
+        # FIPS 197 appendix C.1-C.3: AES-128/192/256 of 00112233...eeff under 000102...
+        block = _h("00112233445566778899aabbccddeeff")
+        for n, want in (
+            (16, "69c4e0d86a7b0430d8cdb78070b4c55a"),
+            (24, "dda97ca4864cdfe06eaf70a0ec0d7191"),
+            (32, "8ea2b7ca516745bfeafc49904b496089"),
+        ):
+            key = bytes(range(n))
+            self.assertEqual(Aes(key).encrypt(block + block), _h(want) * 2)
+            if n != 24:  # cryptolib (axTLS) has no AES-192
+                self.assertEqual(Aes(key).encrypt(block), compat.aes_ecb(key)(block))
 
     def test_block_function_is_aes(self):
         # FIPS 197 appendix C.3: AES-256 of 00112233...eeff

@@ -124,7 +124,9 @@ def main(argv=None):
     if args.json:
         print(json.dumps({"bench": "sdls", "rows": rows}))
         return 0
-    print("%-28s %-12s %14s %16s %7s" % ("case", "impl", "obsw frames/s", "cryptography/s", "ratio"))
+    print(
+        "%-28s %-12s %14s %16s %7s" % ("case", "impl", "obsw frames/s", "cryptography/s", "ratio")
+    )
     for case, impl, a, b in table:
         print("%-28s %-12s %14.0f %16.0f %7.2f" % (case, impl, a, b, b / a))
     return 0

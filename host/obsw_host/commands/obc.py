@@ -62,6 +62,10 @@ def serve(args):
 
     try:
         config = load(args)
+        if config.runs("frames"):  # refuse at once, before any process starts
+            from obsw_host.frames import policy
+
+            policy.check(config)
         if args.process:
             from obsw_host.obc.assembly import ObcProcess
 

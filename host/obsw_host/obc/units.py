@@ -350,11 +350,16 @@ class FramesUnit:
         tm_port = int(opts.get("tm_port", 4999))
         plan = sdb.tm_vcs
         security = {}
-        if opts.get("keys"):  # TC frames authenticated (SDLS) with this key file
+        from obsw_host.frames import policy
+
+        key_path = policy.check(config)  # secure by default: keys, or "tc_security": "none"
+        if key_path is None:
+            out(policy.OFF_WARNING)
+        else:  # TC (and TM, where the file has SAs for it) protected with SDLS
             from obsw_host.frames.processor import security_options
 
             state = os.path.join(config.state, "frames.keys.state")
-            security = security_options(config.resolve(opts["keys"]), sdb, state)
+            security = security_options(key_path, sdb, state)
         self.fp = FrameProcessorHost(
             links[0],
             links[1],

@@ -1,0 +1,82 @@
+"""Secure by default: an OBC whose mission runs the frame processor refuses to start, with one
+line and exit status 2, unless it has usable key material or says "tc_security": "none" (and
+then every start logs that commanding is unauthenticated)."""
+
+import json
+import os
+
+import pytest
+from obsw_host.cli import main
+from obsw_host.frames import keys, policy
+from obsw_host.obc import config as obc_config
+from obsw_host.obc.units import FramesUnit
+from obsw_host.sample import load_sdb
+
+
+def mission(tmp_path, **frames):
+    with open(obc_config.SAMPLE) as f:
+        doc = json.load(f)
+    base = os.path.dirname(obc_config.SAMPLE)
+    doc["sdb"] = os.path.join(base, doc["sdb"])
+    doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])
+    os.makedirs(tmp_path / "state", exist_ok=True)
+    doc["state"] = str(tmp_path / "state")
+    doc["processes"] = {"frames": ["frames"]}
+    doc["frames"] = dict({"uart_a": "pty", "uart_b": "pty", "tm_port": 0}, **frames)
+    path = tmp_path / "mission.json"
+    path.write_text(json.dumps(doc))
+    return str(path)
+
+
+def refused(capsys, path):
+    assert main(["obc", "serve", path]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    return err
+
+
+def test_no_keys_refuses_to_start(tmp_path, capsys):
+    err = refused(capsys, mission(tmp_path))
+    assert "frames.keys" in err and "tc_security" in err
+
+
+def test_missing_or_open_key_file_refuses_to_start(tmp_path, capsys):
+    assert "does not exist" in refused(capsys, mission(tmp_path, keys="absent.keys"))
+    path = tmp_path / "tc.keys"
+    keys.generate(str(path))
+    os.chmod(path, 0o644)
+    assert "chmod 600" in refused(capsys, mission(tmp_path, keys=str(path)))
+
+
+def test_key_file_without_operational_tc_sa_refuses(tmp_path, capsys):
+    path = str(tmp_path / "tc.keys")
+    sas = keys.generate(path)
+    for sa in sas:
+        sa.stop()
+    keys.write_sas(path, sas, replace=True)
+    assert "no operational TC SA" in refused(capsys, mission(tmp_path, keys=path))
+
+
+def test_tc_security_none_must_be_said_and_is_logged_at_every_start(tmp_path):
+    cfg = obc_config.load(mission(tmp_path, tc_security="none"))
+    assert policy.check(cfg) is None
+    said = []
+    unit = FramesUnit(cfg, load_sdb(), out=said.append)
+    unit.fp.close()
+    assert said == [policy.OFF_WARNING]
+    with pytest.raises(obc_config.ConfigError):
+        policy.check(obc_config.load(mission(tmp_path, tc_security="off")))
+
+
+def test_keys_given_start_with_sdls(tmp_path):
+    path = str(tmp_path / "tc.keys")
+    keys.generate(path, algorithm="aes-gcm", tm_vcids=(0,))
+    cfg = obc_config.load(mission(tmp_path, keys=path))
+    said = []
+    unit = FramesUnit(cfg, load_sdb(), out=said.append)
+    try:
+        assert said == []
+        assert unit.fp.core.security.sas[1].algorithm == "aes-gcm"
+        assert unit.fp.core.mux.security.by_vc[0].spi == keys.TM_SPI_BASE
+    finally:
+        unit.fp.close()

@@ -16,6 +16,9 @@ from obsw.frames.sdls_keys import HMAC, KeyFileError, dump_sas, load_security, l
 
 ESSENTIAL_SPI = 63  # the SA of the essential (high priority) commands, on their MAP
 TM_SPI_BASE = 64  # TM SAs: SPI 64 + VC ID
+EP_SPI = 62  # the SA of the SDLS extended procedures (key and SA management), on its own MAP
+EP_MAP = 62
+MASTER_ID = 1  # the first master key, made with the key file
 
 
 def inside_git_tree(path):
@@ -40,11 +43,13 @@ def generate(
     allow_git=False,
     algorithm=HMAC,
     tm_vcids=(),
+    ep=False,
 ):
     """Write a new key file: one SA per VC (SPI = VC ID + 1) and, unless ``essential_map`` is
     None, one for the essential MAP of the first VC (SPI 63), each with a fresh 256-bit key;
     ``algorithm`` "hmac-sha256", "aes-gcm" or "aes-gmac". With ``tm_vcids`` (GCM only), one
-    AES-GCM SA per TM VC too (SPI = 64 + VC ID)."""
+    AES-GCM SA per TM VC too (SPI = 64 + VC ID). With ``ep``, the SA of the extended procedures
+    (SPI 62 on MAP 62) and the key store ``path + '.keystore'`` holding master key 1."""
     if not allow_git and inside_git_tree(path):
         raise KeyFileError("%s is inside a git work tree: keep keys out of repositories" % path)
     if algorithm == HMAC and tm_vcids:
@@ -62,26 +67,57 @@ def generate(
     sas = [sa(v + 1, v) for v in vcids]
     if essential_map is not None:
         sas.append(sa(ESSENTIAL_SPI, vcids[0], essential_map))
+    if ep:
+        sas.append(sa(EP_SPI, vcids[0], EP_MAP))
     for v in tm_vcids:
         tm = sa(TM_SPI_BASE + v, v, None, GCM)
         tm.link = "tm"
         sas.append(tm)
     write_sas(path, sas)
+    if ep:
+        from obsw.frames.sdls_ep import ACTIVE, KeyStore
+
+        store = KeyStore()
+        store.add(MASTER_ID, os.urandom(32), ACTIVE)
+        save_keystore(keystore_path(path), store, replace=False)
     return sas
+
+
+def keystore_path(key_path):
+    return key_path + ".keystore"
+
+
+def load_keystore(path):
+    """The KeyStore (``obsw.frames.sdls_ep``) at ``path``, refused when others can read it."""
+    from obsw.frames.sdls_ep import EpError, KeyStore
+
+    try:
+        return KeyStore.load(read_key_file(path))
+    except (EpError, ValueError, KeyError, TypeError) as e:
+        raise KeyFileError("%s is not a key store: %s" % (path, e)) from None
+
+
+def save_keystore(path, store, replace=True):
+    """Write ``store`` to ``path`` (owner only), atomically over an existing file."""
+    _write_secret(path, store.dump() + "\n", replace)
 
 
 def write_sas(path, sas, replace=False):
     """Write ``sas`` as the key file ``path``, readable by its owner only; with ``replace``
     over an existing file, atomically (the old file stays whole until the new one is)."""
+    _write_secret(path, dump_sas(sas) + "\n", replace)
+
+
+def _write_secret(path, text, replace):
     if not replace:
         fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
         with os.fdopen(fd, "w") as f:
-            f.write(dump_sas(sas) + "\n")
+            f.write(text)
         return
     tmp = path + ".tmp"
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
     with os.fdopen(fd, "w") as f:
-        f.write(dump_sas(sas) + "\n")
+        f.write(text)
         f.flush()
         os.fsync(f.fileno())
     os.replace(tmp, path)

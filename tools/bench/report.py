@@ -38,6 +38,7 @@ RUNS = {
     "cfdp_udp": ("cfdp_udp.py", {}, "CFDP over UDP, two processes"),
     "spacecan": ("spacecan.py", {}, "SpaceCAN"),
     "frames": ("frames.py", {}, "Space data link: frames, CLTU, COP-1, SDLS"),
+    "sdls": ("sdls.py", {}, "SDLS AES-256-GCM per frame"),
     "pluto": ("pluto.py", {}, "PLUTO procedures"),
     "reconfig": ("reconfig.py", {}, "Reconfiguration module logic (host)"),
     "board": ("board.py", {}, "Reconfiguration module CPU budget (Cortex-M, QEMU)"),

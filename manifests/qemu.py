@@ -3,7 +3,8 @@
 # modules (all frozen: their code takes no heap, as on a board whose image carries its tests).
 metadata(version="0.1.0", description="obsw core and tests on the QEMU Cortex-M board")
 
-package("obsw", base_path="../micropython")  # the core, as core.py freezes it
+add_library("obsw", "lib")
+require("obsw", library="obsw")  # the core, as core.py freezes it
 # asyncio as a Pyboard has it (the qemu port builds without it): the package with its pure-Python
 # task queue in place of the C one
 package(

@@ -3,4 +3,5 @@
 metadata(version="0.1.0", description="obsw core frozen into the MicroPython unix port")
 
 include("$(MPY_DIR)/extmod/asyncio")
-package("obsw", base_path="../micropython")
+add_library("obsw", "lib")
+require("obsw", library="obsw")

@@ -14,6 +14,8 @@ import subprocess
 import sys
 import tempfile
 
+from obsw_host.manifest import Manifest  # noqa: F401 (tools import it from here)
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
@@ -54,65 +56,6 @@ def build(out, march="x64"):
             failed += 1
             print("mpy-cross failed on %s: %s" % (rel, err))
     return failed
-
-
-class Manifest:
-    """Just enough of MicroPython's manifestfile.py to list what a manifest freezes."""
-
-    def __init__(self):
-        self.modules = []  # (path on disk, module path in the image)
-        self.required = []
-        self.metadata = None
-        self.included = []  # the manifest files themselves
-        self._dirs = []
-
-    def _base(self, base_path):
-        return (self._dirs[-1] / base_path).resolve()
-
-    def execute(self, path):
-        path = pathlib.Path(path).resolve()
-        self.included.append(str(path))
-        self._dirs.append(path.parent)
-        code = compile(path.read_text(), str(path), "exec")
-        env = {
-            "metadata": self._metadata,
-            "include": self._include,
-            "require": self.required.append,
-            "package": self._package,
-            "module": self._module,
-            "freeze": self._freeze,
-            "options": type("Options", (), {})(),
-        }
-        exec(code, env)
-        self._dirs.pop()
-
-    def _metadata(self, description=None, version=None, license=None, author=None):
-        if self.metadata is None:
-            self.metadata = {"description": description, "version": version}
-
-    def _include(self, manifest_path, **kwargs):
-        if manifest_path.startswith("$("):
-            return  # MicroPython's own manifests (asyncio, ...): not the project's modules
-        p = self._dirs[-1] / manifest_path
-        self.execute(p / "manifest.py" if p.is_dir() else p)
-
-    def _package(self, package_path, files=None, base_path=".", opt=None):
-        if base_path.startswith("$("):
-            return
-        base = self._base(base_path)
-        for f in sorted((base / package_path).rglob("*.py")):
-            rel = f.relative_to(base)
-            if files is None or str(rel.relative_to(package_path)) in files:
-                self.modules.append((f, str(rel)))
-
-    def _freeze(self, path, script=None, opt=None):
-        base = self._base(path)
-        for f in sorted(base.rglob("*.py")) if script is None else [base / script]:
-            self.modules.append((f, str(f.relative_to(base))))
-
-    def _module(self, module_path, base_path=".", opt=None):
-        base = self._base(base_path)
-        self.modules.append((base / module_path, module_path))
 
 
 def sizes(manifests):

@@ -28,6 +28,7 @@ COMMANDS = {
     "pluto": "check or dry-run PLUTO procedures",
     "board": "Pyboard firmware for the reconfiguration module",
     "yamcs": "mission control with Yamcs: XTCE, instance, server",
+    "pus": "PUS-C: the standard's message types the OBC serves",
     "keys": "SDLS keys: key files, OTAR, key and SA management over the link",
 }
 ANYWHERE = ("--json", "--debug")  # flags accepted at any position before "--"

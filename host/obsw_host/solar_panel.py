@@ -1,13 +1,13 @@
 """A sample component, the solar panel: an angle, set_angle, deploy and two events.
 
-Run it in its own process with ``python -m obsw_host.solar_panel [--dir DIR]`` (or
-``obsw il serve solar-panel``); other processes use it through a proxy built from
+A plug-in component (``obsw_host.obc.plugins``): a mission names it as
+``"components": {"SolarPanel": {"module": "obsw_host.solar_panel"}}``; the module gives the
+interface ``SOLAR_PANEL`` (named "SolarPanel") and the class ``SolarPanel``. Run it in its
+own process with ``obsw il serve obsw_host.solar_panel`` (or ``python -m
+obsw_host.solar_panel [--dir DIR]``); other processes use it through a proxy built from
 ``SOLAR_PANEL``. SIGTERM or SIGINT stop it cleanly (its name is withdrawn).
 """
 
-import argparse
-import os
-import signal
 import sys
 
 from obsw.il.errors import ComponentError
@@ -77,38 +77,11 @@ class SolarPanel:
         job.succeed("deployed")
 
 
-def serve(directory=None, name="solar-panel", out=None):
-    """Provide the solar panel in this process until a signal stops it."""
-    from obsw.il.node import Node
-
-    from obsw_host.il.transport import SocketTransport
-
-    node = Node(name)
-    transport = SocketTransport(node, directory)
-    node.provide(SOLAR_PANEL, SolarPanel())
-
-    def stop(signum, frame):
-        transport.stop()
-
-    signal.signal(signal.SIGTERM, stop)
-    signal.signal(signal.SIGINT, stop)
-    if out is not None:
-        out("SolarPanel served by pid %d at %r" % (os.getpid(), transport.address))
-    try:
-        transport.serve()
-    finally:
-        transport.close()
-    return 0
-
-
 def main(argv=None):
-    p = argparse.ArgumentParser(prog="python -m obsw_host.solar_panel", description=__doc__)
-    p.add_argument("--dir", help="name directory (default $OBSW_IL_DIR or a temp dir)")
-    p.add_argument("--name", default="solar-panel", help="node name")
-    p.add_argument("--quiet", action="store_true")
-    args = p.parse_args(argv)
-    out = None if args.quiet else (lambda s: print(s, flush=True))
-    return serve(args.dir, args.name, out)
+    """``python -m obsw_host.solar_panel [--dir DIR] [--quiet]``: serve the panel."""
+    from obsw_host.obc.plugins import main as serve_main
+
+    return serve_main([__name__] + list(sys.argv[1:] if argv is None else argv))
 
 
 if __name__ == "__main__":

@@ -76,10 +76,24 @@ class Loop:
             while self.down:
                 raw = self.down.pop(0)
                 self.raw.append(raw)
-                self.tm.append(PusTm.unpack(raw))
+                tm = PusTm.unpack(raw)
+                self._declared(tm)
+                self.tm.append(tm)
                 r = self.ground.receive(raw)
                 if r is not None:
                     self.results.append(r)
+
+    def _declared(self, tm):
+        """Every TM a standard service sends is one its provider declares in ``REPORTS``
+        (what ``obsw pus coverage`` counts as served)."""
+        provider = self.app.services.get(tm.service)
+        if provider is None or tm.service > 23:
+            return
+        if (tm.service, tm.subtype) not in provider.REPORTS:
+            raise AssertionError(
+                "%s sent TM[%d,%d], not in its REPORTS"
+                % (type(provider).__name__, tm.service, tm.subtype)
+            )
 
     def run(self, tx):
         self.pump()

@@ -24,6 +24,10 @@ def make(store=None):
                 {"sid": 1, "interval": 1, "parameters": [1], "enabled": True},
                 {"sid": 2, "interval": 1, "parameters": [2], "enabled": True},
             ],
+            diagnostic=[
+                {"sid": 1, "interval": 1, "parameters": [3], "enabled": True},
+                {"sid": 3, "interval": 1, "parameters": [3], "enabled": True},
+            ],
         )
     )
     loop.app.register(ServiceTest())
@@ -34,8 +38,10 @@ def make(store=None):
     return loop, fwd, user, test, hk
 
 
-def sids(loop):
-    return [(t.data[0] << 8) | t.data[1] for t in loop.tm if (t.service, t.subtype) == (3, 25)]
+def sids(loop, subtype=25):
+    return [
+        (t.data[0] << 8) | t.data[1] for t in loop.tm if (t.service, t.subtype) == (3, subtype)
+    ]
 
 
 class TestForwarding(unittest.TestCase):
@@ -105,6 +111,36 @@ class TestForwarding(unittest.TestCase):
         loop.pump()
         self.assertEqual(sids(loop), [2])
 
+    def test_diagnostic_structures(self):
+        loop, fwd, user, test, hk = make()
+        loop.app.tick()
+        loop.pump()
+        self.assertEqual(sorted(sids(loop, 26)), [1, 3])  # every SID of the own APID at first
+        self.assertEqual(loop.run(user.report_diag(APID)).reply, {"diag": {APID: []}})
+        self.assertEqual(loop.types()[-2], (14, 12))
+        self.assertTrue(loop.run(user.delete_diag(APID, {APID: []})).ok)
+        self.assertTrue(loop.run(user.add_diag(APID, {APID: [3], 40: [1, 2]})).ok)
+        tx = loop.run(user.report_diag(APID))
+        self.assertEqual(tx.reply, {"diag": {APID: [3], 40: [1, 2]}})
+        n = len(sids(loop, 26))
+        loop.app.tick()
+        loop.pump()
+        self.assertEqual(sids(loop, 26)[n:], [3])
+        self.assertEqual(sorted(sids(loop)[-2:]), [1, 2])  # housekeeping SIDs unaffected
+        tx = loop.run(user.delete_diag(APID, {APID: [1]}))
+        self.assertEqual(tx.failure["code"], FAILURE_UNKNOWN_ID)
+        tx = loop.run(user.delete_diag(APID, {41: []}))
+        self.assertEqual(tx.failure["code"], FAILURE_UNKNOWN_ID)
+        self.assertTrue(loop.run(user.delete_diag(APID, {40: [2]})).ok)
+        self.assertEqual(
+            fwd.diag.as_list(), [{"apid": APID, "ids": [3]}, {"apid": 40, "ids": [1]}]
+        )
+        self.assertTrue(loop.run(user.delete_diag(APID, {})).ok)  # N = 0: all
+        n = len(sids(loop, 26))
+        loop.app.tick()
+        loop.pump()
+        self.assertEqual(len(sids(loop, 26)), n)
+
     def test_blocked_events(self):
         loop, fwd, user, test, hk = make()
         self.assertTrue(loop.run(user.add_blocked(APID, {APID: [3, 4]})).ok)
@@ -130,10 +166,16 @@ class TestForwarding(unittest.TestCase):
         loop.run(user.add_types(APID, {40: {3: [25]}}))
         loop.run(user.add_hk(APID, {40: [7]}))
         loop.run(user.add_blocked(APID, {APID: [9]}))
+        loop.run(user.add_diag(APID, {40: [8]}))
         loop2, fwd2, user2, test2, hk2 = make(Store("/ctx", fs))
         self.assertEqual(fwd2.types.as_list(), fwd.types.as_list())
         self.assertEqual(fwd2.hk.as_list(), [{"apid": APID, "ids": []}, {"apid": 40, "ids": [7]}])
         self.assertEqual(fwd2.blocked.pairs(), [{"apid": APID, "id": 9}])
+        self.assertEqual(
+            fwd2.diag.as_list(), [{"apid": APID, "ids": []}, {"apid": 40, "ids": [8]}]
+        )
+        fwd2.restore(fwd2.context()[:3])  # a context saved before diagnostic forwarding
+        self.assertEqual(len(fwd2.diag.as_list()), 2)
 
 
 if __name__ == "__main__":

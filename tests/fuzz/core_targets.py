@@ -316,7 +316,7 @@ PLUTO_SEEDS = [
 
 def _pluto_files():
     out = []
-    for name in ("cpdu_state_bits.pluto", "deploy_and_track.pluto"):
+    for name in ("cpdu_state_bits.pluto", "deploy_and_track.pluto", "annex_a.pluto"):
         try:
             with open("tests/data/pluto/" + name) as f:
                 out.append(f.read())
@@ -361,6 +361,14 @@ _PLUTO_WORDS = (
     "of",
     "wait for",
     "wait until",
+    "to string(",
+    "day of year(",
+    "to integer(",
+    "save context refer to a of B by v",
+    ", refer to",
+    "confirmation status of",
+    "1 V",
+    "2 m",
 )
 
 

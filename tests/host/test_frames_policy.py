@@ -9,8 +9,8 @@ import pytest
 from obsw_host.cli import main
 from obsw_host.frames import keys, policy
 from obsw_host.obc import config as obc_config
-from obsw_host.obc.units import FramesUnit
-from obsw_host.sample import load_sdb
+from obsw_host.obc.frames_unit import FramesUnit
+from obsw_host.obc.topology import Topology
 
 
 def mission(tmp_path, **frames):
@@ -61,7 +61,8 @@ def test_tc_security_none_must_be_said_and_is_logged_at_every_start(tmp_path):
     cfg = obc_config.load(mission(tmp_path, tc_security="none"))
     assert policy.check(cfg) is None
     said = []
-    unit = FramesUnit(cfg, load_sdb(), out=said.append)
+    topology = Topology(cfg)
+    unit = FramesUnit(topology, topology.process("frames"), out=said.append)
     unit.fp.close()
     assert said == [policy.OFF_WARNING]
     with pytest.raises(obc_config.ConfigError):
@@ -73,7 +74,8 @@ def test_keys_given_start_with_sdls(tmp_path):
     keys.generate(path, algorithm="aes-gcm", tm_vcids=(0,))
     cfg = obc_config.load(mission(tmp_path, keys=path))
     said = []
-    unit = FramesUnit(cfg, load_sdb(), out=said.append)
+    topology = Topology(cfg)
+    unit = FramesUnit(topology, topology.process("frames"), out=said.append)
     try:
         assert said == []
         assert unit.fp.core.security.sas[1].algorithm == "aes-gcm"

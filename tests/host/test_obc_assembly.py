@@ -115,7 +115,7 @@ class EventSink:
 
 def test_platform_manager_restarts_killed_and_hung_processes(tmp_path):
     doc = sample()
-    doc["processes"] = {"core": ["pus", "cfdp", "obcp", "solar_panel"], "can": ["spacecan"]}
+    doc["processes"] = {"core": ["pus", "cfdp", "obcp", "SolarPanel"], "can": ["spacecan"]}
     doc["pus"]["port"] = pus_port = free_port()
     doc["cfdp"]["port"] = free_port()
     doc["spacecan"]["channels"] = ["t-a-%d" % os.getpid(), "t-b-%d" % os.getpid()]

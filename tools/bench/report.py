@@ -33,6 +33,7 @@ RUNS = {
     "pus": ("pus.py", {}, "PUS-C packet codec"),
     "pus-pure": ("pus.py", {"OBSW_PURE": "1"}, "PUS-C packet codec, pure Python (OBSW_PURE=1)"),
     "pus_process": ("pus_process.py", {}, "PUS application process over UDP"),
+    "pus_services": ("pus_services.py", {}, "PUS service requests (housekeeping, diagnostics)"),
     "il": ("il.py", {}, "Interaction layer"),
     "cfdp": ("cfdp.py", {}, "CFDP in memory"),
     "cfdp_udp": ("cfdp_udp.py", {}, "CFDP over UDP, two processes"),
@@ -43,6 +44,7 @@ RUNS = {
     "reconfig": ("reconfig.py", {}, "Reconfiguration module logic (host)"),
     "board": ("board.py", {}, "Reconfiguration module CPU budget (Cortex-M, QEMU)"),
     "chain": ("chain.py", {}, "The end-to-end chain"),
+    "obc_start": ("obc_start.py", {}, "OBC cold start"),
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
 }
 # benchmarks whose figures do not depend on the host's load (instructions counted under QEMU)

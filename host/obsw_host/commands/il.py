@@ -3,7 +3,7 @@
 import json
 import sys
 
-SERVABLE = {"solar-panel": "obsw_host.solar_panel"}
+from obsw_host.obc.plugins import add_serve_arguments, serve_args
 
 
 def add_parser(sub):
@@ -16,9 +16,9 @@ def add_parser(sub):
     isub = p.add_subparsers(dest="il_command", metavar="ACTION")
     isub.required = True
 
-    s = isub.add_parser("serve", help="provide a sample component in this process")
-    s.add_argument("component", choices=sorted(SERVABLE))
-    s.set_defaults(func=_serve)
+    s = isub.add_parser("serve", help="provide a component (any plug-in module) in this process")
+    add_serve_arguments(s)
+    s.set_defaults(func=serve_args)
 
     c = isub.add_parser("call", help="call Component.operation with arguments (JSON or text)")
     c.add_argument("target")
@@ -76,13 +76,6 @@ def _run(args, action):
     if result is not None:
         print(json.dumps(result, default=repr))
     return 0
-
-
-def _serve(args):
-    import importlib
-
-    module = importlib.import_module(SERVABLE[args.component])
-    return module.serve(args.dir, args.component, out=lambda s: print(s, flush=True))
 
 
 def _call(args):

@@ -2,16 +2,26 @@
 
 Without CONFIG it runs the sample spacecraft: every PUS service (1-23) on UDP 5010, the CFDP
 entity on 5100, the OBCP engine, the SpaceCAN master with the CPDU nodes (simulated on
-virtual buses), and the sample solar panel, in processes started and watched by the platform
-manager. `--process NAME` runs one process of the configuration (what the platform manager
-starts); `obsw obc config [CONFIG]` prints the configuration as the OBC understands it.
+virtual buses), and the sample solar panel (a plug-in component), in processes started and
+watched by the platform manager. Its state lives in the mission's state folder (default
+`$XDG_STATE_HOME/obsw/<mission>`), locked while it runs: a second `obsw obc serve` of the
+same mission refuses. `obsw obc reset [CONFIG]` clears that folder; `obsw obc config [CONFIG]`
+prints the configuration and its topology as the OBC understands them. `--process NAME` runs
+one process of the configuration (what the platform manager starts).
 """
 
 import argparse
 import json
 import os
 import sys
-import tempfile
+
+from obsw_host.obc.config import ConfigError
+from obsw_host.obc.config import load as load_config
+from obsw_host.obc.state import StateLock, StateLocked, default_state
+from obsw_host.obc.state import reset as reset_state
+from obsw_host.obc.topology import Topology
+
+EXIT_REFUSED = 2
 
 
 def add_parser(sub):
@@ -21,15 +31,20 @@ def add_parser(sub):
     x = s.add_parser("serve", help="run the onboard computer until Ctrl-C")
     add_serve_arguments(x)
     x.set_defaults(func=serve)
-    c = s.add_parser("config", help="print the mission configuration as understood")
+    c = s.add_parser("config", help="print the mission configuration and topology as understood")
     c.add_argument("config", nargs="?", help="mission configuration JSON (default: the sample)")
+    c.add_argument("--state", help="the state folder (default: the mission's)")
     c.set_defaults(func=show)
+    r = s.add_parser("reset", help="clear the mission's state folder (refused while it runs)")
+    r.add_argument("config", nargs="?", help="mission configuration JSON (default: the sample)")
+    r.add_argument("--state", help="the state folder (default: the mission's)")
+    r.set_defaults(func=reset)
 
 
 def add_serve_arguments(x):
     x.add_argument("config", nargs="?", help="mission configuration JSON (default: the sample)")
     x.add_argument("--state", help="folder for context, files and packet stores (default: the "
-                   "configuration's 'state', or a folder under the temp directory)")  # fmt: skip
+                   "configuration's 'state', or $XDG_STATE_HOME/obsw/<mission>)")  # fmt: skip
     x.add_argument("--il-dir", help="interaction layer name directory (default STATE/il)")
     x.add_argument("--process", help="run only this process of the configuration")
     x.add_argument("--parent", type=int, help=argparse.SUPPRESS)
@@ -37,25 +52,25 @@ def add_serve_arguments(x):
 
 
 def load(args):
-    from obsw_host.obc.config import load as load_config
-
     config = load_config(args.config)
     if getattr(args, "state", None):
         config.state = os.path.abspath(args.state)
         config.il_directory = os.path.join(config.state, "il")
     elif "state" not in config.doc:
-        config.state = os.path.join(
-            tempfile.gettempdir(), "obsw-%s-%d" % (config.name, os.getuid())
-        )
-        config.il_directory = os.path.join(config.state, "il")
+        config.state = default_state(config.name)
+        if "il_directory" not in config.doc:
+            config.il_directory = os.path.join(config.state, "il")
     if getattr(args, "il_dir", None):
         config.il_directory = os.path.abspath(args.il_dir)
     return config
 
 
-def serve(args):
-    from obsw_host.obc.config import ConfigError
+def _refuse(text):
+    print("obsw obc: %s" % text, file=sys.stderr, flush=True)
+    return EXIT_REFUSED
 
+
+def serve(args):
     def out(text):
         if not args.quiet:
             print(text, file=sys.stderr, flush=True)
@@ -66,37 +81,74 @@ def serve(args):
             from obsw_host.frames import policy
 
             policy.check(config)
+        topology = Topology(config)
         if args.process:
-            from obsw_host.obc.assembly import ObcProcess
+            return _serve_process(topology, args, out)
+        topology.check()  # component modules import, before anything starts
+    except ConfigError as e:
+        return _refuse(e)
+    from obsw_host.obc.platform import PlatformManager
 
-            ObcProcess(config, args.process, out=out).serve(parent=args.parent)
-        else:
-            from obsw_host.obc.platform import PlatformManager
+    try:
+        lock = StateLock(config.state).acquire()
+    except StateLocked as e:
+        return _refuse(e)
+    try:
+        out("%s: processes %s, state in %s (Ctrl-C stops)" % (
+            config.name, ", ".join(config.processes), config.state))  # fmt: skip
+        if not PlatformManager(topology, out=out).serve():
+            return _refuse("every process stopped: the OBC cannot run this mission")
+    except KeyboardInterrupt:
+        pass
+    finally:
+        lock.release()
+    return 0
 
-            out("%s: processes %s, state in %s (Ctrl-C stops)" % (
-                config.name, ", ".join(config.processes), config.state))  # fmt: skip
-            PlatformManager(config, out=out).serve()
-    except (ConfigError, KeyError) as e:
-        print("obsw obc: %s" % e, file=sys.stderr)
-        return 2
+
+def _serve_process(topology, args, out):
+    """One process of the topology. One that cannot be built says why in one line: status 2
+    for a configuration error (final: the platform manager does not restart it), else 1."""
+    from obsw_host.obc.assembly import ObcProcess
+
+    try:
+        process = ObcProcess(topology, args.process, out=out)
+    except ConfigError as e:
+        return _refuse("process %s: %s" % (args.process, e))
+    except Exception as e:  # one line, not a traceback; the platform manager counts it
+        print("obsw obc: process %s cannot start: %s: %s" % (
+            args.process, type(e).__name__, e), file=sys.stderr, flush=True)  # fmt: skip
+        return 1
+    try:
+        process.serve(parent=args.parent)
     except KeyboardInterrupt:
         pass
     return 0
 
 
 def show(args):
-    from obsw_host.obc.config import ConfigError
-
     try:
         config = load(args)
+        topology = Topology(config)
     except ConfigError as e:
-        print("obsw obc: %s" % e, file=sys.stderr)
-        return 2
+        return _refuse(e)
     print(json.dumps({
         "name": config.name, "path": config.path, "sdb": config.sdb_path, "host": config.host,
         "state": config.state, "il_directory": config.il_directory,
         "processes": config.processes, "platform": config.platform,
+        "topology": topology.describe(),
     }, indent=2))  # fmt: skip
+    return 0
+
+
+def reset(args):
+    try:
+        config = load(args)
+        removed = reset_state(config.state)
+    except ConfigError as e:
+        return _refuse(e)
+    except StateLocked as e:
+        return _refuse("%s: not reset" % e)
+    print(("removed %s" if removed else "nothing to remove at %s") % config.state)
     return 0
 
 

@@ -6,10 +6,10 @@ import sys
 from obsw.pluto.dryrun import dry_run
 from obsw.pluto.interp import load
 from obsw.pluto.lexer import PlutoError
-from obsw.pluto.system import SimulatedSystem
+from obsw.pluto.system import SimulatedSystem, SystemSpecError, argument_code, value_of
 from obsw.pluto.units import Quantity
 
-from obsw_host.errors import read_json
+from obsw_host.errors import UserError, read_json
 
 _TYPES = {"real": "r", "float": "r", "double": "r", "bool": "b", "boolean": "b", "str": "s",
           "string": "s", "int": "i", "integer": "i", "uint": "u", "unsigned": "u"}  # fmt: skip
@@ -62,14 +62,22 @@ class SdbResolver:
             if p.component:
                 code = _type_code(p.type_spec)
                 self.known["%s of %s" % (p.name, p.component)] = ("parameter", code, p.unit)
+        self.signatures = {}
         for op in sdb.operations.values():
-            self.known["%s of %s" % (op.name, op.component)] = ("activity", "?", None)
+            path = "%s of %s" % (op.name, op.component)
+            self.known[path] = ("activity", "?", None)
+            if op.signature is not None:
+                self.signatures[path] = [(n, argument_code(t), u) for n, t, u in op.signature]
         for e in sdb.events.values():
             if e.component:
                 self.known["%s of %s" % (e.name, e.component)] = ("event", "?", None)
 
     def describe(self, path):
         return self.known.get(path)
+
+    def signature(self, path):
+        """The arguments the database declares for activity ``path`` (checked at load)."""
+        return self.signatures.get(path)
 
 
 def _read(path):
@@ -88,7 +96,7 @@ def check_cmd(args):
 
         resolver = SdbResolver(load_sdb(args.sdb))
     elif args.system:
-        resolver = SimulatedSystem(read_json(args.system, "system file"))
+        resolver = _system(args.system, read_json(args.system, "system file"))
     try:
         load(_read(args.file), resolver)
     except PlutoError as e:
@@ -97,6 +105,13 @@ def check_cmd(args):
         return 1
     print("%s: ok" % args.file)
     return 0
+
+
+def _system(path, spec):
+    try:
+        return SimulatedSystem(spec)
+    except SystemSpecError as e:
+        raise UserError("%s: %s" % (path, e)) from None
 
 
 def _json_value(v):
@@ -115,7 +130,15 @@ def _arg(text):
 
 def run_cmd(args):
     spec = read_json(args.system, "system file") if args.system else {}
-    arguments = dict(_arg(a) for a in args.arg)
+    if args.system:
+        _system(args.system, spec)  # a description it cannot play is the user's, said at once
+    arguments = {}
+    for a in args.arg:  # a value with units as in the system file: {"value": 3, "unit": "V"}
+        name, value = _arg(a)
+        try:
+            arguments[name] = value_of(value, "--arg " + name)
+        except SystemSpecError as e:
+            raise UserError(str(e)) from None
 
     def show(t, line, what):
         print("t=%-8g line %-4d %s" % (t, line, what), file=sys.stderr)

@@ -93,22 +93,23 @@ class Connection:
     # -------------------------------------------------------------------------- in
 
     def on_readable(self):
+        """Read and handle what came; False if nothing came (the receive timed out)."""
         try:
             data = self.sock.recv(_RECV)
         except (BlockingIOError, InterruptedError):
-            return
+            return False
         except OSError as e:
             self.close("receive failed: %s" % e)
-            return
+            return True
         if not data:
             self.close("peer closed")
-            return
+            return True
         try:
             msgs = self._reader.feed(data)
         except (CborDecodeError, FrameError) as e:
             self.transport.bad_frames += 1
             self.close("bad frame: %s" % e)
-            return
+            return True
         inbound = self._inbound
         inbound.extend(msgs)
         node = self.transport.node
@@ -121,6 +122,7 @@ class Connection:
                 self.transport.bad_frames += 1
                 continue
             node.deliver(msg, self)
+        return True
 
     def close(self, reason="closed"):
         if not self.alive:
@@ -153,6 +155,7 @@ class SocketTransport:
         self._stop = False
         self._next_renew = 0.0
         self._closed = False
+        self._hot = None  # the connection a provider last heard from (see wait)
         node.registry.resolver = self._resolve
         node.wait = self.wait
         node.listeners.append(self)
@@ -265,6 +268,23 @@ class SocketTransport:
             if self.node._remote_topics:
                 self._renew()
             return
+        hot = self._hot
+        if hot is not None:
+            # a provider with one busy peer: wait on that connection alone with one blocking
+            # recv (bounded by SO_RCVTIMEO), not poll() then recv(); once it stays quiet for
+            # a slice, back to poll() over every socket (new peers are accepted then)
+            self._hot = None
+            if (
+                hot.alive
+                and len(self._fds) == 2
+                and (timeout is None or timeout >= _SLICE)
+                and hot.on_readable()
+            ):
+                if hot.alive:
+                    self._hot = hot
+                return
+            if timeout is not None:
+                timeout = max(0.0, timeout - _SLICE)
         if timeout is None:
             ms = -1
         else:
@@ -283,8 +303,8 @@ class SocketTransport:
                 continue
             if obj is self._server:
                 self._accept()
-            else:
-                obj.on_readable()
+            elif obj.on_readable() and obj.alive and self._server is not None:
+                self._hot = obj
 
     def _accept(self):
         while True:

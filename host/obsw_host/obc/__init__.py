@@ -1,7 +1,10 @@
 """The onboard computer assembled from one mission configuration file.
 
-``config`` reads the file, ``units`` builds each component from its section, ``assembly``
-runs the components of one process with its heartbeat, ``platform`` starts and watches the
-processes. ``obsw obc serve [CONFIG]`` runs it all; without a file, the sample spacecraft
+``config`` reads the file (``defaults`` holds every default of its sections); ``topology`` is
+the composition root everyone reads: the processes, the units each runs (kinds from the
+``registry`` table), the mission's plug-in components (``plugins``) and the interfaces that
+join them; ``units`` holds the units, ``assembly`` runs the units of one process with its
+heartbeat, ``platform`` starts and watches the processes; ``state`` is the state folder and
+its lock. ``obsw obc serve [CONFIG]`` runs it all; without a file, the sample spacecraft
 (``data/spacecraft.json``).
 """

@@ -1,33 +1,22 @@
-"""One OBC process: the components the mission configuration gives it, and its heartbeat.
+"""One OBC process: the units the topology gives it, and its heartbeat.
 
-``ObcProcess(config, name)`` builds the units of process ``name`` (``obsw_host.obc.units``)
-and provides ``Process_<name>``, a small interaction-layer component whose ``beat()`` the
-platform manager calls: it answers with the process id and a count while every unit's work
-moves, and fails with ``HUNG`` naming the units that stopped.
+``ObcProcess(config, name)`` builds the units of process ``name`` of the topology
+(``obsw_host.obc.topology``; each unit's class from ``obsw_host.obc.registry``) and provides
+``Process_<name>``, a small interaction-layer component whose ``beat()`` the platform manager
+calls: it answers with the process id and a count while every unit's work moves, and fails
+with ``HUNG`` naming the units that stopped.
 """
 
 import os
+import signal
 import threading
 
 from obsw.il.errors import ComponentError
-from obsw.il.interface import Interface, Operation
 from obsw.il.node import Node
 
 from obsw_host.il.transport import SocketTransport
-from obsw_host.obc.units import ComponentUnit, FramesUnit, PusUnit, SpaceCanUnit
-
-HEALTH_BASE = 0x7F00  # interface ids of the processes' health components: base + index
-
-
-def health_interface(config, name):
-    """The interface of process ``name``'s health component."""
-    index = list(config.processes).index(name)
-    return Interface(
-        "Process_" + name,
-        HEALTH_BASE + index,
-        [Operation("beat", 1, (), description="pid and beats; HUNG if stuck")],
-        description="heartbeat of OBC process %s" % name,
-    )
+from obsw_host.obc.registry import unit_class
+from obsw_host.obc.topology import Topology
 
 
 class _Health:
@@ -44,34 +33,31 @@ class _Health:
 
 
 class ObcProcess:
-    """The units of one process of ``config`` (see the module text)."""
+    """The units of one process of ``config`` (see the module text); ``config`` may also be
+    a ``Topology`` already built."""
 
     def __init__(self, config, name, out=print):
-        from obsw.pus import sdb as sdb_module
-
-        if name not in config.processes:
-            raise KeyError("no process %r in %s" % (name, config.path))
+        topology = config if isinstance(config, Topology) else Topology(config)
+        config = topology.config
+        plan = topology.process(name)
         os.makedirs(config.state, exist_ok=True)
         os.makedirs(config.il_directory, exist_ok=True)
+        self.topology = topology
         self.config = config
         self.name = name
         self.out = out
-        kinds = config.processes[name]
-        self.sdb = sdb_module.load(config.sdb_path)
-        self.units = []
-        if "pus" in kinds:
-            self.units.append(("pus", PusUnit(config, self.sdb, kinds, out)))
-        elif "solar_panel" in kinds:
-            self.units.append(("components", ComponentUnit(config, kinds, out)))
-        if "spacecan" in kinds:
-            self.units.append(("spacecan", SpaceCanUnit(config, out)))
-        if "frames" in kinds:
-            self.units.append(("frames", FramesUnit(config, self.sdb, out)))
-        self.node = Node("obc-" + name)
+        self.units = [
+            (label, unit_class(kind)(topology, plan, out)) for label, kind in plan.units()
+        ]
+        self.node = Node("obc-%s-health" % name)
         self.transport = SocketTransport(self.node, config.il_directory)
         self.health = _Health(self.units)
-        self.node.provide(health_interface(config, name), self.health)
+        self.node.provide(plan.health, self.health)
         self._thread = None
+
+    @property
+    def sdb(self):
+        return self.topology.sdb
 
     def unit(self, name):
         for n, u in self.units:
@@ -88,8 +74,6 @@ class ObcProcess:
 
     def serve(self, parent=None):
         """Run until SIGTERM or SIGINT (or until process ``parent`` is gone)."""
-        import signal
-
         done = threading.Event()
 
         def stop(signum, frame):

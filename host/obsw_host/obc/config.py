@@ -7,8 +7,10 @@ Every path in it is relative to the file. Top level:
   folder for the context store, the onboard filestore and the packet stores;
   ``il_directory``: the interaction layer's name directory (default: a folder under ``state``).
 - ``processes``: process name -> list of component kinds it runs (``pus``, ``cfdp``,
-  ``obcp``, ``spacecan``, ``frames``, ``solar_panel``); one process or several. ``cfdp`` and
-  ``obcp`` run with ``pus`` (services 23 and 18 use them directly).
+  ``obcp``, ``spacecan``, ``frames``) and names of the mission's ``components`` (plug-ins,
+  ``obsw_host.obc.plugins``); one process or several. ``cfdp`` and ``obcp`` run with ``pus``
+  (services 23 and 18 use them directly).
+- ``components``: component name -> ``{"module", "class", "options"}`` (``obsw_host.obc.plugins``).
 - one section per component kind with its options (``pus``, ``cfdp``, ``obcp``, ``spacecan``,
   ``frames``), and ``platform`` for the platform manager (heartbeat period, restart deadline,
   failures allowed in a window before the OBC asks to be power-cycled).
@@ -21,19 +23,12 @@ import json
 import os
 
 from obsw_host.net import DEFAULT_HOST
+from obsw_host.obc.defaults import PLATFORM as _PLATFORM
+from obsw_host.obc.registry import KINDS, WITH_PUS
 
-KINDS = ("pus", "cfdp", "obcp", "spacecan", "frames", "solar_panel")
-WITH_PUS = ("cfdp", "obcp")
 SAMPLE = os.path.join(os.path.dirname(__file__), "data", "spacecraft.json")
-
-_PLATFORM = {
-    "heartbeat": 0.5,  # seconds between heartbeats
-    "deadline": 3.0,  # a component silent this long is hung: killed and restarted
-    "start_timeout": 20.0,  # a component's first heartbeat may take this long
-    "max_failures": 3,  # this many deaths or hangs within `window` seconds ...
-    "window": 60.0,
-    "power_cycle": {"component": "CpduN", "line": 0, "off_ms": 500},  # ... power-cycle the OBC
-}
+# component kinds that became plug-ins: the kind -> (component name, its entry)
+_LEGACY_KINDS = {"solar_panel": ("SolarPanel", {"module": "obsw_host.solar_panel"})}
 
 
 class ConfigError(ValueError):
@@ -78,18 +73,38 @@ class MissionConfig:
             raise ConfigError(key, "expected a path, got %r" % (v,))
         return v
 
+    def _legacy(self, procs):
+        """Kinds that became plug-ins (``solar_panel``) as the components they are now."""
+        components = self.doc.get("components")
+        for kinds in procs.values():
+            if not isinstance(kinds, list):
+                continue
+            for i, k in enumerate(kinds):
+                if k in _LEGACY_KINDS:
+                    component, entry = _LEGACY_KINDS[k]
+                    kinds[i] = component
+                    if components is None:
+                        components = self.doc["components"] = {}
+                    if isinstance(components, dict):
+                        components.setdefault(component, dict(entry))
+
     def _processes(self):
         procs = self.doc.get("processes")
         if not isinstance(procs, dict) or not procs:
             raise ConfigError("processes", "expected process name -> [component kinds]")
+        self._legacy(procs)
+        components = self.doc.get("components", {})
+        components = components if isinstance(components, dict) else {}
         where = {}
         for name, kinds in procs.items():
             if not isinstance(kinds, list) or not kinds:
                 raise ConfigError("processes.%s" % name, "expected a list of component kinds")
             for k in kinds:
-                if k not in KINDS:
+                if k not in KINDS and k not in components:
                     raise ConfigError(
-                        "processes.%s" % name, "unknown component %r (one of %s)" % (k, KINDS)
+                        "processes.%s" % name,
+                        "unknown component %r (a kind of %s, or a name of 'components')"
+                        % (k, ", ".join(KINDS)),
                     )
                 if k in where:
                     raise ConfigError(

@@ -7,45 +7,34 @@ whose heartbeat has failed for ``deadline`` seconds (``start_timeout`` for its f
 killed and started again at once. Starts, deaths and restarts become service 5 events
 (``platform.started``, ``platform.died``, ``platform.restarted``: process index and pid),
 raised through the PUS process's ``Platform`` component and kept until it can take them.
-After ``max_failures`` failures within ``window`` seconds the manager asks the
-reconfiguration module to power-cycle the OBC: ``power_cycle(line, off_ms)`` of the CPDU
-node's equipment component (``platform.power_cycle`` event first), once per window.
+
+A process that dies before its first heartbeat is not a hardware fault but a mistake (its
+configuration, a component module that does not import): one that refuses its configuration
+(exit status 2) is stopped at once, one that dies ``crash_loop`` times in a row before its
+first heartbeat is stopped then; either way one line says so and ``platform.stopped`` is
+raised, and nothing is power-cycled. When every process is stopped, ``serve`` returns.
+Failures of processes that ran healthy count towards the power cycle: after
+``max_failures`` of them within ``window`` seconds the manager asks the reconfiguration
+module to power-cycle the OBC: ``power_cycle(line, off_ms)`` of the CPDU node's equipment
+component (``platform.power_cycle`` event first), once per window.
 """
 
 import collections
 import os
+import signal
 import subprocess
 import sys
 import threading
 import time
 
 from obsw.il.errors import InteractionError
-from obsw.il.interface import Interface, Operation
 from obsw.il.node import Node
 
 from obsw_host.il.transport import SocketTransport
+from obsw_host.obc.topology import PLATFORM, Topology
 
-PLATFORM = Interface(
-    "Platform",
-    0x7EFF,
-    [Operation("report", 1, ("event", "process", "pid"), description="raise a platform event")],
-    description="the platform manager's events, raised by the PUS process",
-)
-EVENTS = ("started", "died", "restarted", "power_cycle")
-
-
-class PlatformEvents:
-    """The PUS process's side of ``PLATFORM``: events raised on its application process."""
-
-    def __init__(self, app, sdb):
-        self.app = app
-        self.sdb = sdb
-
-    def report(self, event, process, pid):
-        if event not in EVENTS:
-            raise ValueError("no platform event %r" % (event,))
-        e = self.sdb.event("platform." + event)
-        return self.app.event(e.id, e.severity, e.pack({"process": process, "pid": pid}))
+EXIT_REFUSED = 2  # a process's exit status when it refuses its configuration
+_STARTING_BEAT = 0.05  # seconds between heartbeats until a process's first answer
 
 
 class Child:
@@ -59,6 +48,8 @@ class Child:
         self.last_beat = None
         self.next_beat = 0.0
         self.restarts = 0
+        self.early_deaths = 0  # deaths in a row before a first heartbeat
+        self.stopped = None  # why the manager stopped restarting it
         self.proxy = None
 
     @property
@@ -70,8 +61,9 @@ class PlatformManager:
     """Supervises the processes of ``config`` (see the module text)."""
 
     def __init__(self, config, *, out=print, python=sys.executable, clock=time.monotonic):
-        from obsw_host.obc.assembly import health_interface
-
+        topology = config if isinstance(config, Topology) else Topology(config)
+        config = topology.config
+        self.topology = topology
         self.config = config
         self.out = out
         self.python = python
@@ -81,9 +73,9 @@ class PlatformManager:
         self.node = Node("platform")
         self.transport = SocketTransport(self.node, config.il_directory, listen=False)
         self.children = []
-        for i, name in enumerate(config.processes):
-            c = Child(name, i)
-            c.proxy = self.node.proxy(health_interface(config, name), timeout=0.5, retries=0)
+        for plan in topology.processes:
+            c = Child(plan.name, plan.index)
+            c.proxy = self.node.proxy(plan.health, timeout=0.5, retries=0)
             self.children.append(c)
         self.platform = self.node.proxy(PLATFORM, timeout=0.5, retries=0)
         self.failures = collections.deque()  # times of deaths and hangs
@@ -92,6 +84,7 @@ class PlatformManager:
         self.log = []  # (time, text)
         self._last_power_cycle = None
         self._stop = threading.Event()
+        self.finished = threading.Event()  # set when every process is stopped
         self._thread = None
 
     def _say(self, text):
@@ -132,13 +125,39 @@ class PlatformManager:
 
     def _failed(self, child, why):
         now = self.clock()
+        healthy = child.last_beat is not None
+        status = child.popen.poll()
+        if not healthy:
+            child.early_deaths += 1
+            limit = int(self.settings["crash_loop"])
+            if status == EXIT_REFUSED or child.early_deaths >= limit:
+                self._stop_child(child, why, status)
+                return
         self._say("%s (pid %d) %s: restarting" % (child.name, child.pid, why))
         self._event("died", child)
         self._kill(child)
-        self.failures.append(now)
         self._spawn(child)
         child.restarts += 1
         self._event("restarted", child)
+        if healthy:
+            self._count_failure(child, now)
+
+    def _stop_child(self, child, why, status):
+        """A process that cannot start: stopped, with one line and one event."""
+        self._kill(child)
+        if status == EXIT_REFUSED:
+            child.stopped = "refused its configuration (exit status 2)"
+        else:
+            child.stopped = "died %d times in a row before its first heartbeat (last: %s)" % (
+                child.early_deaths, why)  # fmt: skip
+        self._say("%s %s: stopped, not restarted (fix the mission, then start the OBC again)" % (
+            child.name, child.stopped))  # fmt: skip
+        self._event("stopped", child)
+        if all(c.stopped for c in self.children):
+            self.finished.set()
+
+    def _count_failure(self, child, now):
+        self.failures.append(now)
         window = float(self.settings["window"])
         while self.failures and now - self.failures[0] > window:
             self.failures.popleft()
@@ -156,9 +175,7 @@ class PlatformManager:
         self._say("%d failures within %ss: asking %s to power-cycle the OBC" % (
             len(self.failures), self.settings["window"], pc["component"]))  # fmt: skip
         try:
-            from obsw_host.obc.units import equipment_interfaces
-
-            itf = [i for i in equipment_interfaces(self.config) if i.name == pc["component"]]
+            itf = [i for i in self.topology.equipment_interfaces() if i.name == pc["component"]]
             if not itf:
                 raise KeyError("no equipment %r in the configuration" % pc["component"])
             cpdu = self.node.proxy(itf[0], timeout=2.0, retries=1)
@@ -173,12 +190,14 @@ class PlatformManager:
         now = self.clock()
         period = float(self.settings["heartbeat"])
         for child in self.children:
+            if child.stopped:
+                continue
             if child.popen.poll() is not None:
                 self._failed(child, "ended with status %s" % child.popen.returncode)
                 continue
             if now < child.next_beat:
                 continue
-            child.next_beat = now + period
+            child.next_beat = now + (period if child.last_beat is not None else _STARTING_BEAT)
             try:
                 child.proxy.beat()
             except InteractionError:
@@ -194,6 +213,7 @@ class PlatformManager:
             if child.last_beat is None:
                 self._say("%s up (pid %d)" % (child.name, child.pid))
                 self._event("started", child)
+                child.early_deaths = 0
             child.last_beat = self.clock()
         self._flush_events()
 
@@ -238,9 +258,7 @@ class PlatformManager:
         self.transport.close()
 
     def serve(self):
-        """Run until SIGTERM or SIGINT."""
-        import signal
-
+        """Run until SIGTERM or SIGINT, or until every process is stopped; True if so."""
         done = threading.Event()
 
         def stop(signum, frame):
@@ -250,7 +268,9 @@ class PlatformManager:
         signal.signal(signal.SIGINT, stop)
         self.start()
         try:
-            while not done.wait(0.5):
-                pass
+            while not done.wait(0.1):
+                if self.finished.is_set():
+                    return False
         finally:
             self.stop()
+        return True

@@ -1,11 +1,15 @@
-"""The components an OBC process runs, each built from its section of the mission configuration.
+"""The PUS and component units of an OBC process (``obsw_host.obc.registry`` names every unit
+kind; the SpaceCAN and frame processor units have modules of their own), each built from the
+topology (``obsw_host.obc.topology``) and its section of the mission configuration.
 
-A unit has ``start()``, ``stop()`` and ``alive()`` (False when its work has stopped moving:
-the platform manager then treats the process as hung). ``PusUnit`` is the PUS application
-process with every service 1-23 and, in the same asyncio loop, the CFDP entity (service 23's
-copies), the OBCP engine (service 18) and its interaction-layer transport; the SpaceCAN master
-and the frame processor run in threads of their own; everything meets on the interaction
-layer's name directory and on UDP.
+A unit is built as ``Unit(topology, process, out)`` and has ``start()``, ``stop()`` and
+``alive()`` (False when its work has stopped moving: the platform manager then treats the
+process as hung). ``PusUnit`` is the PUS application process with the services of its
+service table (``obsw_host.pus.onboard.SERVICES``) and, in the same asyncio loop, the CFDP
+entity (service 23's copies), the OBCP engine (service 18), the process's plug-in components
+and its interaction-layer transport; the SpaceCAN master and the frame processor run in
+threads of their own; ``ComponentUnit`` serves plug-in components in a process without PUS.
+Everything meets on the interaction layer's name directory and on UDP.
 """
 
 import asyncio
@@ -13,38 +17,33 @@ import os
 import threading
 import time
 
+from obsw.cfdp.filestore import OsFilestore
 from obsw.il.node import Node
+from obsw.pluto.engine import provide as provide_engine
+from obsw.store import Store
 
+from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.il.transport import SocketTransport
-
-PLAYBACK_PORT = 5000  # the frame processor's playback input (UDP 4999 + 1)
-
-
-def equipment_interfaces(config):
-    """The interfaces of the SpaceCAN equipment components the mission has."""
-    from obsw.spacecan.equipment import equipment_interface
-
-    return [equipment_interface(eq.name, eq.node_id, eq.nodedef) for eq in equipments(config)]
+from obsw_host.obc.topology import PLATFORM, PLATFORM_EVENTS
+from obsw_host.pus.onboard import Onboard
 
 
-def equipments(config):
-    """The SpaceCAN equipment: the configuration's ``spacecan.nodes`` if it lists any, else
-    the spacecraft database's ``nodes``."""
-    from obsw.pus.sdb import NodeDef
-    from obsw.pus.sdb import load as load_sdb
-    from obsw.spacecan.equipment import Equipment
-    from obsw.spacecan.nodedef import NodeDefinition
+class PlatformEvents:
+    """The PUS process's side of ``PLATFORM``: events raised on its application process."""
 
-    listed = config.section("spacecan").get("nodes")
-    if listed:
-        nodes = [
-            NodeDef(n["name"], int(n["node_id"]), config.resolve(n["definition"])) for n in listed
-        ]
-    else:
-        nodes = list(load_sdb(config.sdb_path).nodes.values())
-    return [
-        Equipment(n.name, n.node_id, NodeDefinition.load(n.definition, n.node_id)) for n in nodes
-    ]
+    def __init__(self, app, sdb):
+        self.app = app
+        self.sdb = sdb
+
+    def report(self, event, process, pid):
+        if event not in PLATFORM_EVENTS:
+            raise ValueError("no platform event %r" % (event,))
+        try:
+            e = self.sdb.event("platform." + event)
+        except KeyError:  # a database without this event: counted, not raised
+            self.app.count("platform_events_unknown")
+            return None
+        return self.app.event(e.id, e.severity, e.pack({"process": process, "pid": pid}))
 
 
 async def drive_transport(transport, node):
@@ -72,65 +71,72 @@ async def drive_transport(transport, node):
             loop.remove_reader(fd)
 
 
+def _components_alive(built):
+    """False if a plug-in component that can say so says its work has stopped."""
+    for _, impl in built:
+        alive = getattr(impl, "alive", None)
+        if alive is not None and not alive():
+            return False
+    return True
+
+
+def _close_components(built):
+    for _, impl in built:
+        close = getattr(impl, "close", None)
+        if close is not None:
+            close()
+
+
 class PusUnit:
-    """The PUS application process with services 1-23, the CFDP entity and the OBCP engine."""
+    """The PUS application process, its services, CFDP, OBCP and the process's components."""
 
-    def __init__(self, config, sdb, kinds, out=print):
-        from obsw.store import Store
-
-        from obsw_host.pus.onboard import Onboard
-
+    def __init__(self, topology, process, out=print):
+        config = topology.config
         self.config = config
-        self.sdb = sdb
+        self.sdb = sdb = topology.sdb
         self.out = out
-        opts = config.section("pus")
-        state = config.state
-        components = []
-        if "solar_panel" in kinds:
-            from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
-
-            components.append((SOLAR_PANEL, SolarPanel()))
-        self.interfaces = [itf for itf, _ in components]
-        if config.runs("solar_panel") and "solar_panel" not in kinds:
-            from obsw_host.solar_panel import SOLAR_PANEL
-
-            self.interfaces.append(SOLAR_PANEL)
-        self.interfaces += equipment_interfaces(config) if config.runs("spacecan") else []
+        opts = topology.section("pus")
+        self.components = [c.build() for c in process.components]
+        self.interfaces = topology.interfaces()
+        self.ids = ids = topology.ids
         playback_to = None
         tm_to = None
-        if config.runs("frames"):
-            f = config.section("frames")
-            tm_port = int(f.get("tm_port", 4999))
-            tm_to = (config.host, tm_port)
-            playback_to = {int(f.get("playback_vc", 1)): (config.host, tm_port + 1)}
+        if topology.runs("frames"):
+            tm_to = (config.host, ids.ports.tm)
+            playback_to = {ids.playback_vc: (config.host, ids.ports.playback)}
         if opts.get("tm_to"):  # a fixed ground address besides the last TC's sender
             host, port = str(opts["tm_to"]).rsplit(":", 1)
             tm_to = (host, int(port))
         self.node = Node("obc-pus")
         self.transport = SocketTransport(self.node, config.il_directory)
+        self.files = RootedFilestore(os.path.join(config.state, "files"))
+        self.cfdp = None
+        if "cfdp" in process.kinds:
+            self._cfdp(topology.section("cfdp"))
+        self.engine = None
+        context = {"obc": True, "files": self.files, "options": dict(opts)}
+        if "obcp" in process.kinds:
+            obcp = topology.section("obcp")
+            context.update(self._obcp(obcp))
+            context["options"]["level"] = int(obcp["level"])
         self.onboard = Onboard(
             sdb,
             node=self.node,
-            apid=opts.get("apid"),
+            apid=ids.pus_apid,
             host=config.host,
-            port=opts.get("port"),
-            period=float(opts.get("period", 0.1)),
-            store=Store(os.path.join(state, "context")),
+            port=ids.ports.pus,
+            config=ids.pus_config,
+            period=float(opts["period"]),
+            store=Store(os.path.join(config.state, "context")),
             tm_to=tm_to,
             playback_to=playback_to,
-            components=components,
+            components=self.components,
+            context=context,
+            time_code=opts["time_code"],  # ST[09] reports: "cuc" (9,2) or "cds" (9,3)
         )
+        self.onboard.follow_period = float(opts["follow_period"])
         self.app = self.onboard.app
-        self.cfdp = None
-        if "cfdp" in kinds:
-            self._cfdp(config.section("cfdp"))
-        self.engine = None
-        if "obcp" in kinds:
-            self._obcp(config.section("obcp"))
-        self._storage(opts)
-        self._services(opts)
-        from obsw_host.obc.platform import PLATFORM, PlatformEvents
-
+        self.obcp = self.app.services.get(18)
         self.node.provide(PLATFORM, PlatformEvents(self.app, sdb))
         self._running = False
 
@@ -140,78 +146,45 @@ class PusUnit:
         from obsw.cfdp.remote_copy import REMOTE_COPY, RemoteCopy
         from obsw.spp import TYPE_TM
 
-        from obsw_host.cfdp.filestore import RootedFilestore
         from obsw_host.cfdp.link import UdpEntity, make_entity
 
-        sdb = self.sdb
-        self.files = RootedFilestore(os.path.join(self.config.state, "files"))
-        local = sdb.filestore_entity(sdb.local_filestore)
+        ids = self.ids
+        local, ground = ids.cfdp_entities
         peers = {}
-        for eid, address in opts.get("peers", {}).items():
+        for eid, address in opts["peers"].items():
             host, port = address.rsplit(":", 1)
             peers[int(eid)] = (host, int(port))
+        if not peers:  # the ground entity of the filestores, on its port of the mission
+            peers[ground] = (self.config.host, ids.ports.cfdp_ground)
         entity = make_entity(local, list(peers), self.files)
-        self.cfdp = UdpEntity(entity, (self.config.host, int(opts.get("port", 5100))), peers)
-        self.cfdp.packet_type = TYPE_TM
+        self.cfdp = UdpEntity(
+            entity,
+            (self.config.host, ids.ports.cfdp),
+            peers,
+            apid=ids.apid("cfdp"),
+            packet_type=TYPE_TM,
+        )
         self.copy = RemoteCopy(entity)
         self.node.provide(REMOTE_COPY, self.copy)
         self.cfdp.on_indication = self.copy.indication
         entity.restore(time.monotonic())
 
     def _obcp(self, opts):
-        from obsw.cfdp.filestore import OsFilestore
-        from obsw.pluto.engine import provide
-        from obsw.pus.services.s18_obcp import ObcpManagement
-
-        self.engine = provide(
+        """The OBCP engine; returns what service 18 takes from the context."""
+        self.engine = provide_engine(
             self.node,
             self.sdb,
             self.interfaces,
-            timeout=float(opts.get("timeout", 2.0)),
-            activity_timeout=float(opts.get("activity_timeout", 30.0)),
+            timeout=float(opts["timeout"]),
+            activity_timeout=float(opts["activity_timeout"]),
             poll=0.05,
         )
         files = opts.get("files")
-        fs = OsFilestore(self.config.resolve(files)) if files else None
-        self.step_period = float(opts.get("step_period", 0.01))
-        self.obcp = self.app.register(
-            ObcpManagement(
-                self.engine,
-                filestore=fs,
-                events=self.sdb.event,
-                level=int(opts.get("level", 2)),
-                clock=time.time,
-            )
-        )
-
-    def _storage(self, opts):
-        from obsw_host.cfdp.filestore import RootedFilestore
-
-        if self.cfdp is None:
-            self.files = RootedFilestore(os.path.join(self.config.state, "files"))
-
-    def _services(self, opts):
-        from obsw.pus.services.s02_device_access import DeviceAccess
-        from obsw.pus.services.s04_statistics import ParameterStatistics
-        from obsw.pus.services.s06_memory import MemoryManagement, areas_from_sdb
-        from obsw.pus.services.s13_large_packets import LargePacketTransfer
-        from obsw.pus.services.s14_forwarding import ForwardingControl
-        from obsw.pus.services.s15_storage import Storage
-        from obsw.pus.services.s23_files import FileManagement
-
-        sdb = self.sdb
-        app = self.app
-        app.register(DeviceAccess(self.node, timeout=float(opts.get("device_timeout", 5.0))))
-        app.register(ParameterStatistics(self.onboard.pool))
-        app.register(MemoryManagement(areas_from_sdb(sdb, self.files)))
-        app.register(LargePacketTransfer())
-        app.register(ForwardingControl())
-        app.register(Storage(filestore=self.files, rate=int(opts.get("playback_rate", 64))))
-        app.register(
-            FileManagement(
-                self.files, sdb.filestores, sdb.local_filestore, self.node, poll_every=4
-            )
-        )
+        self.step_period = float(opts["step_period"])
+        return {
+            "engine": self.engine,
+            "procedures": OsFilestore(self.config.resolve(files)) if files else None,
+        }
 
     # -------------------------------------------------------------------------- running
 
@@ -262,7 +235,9 @@ class PusUnit:
 
     def alive(self):
         last = self.app.last_cycle
-        return last is not None and time.monotonic() - last < max(2.0, 20 * self.onboard.period)
+        if last is None or time.monotonic() - last >= max(2.0, 20 * self.onboard.period):
+            return False
+        return _components_alive(self.components)
 
     def stop(self):
         self._running = False
@@ -270,171 +245,36 @@ class PusUnit:
         if self.cfdp is not None:
             self.cfdp.close()
         self.transport.close()
-
-
-class SpaceCanUnit:
-    """The SpaceCAN master, the equipment components and device access, in their own thread."""
-
-    def __init__(self, config, out=print):
-        from obsw_host.spacecan.obc import ObcSpaceCan
-
-        opts = config.section("spacecan")
-        self.out = out
-        self.opts = opts
-        interface = opts.get("interface", "virtual")
-        channels = tuple(opts.get("channels", ("can0", "can1")))
-        buses = None
-        if interface == "hub":  # the simulated reconfiguration module's CAN hub (UDP ports)
-            from obsw_host.reconfig.canhub import HubBus
-
-            buses = [HubBus(int(channels[0])), HubBus(int(channels[1]))]
-        self.obc = ObcSpaceCan(
-            equipments(config),
-            interface=interface,
-            channels=channels,
-            buses=buses,
-            directory=config.il_directory,
-            heartbeat_period=float(opts.get("heartbeat_period", 0.5)),
-            timeout=float(opts.get("timeout", 0.5)),
-            retries=int(opts.get("retries", 2)),
-            device_access=True,
-        )
-        self._thread = None
-
-    def start(self):
-        self.obc.start()
-        if self.opts.get("simulate"):
-            self.obc.simulate()
-        self._thread = threading.Thread(target=self.obc.serve, name="spacecan", daemon=True)
-        self._thread.start()
-        self.out("%r on %s" % (self.obc, self.obc.interface))
-        return self
-
-    def alive(self):
-        return self._thread is not None and self._thread.is_alive()
-
-    def stop(self):
-        self.obc.stop()
-        if self._thread is not None:
-            self._thread.join(2.0)
-        self.obc.close()
-
-
-class FramesUnit:
-    """The frame processor on two UARTs (device paths, or ``pty``: a pseudo-terminal pair
-    whose other end's path is written to ``STATE/uart_a`` and ``STATE/uart_b``); with
-    ``keys`` (a key file) TC frames are authenticated."""
-
-    def __init__(self, config, sdb, out=print):
-        from obsw_host.frames.links import FdLink
-        from obsw_host.frames.processor import FrameProcessorHost
-
-        opts = config.section("frames")
-        self.out = out
-        links = []
-        self.paths = {}
-        for side in ("a", "b"):
-            dev = opts.get("uart_" + side, "pty")
-            if dev == "pty":
-                controller, path = _pty()
-                links.append(FdLink(controller, side.upper()))
-                with open(os.path.join(config.state, "uart_" + side), "w") as f:
-                    f.write(path + "\n")
-                self.paths[side] = path
-            else:
-                links.append(config.resolve(dev) if dev.startswith(".") else dev)
-                self.paths[side] = dev
-        pus = config.section("pus")
-        apid = int(pus.get("apid", sdb.apid("pus")))
-        port = int(pus.get("port", 5000 + apid))
-        tm_port = int(opts.get("tm_port", 4999))
-        plan = sdb.tm_vcs
-        security = {}
-        from obsw_host.frames import policy
-
-        key_path = policy.check(config)  # secure by default: keys, or "tc_security": "none"
-        if key_path is None:
-            out(policy.OFF_WARNING)
-        else:  # TC (and TM, where the file has SAs for it) protected with SDLS
-            from obsw_host.frames.processor import security_options
-
-            state = os.path.join(config.state, "frames.keys.state")
-            security = security_options(key_path, sdb, state)
-        self.fp = FrameProcessorHost(
-            links[0],
-            links[1],
-            int(opts.get("scid", 0x42)),
-            host=config.host,
-            port_base=port - apid,
-            tm_port=tm_port,
-            vc_ports={int(opts.get("playback_vc", 1)): tm_port + 1},
-            tm_plan=plan,
-            tm_frame_length=int(opts.get("tm_frame_length", 256)),
-            clcw_period=float(opts.get("clcw_period", 0.5)),
-            **security,
-        )
-        self.last_step = time.monotonic()
-        self._stop = threading.Event()
-        self._thread = None
-
-    def _run(self):
-        while not self._stop.is_set():
-            self.fp.step(0.05)
-            self.last_step = time.monotonic()
-
-    def start(self):
-        self._thread = threading.Thread(target=self._run, name="frames", daemon=True)
-        self._thread.start()
-        self.out(
-            "frame processor: UART A %s, UART B %s, TM in on udp %d"
-            % (self.paths["a"], self.paths["b"], self.fp.tm_port)
-        )
-        return self
-
-    def alive(self):
-        return self._thread is not None and time.monotonic() - self.last_step < 2.0
-
-    def stop(self):
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(2.0)
-        self.fp.close()
+        _close_components(self.components)
 
 
 class ComponentUnit:
-    """Sample equipment components served on their own node (when not with the PUS process)."""
+    """The process's plug-in components, on a node of their own (a process without PUS)."""
 
-    def __init__(self, config, kinds, out=print):
-        self.node = Node("obc-components")
-        self.transport = SocketTransport(self.node, config.il_directory)
-        if "solar_panel" in kinds:
-            from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
-
-            self.node.provide(SOLAR_PANEL, SolarPanel())
+    def __init__(self, topology, process, out=print):
+        self.out = out
+        self.node = Node("obc-%s-components" % process.name)
+        self.transport = SocketTransport(self.node, topology.config.il_directory)
+        self.components = [c.build() for c in process.components]
+        for itf, impl in self.components:
+            self.node.provide(itf, impl)
         self._thread = None
 
     def start(self):
         self._thread = threading.Thread(target=self.transport.serve, name="components")
         self._thread.daemon = True
         self._thread.start()
+        self.out("components %s" % ", ".join(itf.name for itf, _ in self.components))
         return self
 
     def alive(self):
-        return self._thread is not None and self._thread.is_alive()
+        if self._thread is None or not self._thread.is_alive():
+            return False
+        return _components_alive(self.components)
 
     def stop(self):
         self.transport.stop()
         if self._thread is not None:
             self._thread.join(2.0)
         self.transport.close()
-
-
-def _pty():
-    import tty
-
-    controller, device = os.openpty()
-    tty.setraw(device)
-    path = os.ttyname(device)
-    # the device end stays open here: with no one on it, the controller end would read EIO
-    # (and be "readable") until the ground opens the path
-    return controller, path
+        _close_components(self.components)

@@ -1,9 +1,12 @@
-"""The on-board PUS process on the host: the core application process on UDP 5000 + APID.
+"""The on-board PUS process on the host: the core application process on UDP base + APID.
 
-``Onboard(sdb)`` builds the application process with the services the spacecraft database
-calls for (1, 3, 5, 8, 9, 11, 12, 17, 19, 20, 21, and 22 when the database names a
-``position_scheduling`` parameter), a parameter pool and an event manager on an interaction
-layer node, and serves TCs from UDP. TM goes to every ground client that sent a TC or
+``Onboard(sdb)`` builds the application process with the services of ``SERVICES`` (the one
+service table of the PUS process) whose needs are met: 1, 3, 5, 8, 9, 11, 12, 17, 19, 20, 21,
+and 22 when the database names a ``position_scheduling`` parameter; the OBC's PUS unit gives
+what the others need (``needs``: a filestore for 6, 15 and 23, the OBCP engine for 18, the
+OBC itself for 2, 4, 13 and 14). A parameter pool and an event manager on an interaction
+layer node follow the components (also those that start later or restart), and TCs are
+served from UDP. TM goes to every ground client that sent a TC or
 subscribed (``obsw_host.pus.tm_fanout``), and to ``tm_to`` if given; each TM is logged
 (``obsw_host.pus.tm_log``). Packets that service 15 retrieves from a packet store go to
 ``playback_to[vc]`` (a UDP address per virtual channel: the frame processor's input for that
@@ -13,43 +16,126 @@ calling thread until stopped (``obsw obc serve``).
 """
 
 import asyncio
-import os
 import threading
 import time
 
 from obsw.il.clock import REAL_CLOCK
 from obsw.il.node import Node
-from obsw.pus.app import EVENT_CYCLE_OVERRUN, ApplicationProcess
+from obsw.pus.app import ApplicationProcess
+from obsw.pus.config import from_sdb
 from obsw.pus.events import EventManager
 from obsw.pus.parameters import ParameterPool
+from obsw.pus.services.s02_device_access import DeviceAccess
 from obsw.pus.services.s03_housekeeping import Housekeeping
+from obsw.pus.services.s04_statistics import ParameterStatistics
 from obsw.pus.services.s05_events import EventReporting
+from obsw.pus.services.s06_memory import MemoryManagement, areas_from_sdb
 from obsw.pus.services.s08_functions import FunctionManagement, functions
 from obsw.pus.services.s09_time import TimeManagement
 from obsw.pus.services.s11_scheduling import TimeScheduling
-from obsw.pus.services.s12_monitoring import OnBoardMonitoring
+from obsw.pus.services.s12_functional import FunctionalOnBoardMonitoring
+from obsw.pus.services.s13_large_packets import LargePacketTransfer
+from obsw.pus.services.s14_forwarding import ForwardingControl
+from obsw.pus.services.s15_storage import Storage
 from obsw.pus.services.s17_test import ServiceTest
+from obsw.pus.services.s18_obcp import ObcpManagement
 from obsw.pus.services.s19_event_action import EventAction
 from obsw.pus.services.s20_parameters import ParameterManagement
 from obsw.pus.services.s21_sequencing import RequestSequencing
 from obsw.pus.services.s22_position_scheduling import PositionScheduling
+from obsw.pus.services.s23_files import FileManagement
 
+from obsw_host.ids import EVENT_COPY_COMPLETED, EVENT_COPY_FAILED, EVENT_OVERRUN, event_id
 from obsw_host.net import DEFAULT_HOST
+from obsw_host.ports import app_port
 from obsw_host.pus.tm_fanout import TmFanout
 from obsw_host.pus.tm_log import TmLog
 
-PORT_BASE = int(os.environ.get("OBSW_PORT_BASE", "5000"))  # another base for a second system
 TAI_MINUS_UNIX = 378691200 + 37  # seconds from 1958-01-01 TAI to 1970-01-01 UTC, now
-
-
-def port_for(apid):
-    """The UDP port of an application process: 5000 + APID."""
-    return PORT_BASE + apid
 
 
 def tai_now():
     """On-board time: TAI seconds since 1958-01-01 from the host clock."""
     return time.time() + TAI_MINUS_UNIX
+
+
+def copy_events(sdb):
+    """Service 23's copy events by name in the database (None: it declares them not)."""
+    ids = (event_id(sdb, EVENT_COPY_COMPLETED), event_id(sdb, EVENT_COPY_FAILED))
+    return None if None in ids else ids
+
+
+class ServiceContext:
+    """What the builders of ``SERVICES`` take: the process's database, pool, node and
+    options, and what the OBC gives besides (``obc``, ``files``, ``engine``, ...)."""
+
+    def __init__(self, sdb, pool, node, **extra):
+        self.sdb = sdb
+        self.pool = pool
+        self.node = node
+        self.position = sdb.position_parameter
+        self.time_exponent = None
+        self.time_code = "cuc"  # TM[9,2] (CUC) or TM[9,3] (CDS) time reports
+        self.obc = None  # True in the OBC's PUS unit
+        self.files = None  # the onboard filestore (services 6, 15, 23)
+        self.engine = None  # the OBCP engine (service 18)
+        self.procedures = None  # the filestore procedures are loaded from
+        self.options = {}
+        for k, v in extra.items():
+            setattr(self, k, v)
+
+    def option(self, key, default):
+        return self.options.get(key, default)
+
+
+# The service table of the PUS process: (service, needs, build(context)), in registration
+# order; a service is built when every context attribute it needs is given (not None).
+SERVICES = (
+    (3, (), lambda c: Housekeeping(c.pool, c.sdb.housekeeping)),
+    (5, (), lambda c: EventReporting(known=c.sdb.events)),
+    (9, (), lambda c: TimeManagement(c.time_exponent, c.time_code)),
+    (17, (), lambda c: ServiceTest()),
+    (20, (), lambda c: ParameterManagement(c.pool)),
+    (8, (), lambda c: FunctionManagement(functions(c.sdb), c.node)),
+    (11, (), lambda c: TimeScheduling()),
+    (12, (), lambda c: FunctionalOnBoardMonitoring(c.pool, c.sdb.events)),  # types 1-28
+    (19, (), lambda c: EventAction(known=c.sdb.events)),
+    (21, (), lambda c: RequestSequencing()),
+    (22, ("position",), lambda c: PositionScheduling(c.pool, c.position.qualified)),
+    (
+        18,
+        ("engine",),
+        lambda c: ObcpManagement(
+            c.engine,
+            filestore=c.procedures,
+            events=c.sdb.event,
+            level=int(c.option("level", 2)),
+            clock=time.time,
+        ),
+    ),  # fmt: skip
+    (2, ("obc",), lambda c: DeviceAccess(c.node, timeout=float(c.option("device_timeout", 5)))),
+    (4, ("obc",), lambda c: ParameterStatistics(c.pool)),
+    (6, ("files",), lambda c: MemoryManagement(areas_from_sdb(c.sdb, c.files))),
+    (13, ("obc",), lambda c: LargePacketTransfer()),
+    (14, ("obc",), lambda c: ForwardingControl()),
+    (
+        15,
+        ("files",),
+        lambda c: Storage(filestore=c.files, rate=int(c.option("playback_rate", 64))),
+    ),  # fmt: skip
+    (
+        23,
+        ("files",),
+        lambda c: FileManagement(
+            c.files,
+            c.sdb.filestores,
+            c.sdb.local_filestore,
+            c.node,
+            poll_every=4,
+            events=copy_events(c.sdb),
+        ),
+    ),  # fmt: skip
+)
 
 
 class _Protocol(asyncio.DatagramProtocol):
@@ -84,11 +170,14 @@ class Onboard:
         max_tasks=16,
         components=(),
         time_exponent=None,
+        time_code="cuc",
+        context=None,
+        config=None,
     ):
         self.sdb = sdb
         self.apid = apid if apid is not None else sdb.apid("pus")
         self.host = host
-        self.port = port_for(self.apid) if port is None else port
+        self.port = app_port(self.apid) if port is None else port
         self.period = period
         self.tm_to = tm_to
         self.playback_to = dict(playback_to or {})
@@ -103,11 +192,7 @@ class Onboard:
         self._stopping = None
         self._ready = threading.Event()
         self._error = None
-        overrun = EVENT_CYCLE_OVERRUN
-        try:
-            overrun = sdb.event("pus.cycle_overrun").id
-        except KeyError:
-            pass
+        overrun = event_id(sdb, EVENT_OVERRUN)  # None: the database declares none
         self.app = ApplicationProcess(
             self.apid,
             self._send,
@@ -118,6 +203,7 @@ class Onboard:
             max_tasks=max_tasks,
             task_timeout=10.0,
             overrun_event=overrun,
+            config=config if config is not None else from_sdb(sdb),
         )
         self.tasks = []  # more coroutine functions to run on the process's loop
         self.providers = [self.node.provide(itf, impl) for itf, impl in components]
@@ -127,21 +213,26 @@ class Onboard:
         self._own_parameters()
         self.pool.bind()
         self.events.bind()
-        app = self.app
+        self.follow_period = 0.25  # seconds between looks for components that (re)appeared
         if self.playback_to:
-            app.playback = self._playback
-        app.register(Housekeeping(self.pool, sdb.housekeeping))
-        app.register(EventReporting(known=sdb.events))
-        app.register(TimeManagement(time_exponent))
-        app.register(ServiceTest())
-        app.register(ParameterManagement(self.pool))
-        app.register(FunctionManagement(functions(sdb), self.node))
-        app.register(TimeScheduling())
-        app.register(OnBoardMonitoring(self.pool, sdb.events))
-        app.register(EventAction(known=sdb.events))
-        app.register(RequestSequencing())
-        if sdb.position_parameter is not None:
-            app.register(PositionScheduling(self.pool, sdb.position_parameter.qualified))
+            self.app.playback = self._playback
+        self.context = ServiceContext(
+            sdb, self.pool, self.node, time_exponent=time_exponent, time_code=time_code
+        )
+        for k, v in (context or {}).items():  # what the OBC gives the services besides
+            setattr(self.context, k, v)
+        self.register_services(self.context)
+
+    def register_services(self, context, table=SERVICES):
+        """Build and register every service of ``table`` whose needs ``context`` meets."""
+        for number, needs, build in table:
+            if number in self.app.services:
+                continue
+            if all(getattr(context, n, None) is not None for n in needs):
+                self.app.register(build(context))
+        memory, parameters = self.app.services.get(6), self.app.services.get(20)
+        if memory is not None and parameters is not None:
+            parameters.use_memories(memory.areas)  # service 20 places parameters in them
 
     def _own_parameters(self):
         counters = self.app.counters
@@ -200,6 +291,7 @@ class Onboard:
         tasks = [asyncio.ensure_future(self.app.run(self.period))]
         if self.node is not None:
             tasks.append(asyncio.ensure_future(self.node.serve()))
+            tasks.append(asyncio.ensure_future(self.pool.follow(self.follow_period)))
         for make in self.tasks:
             tasks.append(asyncio.ensure_future(make()))
         self._ready.set()

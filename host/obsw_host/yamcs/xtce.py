@@ -17,12 +17,15 @@
 import xml.etree.ElementTree as ET
 
 from obsw.pus import messages as M
+from obsw.pus.calibration import CalibrationError, Values
 from obsw.pus.config import PusConfig
+from obsw.pus.fields import field
 from obsw.pus.packets import ACK_ALL
 from obsw.pus.services.s01_verification import FAILURE_NAMES
-from obsw.pus.services.s12_layouts import STATUS_NAMES
+from obsw.pus.services.s12_layouts import FMON_STATUS_NAMES, STATUS_NAMES
+from obsw.pus.services.s20_parameters import DEFINITION_NAMES
 
-from obsw_host.yamcs.xtce_types import argument_type, parameter_type
+from obsw_host.yamcs.xtce_types import argument_type, linear, parameter_type
 
 XTCE_NS = "http://www.omg.org/spec/XTCE/20180204"
 U8, U16, U32, E8, E16 = (3, 4), (3, 12), (3, 14), (2, 8), (2, 16)
@@ -119,10 +122,12 @@ class Generator:
 
     def __init__(self, sc, config=None):
         self.sc = sc
-        self.cfg = config or PusConfig()
+        ids = sc.ids  # the mission's: layout, source id, APIDs
+        self.cfg = config or (ids.pus_config if ids is not None else PusConfig())
         self.root = SpaceSystem(_label(sc.mission), "/" + _label(sc.mission))
         self.refs = {}  # parameter id -> absolute reference
-        self.apid = sc.apid("pus", 10)
+        self.apid = sc.required_apid("pus")
+        self.source_id = ids.source_id if ids is not None else 0
 
     # ------------------------------------------------------------------ helpers
     def system_of(self, parts):
@@ -233,7 +238,9 @@ class Generator:
         for pid in sorted(self.sc.params):
             p = self.sc.params[pid]
             s = self.system_of(p.path[:-1])
-            ptype = parameter_type("", p.pair, p.unit, limits=p.limits, calibration=p.calibration)
+            ptype = parameter_type(
+                "", p.pair, p.unit, limits=p.limits, calibration=p.calibration, labels=p.labels
+            )
             self.refs[pid] = s.parameter(_label(p.path[-1]), ptype, p.description)
 
     def housekeeping(self):
@@ -330,7 +337,8 @@ class Generator:
     def tc_base(self):
         r = self.root
         cfg = self.cfg
-        for name, bits in (("apid_t", 11), ("ack_t", 4), ("u8_t", 8), ("source_t", 16)):
+        source_bits = 8 * cfg.source_id_size or 16
+        for name, bits in (("apid_t", 11), ("ack_t", 4), ("u8_t", 8), ("source_t", source_bits)):
             r.atypes.append(argument_type(name, (0, bits)))
         cmd = _sub(ET.Element("root"), "MetaCommand", name="pus_tc", abstract="true")
         cmd.set("shortDescription", "PUS-C telecommand: header, then the service's data")
@@ -340,7 +348,13 @@ class Generator:
         _sub(args, "Argument", name="service", argumentTypeRef="u8_t")
         _sub(args, "Argument", name="subtype", argumentTypeRef="u8_t")
         if cfg.source_id_size:
-            _sub(args, "Argument", name="source", argumentTypeRef="source_t", initialValue=0)
+            _sub(
+                args,
+                "Argument",
+                name="source",
+                argumentTypeRef="source_t",
+                initialValue=self.source_id,
+            )
         cc = _sub(cmd, "CommandContainer", name="pus_tc")
         entries = _sub(cc, "EntryList")
         _fixed(entries, "ccsds_version_type_flag", 0b00011, 5)
@@ -481,6 +495,7 @@ class Generator:
         )
         self.obcp_commands(pus)
         self.file_commands(pus)
+        self.memory_storage_commands(pus)
 
     def obcp_commands(self, pus):
         def obcp():
@@ -535,13 +550,132 @@ class Generator:
             "TC[23,14] copy a file (by CFDP between SAT: and GROUND:)",
         )
 
+    # ------------------------------------------------------------------ services 6, 15, 21, 22
+    def memory_storage_commands(self, pus):
+        """Service 6 (the loads that carry their data in the TC are the CLI's: XTCE loads
+        from files), 15 (copy by time window, diagnostic storage control), 21 (sequences by
+        reference) and 22 (orbit number)."""
+
+        def u(name, pair):
+            return ("arg", name, argument_type("", pair))
+
+        def path(name):
+            return ("arg", name, argument_type("", (8, 0)))
+
+        one = ("fixed", "n", 1, 8)
+
+        def mem():  # each command gets its own argument type elements
+            return u("memory", U16)
+
+        def obj():
+            return u("object", U16)
+
+        def rng(first="address"):
+            return [u(first, U32), u("length", U32)]
+
+        def files():
+            return [path("repository"), path("file")]
+
+        self.command(pus, "memory_abort_dumps", M.TC_MEM_ABORT_ALL_DUMPS, (), "TC[6,12]")
+        for name, mt in (
+            ("memory_scrub_enable", M.TC_MEM_ENABLE_SCRUBBING),
+            ("memory_scrub_disable", M.TC_MEM_DISABLE_SCRUBBING),
+            ("memory_protect", M.TC_MEM_ENABLE_WRITE_PROTECTION),
+            ("memory_unprotect", M.TC_MEM_DISABLE_WRITE_PROTECTION),
+        ):
+            self.command(pus, name, mt, [mem()], "TC[%d,%d]" % mt)
+        for name, mt, fields in (
+            ("memory_dump", M.TC_MEM_DUMP_RAW, lambda: [mem(), one] + rng()),
+            ("memory_check", M.TC_MEM_CHECK_RAW, lambda: [mem(), one] + rng()),
+            (
+                "memory_dump_object",
+                M.TC_MEM_DUMP_OBJECT,
+                lambda: [mem(), obj(), one] + rng("offset"),
+            ),
+            (
+                "memory_check_object",
+                M.TC_MEM_CHECK_OBJECT,
+                lambda: [mem(), obj(), one] + rng("offset"),
+            ),
+            ("memory_check_whole_object", M.TC_MEM_CHECK_OBJECT_WHOLE, lambda: [mem(), obj()]),
+            (
+                "memory_load_file",
+                M.TC_MEM_LOAD_RAW_BY_REFERENCE,
+                lambda: [mem(), one, u("address", U32)] + files() + [u("crc", U16)],
+            ),
+            (
+                "memory_dump_file",
+                M.TC_MEM_DUMP_RAW_TO_FILE,
+                lambda: [mem(), one] + rng() + files(),
+            ),
+            (
+                "memory_load_object_file",
+                M.TC_MEM_LOAD_OBJECT_BY_REFERENCE,
+                lambda: [mem(), obj(), one, u("offset", U32)] + files() + [u("crc", U16)],
+            ),
+            (
+                "memory_dump_object_file",
+                M.TC_MEM_DUMP_OBJECT_TO_FILE,
+                lambda: [mem(), obj(), one] + rng("offset") + files(),
+            ),
+        ):
+            self.command(pus, name, mt, fields(), "TC[%d,%d]" % mt)
+        whole = [
+            self.header_param("memory_id", 16),
+            self.header_param("memory_object_id", 16),
+            self.header_param("memory_object_length", 32),
+            self.header_param("memory_object_checksum", 16),
+        ]
+        self.report("memory_whole_object_report", M.TM_MEM_CHECK_OBJECT_WHOLE_REPORT, whole)
+        self.report("memory_object_dump", M.TM_MEM_DUMP_OBJECT_REPORT, whole[:2])
+        self.report("memory_object_check", M.TM_MEM_CHECK_OBJECT_REPORT, whole[:2])
+        # ST[15]: time tags as the CUC coarse (seconds) and fine (1/65536 s) parts
+        windows = {0: "from_to", 1: "after", 2: "before"}
+        self.command(
+            pus,
+            "store_copy",
+            M.TC_STORE_COPY_BY_TIME_WINDOW,
+            [
+                ("arg", "window", argument_type("", E8, labels=windows)),
+                u("tag1_seconds", U32),
+                ("fixed", "tag1_fraction", 0, 16),
+                u("tag2_seconds", U32),
+                ("fixed", "tag2_fraction", 0, 16),
+                u("source", U16),
+                u("target", U16),
+            ],
+            "TC[15,24] copy the packets of a time window into an empty store",
+        )
+        for name, mt in (
+            ("store_diag_add", M.TC_STORE_ADD_DIAG_STRUCTURES),
+            ("store_diag_delete", M.TC_STORE_DELETE_DIAG_STRUCTURES),
+        ):
+            fields = [u("store", U16), one, ("fixed", "apid", self.apid, 16)]
+            fields += [("fixed", "sid_count", 1, 8), u("sid", U16)]
+            self.command(pus, name, mt, fields, "TC[%d,%d]" % mt)
+        self.command(
+            pus, "store_diag_report", M.TC_STORE_REPORT_DIAG_STRUCTURES, [u("store", U16)]
+        )
+        self.report(
+            "store_diag_report",
+            M.TM_STORE_DIAG_STRUCTURES_REPORT,
+            [self.header_param("store_id", 16)],
+        )
+        # ST[21] sequences from files, ST[22] the orbit number
+        for name, mt in (
+            ("sequence_load_file", M.TC_SEQUENCE_LOAD_BY_REFERENCE),
+            ("sequence_load_file_activate", M.TC_SEQUENCE_LOAD_AND_ACTIVATE),
+        ):
+            fields = [("arg", "sequence", argument_type("", (8, 8)))]
+            self.command(pus, name, mt, fields + files())
+        self.command(pus, "position_set_orbit", M.TC_POS_SCHED_SET_ORBIT_NUMBER, [u("orbit", U32)])
+
     def parameter_commands(self):
         for pid in sorted(self.sc.params):
             p = self.sc.params[pid]
             if not p.writable:
                 continue
             s = self.system_of(p.path[:-1])
-            valid = tuple(p.range) if p.range else None
             self.command(
                 s,
                 "set_" + _label(p.path[-1]),
@@ -549,7 +683,7 @@ class Generator:
                 [
                     ("fixed", "n", 1, 8),
                     ("fixed", "parameter", pid, 16),
-                    ("arg", "value", argument_type("", p.pair, p.unit, valid=valid)),
+                    ("arg", "value", _value_argument(p)),
                 ],
                 "TC[20,3] set %s" % p.qualified,
             )
@@ -596,11 +730,7 @@ class Generator:
                 "low_event": "none",
                 "high_event": "none",
             }
-            if p.calibration or p.pair[0] != 5:  # on-board limits are raw integer values
-                for key in ("low", "high"):
-                    v = defaults[key]
-                    ok = v is not None and not p.calibration and float(v).is_integer()
-                    defaults[key] = int(v) if ok else None
+            defaults["low"], defaults["high"] = _raw_limits(p, low, high)
             for a in cmd.find("ArgumentList"):
                 if defaults.get(a.get("name")) is not None:
                     a.set("initialValue", str(defaults[a.get("name")]))
@@ -617,6 +747,123 @@ class Generator:
                 s, _label(f.path[-1]), M.TC_FUNCTION_PERFORM, fields, "TC[8,1] %s" % f.qualified
             )
 
+    # ------------------------------------------------------------------ ST[12] 17-28, ST[20] 4-7
+    def functional_monitoring(self):
+        """TM[12,26] and TM[12,28] (their first FMON), TC[12,17] to TC[12,27]."""
+        fmon_states = {k: _label(v) for k, v in FMON_STATUS_NAMES.items()}
+        yes_no = {0: "no", 1: "yes"}
+        count = self.header_param("fmon_count", 16)
+        fmon = self.header_param("fmon_id", 16)
+        protected = self.header_param("fmon_protected", 8, labels=yes_no)
+        enabled = self.header_param("fmon_enabled", 8, labels=yes_no)
+        checking = self.root.parameter(
+            "fmon_checking_status",
+            parameter_type("", E8, labels=fmon_states, alarms={"failed": "critical"}),
+        )
+        self.report(
+            "functional_status_report",
+            M.TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT,
+            [count, fmon, protected, enabled, checking],
+            archive=True,
+        )
+        validity = [
+            self.header_param("fmon_validity_parameter", 16),
+            self.header_param("fmon_validity_mask", 32),
+            self.header_param("fmon_validity_value", 32),
+        ]
+        ev_labels = {e.id: _label(e.qualified) for e in self.sc.events.values()}
+        ev_labels[0] = "none"
+        event = self.root.parameter("fmon_event", parameter_type("", E16, labels=ev_labels))
+        tail = [event, self.header_param("fmon_failing", 16), self.header_param("fmon_pmons", 16)]
+        self.report(
+            "functional_definition_report",
+            M.TM_MON_FUNCTIONAL_MONITORING_REPORT,
+            [count, fmon] + validity + [protected, enabled] + tail,
+        )
+        pus = self.root.child("PUS")
+        one = ("fixed", "n", 1, 16)
+
+        def fmon_arg():
+            return ("arg", "fmon", argument_type("", U16))
+
+        for name, mt in (
+            ("fmon_function_enable", M.TC_MON_ENABLE_FUNCTIONAL_MONITORING_FUNCTION),
+            ("fmon_function_disable", M.TC_MON_DISABLE_FUNCTIONAL_MONITORING_FUNCTION),
+            ("fmon_status_report", M.TC_MON_REPORT_FUNCTIONAL_MONITORING_STATUS),
+        ):
+            self.command(pus, name, mt)
+        for name, mt in (
+            ("fmon_enable", M.TC_MON_ENABLE_FUNCTIONAL_MONITORING),
+            ("fmon_disable", M.TC_MON_DISABLE_FUNCTIONAL_MONITORING),
+            ("fmon_protect", M.TC_MON_PROTECT_FUNCTIONAL_MONITORING),
+            ("fmon_unprotect", M.TC_MON_UNPROTECT_FUNCTIONAL_MONITORING),
+            ("fmon_delete", M.TC_MON_DELETE_FUNCTIONAL_MONITORING),
+            ("fmon_report", M.TC_MON_REPORT_FUNCTIONAL_MONITORING),
+        ):
+            self.command(pus, name, mt, [one, fmon_arg()])
+        for n in (1, 2, 3, 4):  # one command per number of PMONs
+            fields = [one, fmon_arg()]
+            fields += [
+                ("fixed", "validity", 0, 16),
+                ("fixed", "validity_mask", 0, 32),
+                ("fixed", "validity_value", 0, 32),
+                ("arg", "event", argument_type("", E16, labels=ev_labels)),
+                ("arg", "failing", argument_type("", U16, valid=(1, n))),
+                ("fixed", "n2", n, 16),
+            ]
+            fields += [("arg", "pmon%d" % i, argument_type("", U16)) for i in range(1, n + 1)]
+            self.command(
+                pus,
+                "fmon_add_%d" % n,
+                M.TC_MON_ADD_FUNCTIONAL_MONITORING,
+                fields,
+                "TC[12,23] an FMON over %d PMON%s" % (n, "s" if n > 1 else ""),
+            )
+
+    def parameter_definitions(self):
+        """TM[20,7] (its first parameter), TC[20,4] to TC[20,6]."""
+        param_labels = {pid: _label(p.qualified) for pid, p in self.sc.params.items()}
+        kinds = {k: _label(v) for k, v in DEFINITION_NAMES.items()}
+        entries = [
+            self.header_param("definition_count", 8),
+            self.root.parameter("defined_parameter", parameter_type("", U16, labels=param_labels)),
+            self.header_param("definition_kind", 8, labels=kinds),
+            self.header_param("definition_memory", 16),
+            self.header_param("definition_object", 16),
+            self.header_param("definition_address", 32),
+        ]
+        self.report("parameter_definition_report", M.TM_PARAM_DEFINITION_REPORT, entries)
+        pus = self.root.child("PUS")
+        one = ("fixed", "n", 1, 8)
+
+        def param():
+            return ("arg", "parameter", argument_type("", U16, labels=param_labels))
+
+        self.command(
+            pus,
+            "parameter_definitions_report",
+            M.TC_PARAM_REPORT_DEFINITIONS,
+            [one, param()],
+            "TC[20,6] report where a parameter lives",
+        )
+        for name, mt, where in (
+            ("parameter_define_raw", M.TC_PARAM_CHANGE_RAW_MEMORY_DEFINITIONS, "address"),
+            ("parameter_define_object", M.TC_PARAM_CHANGE_OBJECT_MEMORY_DEFINITIONS, "offset"),
+        ):
+            self.command(
+                pus,
+                name,
+                mt,
+                [
+                    one,
+                    param(),
+                    ("arg", "memory", argument_type("", U16)),
+                ]
+                + ([("arg", "object", argument_type("", U16))] if where == "offset" else [])
+                + [("arg", where, argument_type("", U32))],
+                "TC[%d,%d] place a parameter in memory (%s)" % (mt[0], mt[1], where),
+            )
+
     def build(self):
         self.headers()
         self.verification()
@@ -631,7 +878,146 @@ class Generator:
         self.parameter_commands()
         self.monitor_commands()
         self.function_commands()
+        self.functional_monitoring()
+        self.parameter_definitions()
+        self.services_2_3_9_14()
         return self.root.element()
+
+    # ------------------------------------------------------------------ services 2, 3, 9, 14
+    def services_2_3_9_14(self):
+        """Reports and commands of device access, diagnostics, functional reporting, time and
+        diagnostic forwarding: one item per command (N = 1), the first item of a report."""
+        r = self.root
+        exponent = self.header_param("time_rate_exponent", 8)
+        status = self.header_param("time_reference_status", 8)
+        cuc = [self.header_param("cuc_coarse", 32), self.header_param("cuc_fine", 16)]
+        cds = [self.header_param("cds_day", 16), self.header_param("cds_ms_of_day", 32)]
+        self.report("cuc_time_report", M.TM_TIME_CUC_REPORT, [exponent] + cuc + [status])
+        self.report("cds_time_report", M.TM_TIME_CDS_REPORT, [exponent] + cds + [status])
+        diag_sid = self.header_param("diag_structure_id", 16)
+        self.report("diag_report", M.TM_HK_DIAG_REPORT, [diag_sid])
+        n = self.header_param("register_count", 8)
+        address = self.header_param("register_address", 32)
+        value = self.header_param("register_value", 32)
+        self.report("register_dump", M.TM_DEVICE_REGISTER_DUMP_REPORT, [n, address, value])
+        for name, msg_type in (
+            ("diag_structure_report", M.TM_HK_DIAG_STRUCTURE_REPORT),
+            ("diag_properties_report", M.TM_HK_DIAG_PERIODIC_PROPERTIES_REPORT),
+            ("functional_reporting_report", M.TM_HK_FUNCTIONAL_REPORTING_REPORT),
+            ("forward_diag_report", M.TM_FWD_DIAG_STRUCTURES_REPORT),
+        ):
+            self.report(name, msg_type)
+
+        pus = r.child("PUS")
+        one8, one16 = ("fixed", "n", 1, 8), ("fixed", "n", 1, 16)
+        none16 = ("fixed", "nfa", 0, 16)
+        pids = {pid: _label(p.qualified) for pid, p in self.sc.params.items()}
+
+        def arg(name, pair, valid=None, labels=None):
+            return ("arg", name, argument_type("", pair, valid=valid, labels=labels))
+
+        self.command(
+            pus,
+            "time_rate",
+            M.TC_TIME_SET_REPORT_RATE,
+            [arg("exponent", U8, (0, 16))],
+            "TC[9,1] a report every 2**exponent s",
+        )
+        self.command(
+            pus,
+            "device_on_off",
+            M.TC_DEVICE_ON_OFF,
+            [one8, arg("address", U16)],
+            "TC[2,1] on/off device command",
+        )
+        self.command(
+            pus,
+            "device_register_load",
+            M.TC_DEVICE_REGISTER_LOAD,
+            [one8, arg("address", U32), arg("value", U32)],
+            "TC[2,2] register load",
+        )
+        self.command(
+            pus,
+            "device_register_dump",
+            M.TC_DEVICE_REGISTER_DUMP,
+            [one8, arg("address", U32)],
+            "TC[2,5] register dump",
+        )
+        self.command(
+            pus,
+            "device_cpdu",
+            M.TC_DEVICE_CPDU,
+            [one8, arg("line", U16), arg("duration_ms", U16)],
+            "TC[2,4] CPDU command",
+        )
+        for name, msg_type in (
+            ("diag_enable", M.TC_HK_ENABLE_DIAG_REPORTS),
+            ("diag_disable", M.TC_HK_DISABLE_DIAG_REPORTS),
+            ("diag_one_shot", M.TC_HK_ONE_SHOT_DIAG),
+            ("diag_delete", M.TC_HK_DELETE_DIAG_STRUCTURES),
+            ("diag_structures", M.TC_HK_REPORT_DIAG_STRUCTURES),
+            ("diag_properties", M.TC_HK_REPORT_DIAG_PERIODIC_PROPERTIES),
+        ):
+            self.command(pus, name, msg_type, [one16, arg("sid", U16)])
+        self.command(
+            pus,
+            "diag_interval",
+            M.TC_HK_MODIFY_DIAG_INTERVAL,
+            [one16, arg("sid", U16), arg("interval", U16, (1, 65535))],
+        )
+        for name, msg_type in (
+            ("hk_append", M.TC_HK_APPEND_HK_PARAMETERS),
+            ("diag_append", M.TC_HK_APPEND_DIAG_PARAMETERS),
+        ):
+            self.command(
+                pus,
+                name,
+                msg_type,
+                [arg("sid", U16), one16, arg("parameter", U16, labels=pids), none16],
+            )
+        for name, msg_type in (
+            ("functional_apply", M.TC_HK_APPLY_FUNCTIONAL_REPORTING),
+            ("functional_delete", M.TC_HK_DELETE_FUNCTIONAL_REPORTING),
+            ("functional_report", M.TC_HK_REPORT_FUNCTIONAL_REPORTING),
+        ):
+            self.command(pus, name, msg_type, [one16, arg("definition", U16)])
+        for name, msg_type in (
+            ("forward_diag_add", M.TC_FWD_ADD_DIAG_STRUCTURES),
+            ("forward_diag_delete", M.TC_FWD_DELETE_DIAG_STRUCTURES),
+        ):
+            self.command(
+                pus,
+                name,
+                msg_type,
+                [one8, arg("apid", U16, (0, 2047)), ("fixed", "n2", 1, 8), arg("sid", U16)],
+            )
+        self.command(pus, "forward_diag_report", M.TC_FWD_REPORT_DIAG_STRUCTURES)
+
+
+def _value_argument(p):
+    """The value argument of a set command: a label of an enumeration; an engineering value
+    (range checked by Yamcs) when the calibration is linear; else the raw value."""
+    if p.labels:
+        return argument_type("", p.pair, p.unit, labels=p.labels)
+    valid = tuple(p.range) if p.range else None
+    if p.calibration:
+        if linear(p.calibration):
+            return argument_type("", p.pair, p.unit, valid=valid, calibration=p.calibration)
+        return argument_type("", p.pair)  # raw: the range is in engineering units
+    return argument_type("", p.pair, p.unit, valid=valid)
+
+
+def _raw_limits(p, low, high):
+    """Default raw limits of a limit check from engineering ones (None: not expressible)."""
+    if low is None or high is None:
+        return None, None
+    try:
+        values = Values(field(*p.pair), {"calibration": p.calibration})
+        raw_low, raw_high, _ = values.raw_limits(low, high)
+    except CalibrationError:
+        return None, None
+    return raw_low, raw_high
 
 
 def _drop_condition(container, ref):

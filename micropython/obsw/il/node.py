@@ -169,6 +169,29 @@ class Node(Calls):
             self._callback_subs.append(sub)
         return sub
 
+    def watch(self, target, callback=None, *, length=8, policy=OVERWRITE_OLDEST):
+        """Subscribe to ``"Component.member"`` whether or not its provider is there now.
+
+        Nothing waits: a provider in another process, now or once it appears (or comes back
+        after a restart), is subscribed by the transport as soon as its name resolves. A
+        member the interface lacks is refused only when the provider is local (known now).
+        """
+        comp, member = split_name(target)
+        route = self.registry.resolve(comp)
+        if route is not None and route.local:
+            _check_topic(route.interface, member)
+        else:
+            key = (comp, member)
+            if not self._remote_topics.get(key) and route is not None:
+                route.send((SUBSCRIBE, 0, comp, member, None, (), None))
+            self._remote_topics[key] = self._remote_topics.get(key, 0) + 1
+        queue = Queue(length, policy, clock=self.clock, copy=False, name=target)
+        sub = Subscription(self, comp, member, queue, callback)
+        self._subs.setdefault((comp, member), []).append(sub)
+        if callback is not None:
+            self._callback_subs.append(sub)
+        return sub
+
     def _unsubscribe(self, sub):
         key = (sub.component, sub.member)
         subs = self._subs.get(key)

@@ -1,20 +1,23 @@
 """PLUTO load-time checks: resolves every reference and types every statement before a run."""
 
 from obsw.pluto.exprcheck import (
+    _DECLARED,
     ANY,
     NONE,
     STRING,
     ExprChecker,
     PlutoReferenceError,
     PlutoTypeError,
+    _a,
     _num,
     _show,
     type_of_code,
     type_of_value,
 )
+from obsw.pluto.signatures import SignatureChecker
 
 
-class Checker(ExprChecker):
+class Checker(ExprChecker, SignatureChecker):
     """Resolves references in place (ref nodes get kind and target) and collects errors."""
 
     def __init__(self, resolver=None, arguments=None):
@@ -26,6 +29,8 @@ class Checker(ExprChecker):
         self.subj = []
         self.var_types = {}  # variable key -> (type, unit, enumerated values or None, code)
         self.def_vars = {}  # id(definition node) -> keys of the variables it declares
+        self.defs = []  # definitions being checked, innermost last
+        self.saved = set()  # keys of values a save context statement holds (read only)
 
     def lookup(self, scopes, name, kinds):
         for s in reversed(scopes):
@@ -38,6 +43,7 @@ class Checker(ExprChecker):
         _, p, decls, pre, main, wd, conf = node
         scope = {}
         scopes = scopes + [scope]
+        self.defs.append(id(node))
         for d in decls:
             if d[2] in scope:
                 self.fail(PlutoTypeError, "%s declared twice" % d[2], d[1])
@@ -71,6 +77,7 @@ class Checker(ExprChecker):
             self.stmt(s, scopes)
         for c in conf or ():
             self.condition(c, scopes)
+        self.defs.pop()
 
     def condition(self, c, scopes):
         if c[0] == "if":
@@ -150,6 +157,7 @@ class Checker(ExprChecker):
         elif k == "op":
             self.activity((s[2], s[3], ()), scopes)
         elif k == "step":
+            scopes[-1][s[2]] = ("step", s[2])
             self.definition(s[3], scopes)
             self.continuation(s[4], scopes)
         elif k == "par":
@@ -158,12 +166,32 @@ class Checker(ExprChecker):
         elif k in ("log", "inform"):
             for e in s[2]:
                 self.expr(e, scopes)
+        elif k == "save":
+            self.save_context(s, scopes)
         elif k == "ctx":
             r = s[2]
             r[4], r[5] = "ctx", " of ".join(r[2])
             self.ctx.append(r[2])
             self.block(s[3], scopes)
             self.ctx.pop()
+
+    def save_context(self, s, scopes):
+        """Each saved value becomes a read-only variable of the enclosing step."""
+        for item in s[2]:
+            r, name = item[0], item[1]
+            typ = self.ref(r, scopes)
+            unit = r[5][1] if r[4] == "p" else None
+            if r[4] == "v":
+                unit = self.var_types[r[5]][1]
+            if name in scopes[-1]:
+                self.fail(PlutoTypeError, "%s declared twice" % name, s[1])
+            self.n += 1
+            key = "%d.%s" % (self.n, name)
+            item[2] = key
+            self.var_types[key] = (typ, unit, None, "saved")
+            self.saved.add(key)
+            self.def_vars.setdefault(self.defs[-1], []).append(key)
+            scopes[-1][name] = ("v", key)
 
     def continuation(self, cont, scopes):
         for a in (cont or {}).values():
@@ -187,8 +215,16 @@ class Checker(ExprChecker):
             if d is None or d[0] != "activity":
                 self.fail(PlutoReferenceError, "unknown activity %s" % path, r[1])
         r[4], r[5] = "act", path
-        for _, v in tuple(call[1]) + tuple(call[2]):
+        for _, v in call[2]:
             self.argument(v, scopes)
+        sig = None
+        if self.resolver is not None and hasattr(self.resolver, "signature"):
+            sig = self.resolver.signature(path)
+        if sig is None or (call[1] and call[1][0][0] == "value set"):
+            for _, v in call[1]:
+                self.argument(v, scopes)
+            return
+        self.signature(path, sig, call[1], scopes, r[1])
 
     def argument(self, v, scopes):
         if isinstance(v, tuple) and v[0] in ("rec", "arr"):
@@ -218,6 +254,10 @@ class Checker(ExprChecker):
 
     def var(self, r, scopes):
         self.ref(r, scopes)
+        if r[4] == "v" and r[5] in self.saved:
+            self.fail(PlutoTypeError, "%s holds a saved context value, it cannot be assigned"
+                      % " of ".join(r[2]), r[1])  # fmt: skip
+            return None
         if r[4] != "v":
             if r[4] is not None:
                 self.fail(PlutoTypeError, "only variables can be assigned, %s is not one"
@@ -247,8 +287,10 @@ class Checker(ExprChecker):
                 self.fail(PlutoTypeError, "%scannot assign a real to %s variable"
                           % (who, _a(declared)), p)  # fmt: skip
             elif et[1] != vt[1] and et[1] != NONE:
-                self.fail(PlutoTypeError, "%sunits do not match: variable has %s"
-                          % (who, unit or "no units"), p)  # fmt: skip
+                self.fail(PlutoTypeError, "%scannot assign %s to %s variable with units %s: "
+                          "units %s and %s differ" % (who, self.operand(e, et), _a(declared),
+                          unit or "none", self.unit_name(e, et) or "none", unit or "none"),
+                          p)  # fmt: skip
             return
         if vt[0] != et[0]:
             self.fail(PlutoTypeError, "%scannot assign %s to %s variable"
@@ -259,6 +301,11 @@ class Checker(ExprChecker):
         names = r[2]
         if names[0] == "value" and len(names) > 1:
             names = names[1:]
+        if len(names) == 2 and names[0] in _STATUS_PROPERTIES:
+            e = self.lookup(scopes, names[1], ("act", "step"))
+            if e is not None:
+                r[4], r[5] = "st", (names[0], names[1], e[0])
+                return STRING
         if len(names) == 1:
             n = names[0]
             e = self.lookup(scopes, n, ("v", "act"))
@@ -296,22 +343,18 @@ def check(proc, resolver=None, arguments=None):
     c = Checker(resolver, arguments)
     c.definition(proc, [], True)
     if c.errors:
-        c.errors.sort(key=lambda x: (x.line, x.col))
+        order = {}
+        for i, x in enumerate(c.errors):  # MicroPython's sort is not stable: ties by order
+            order[id(x)] = i
+        c.errors.sort(key=lambda x: (x.line, x.col, order[id(x)]))
         err = c.errors[0]
         err.errors = c.errors
         raise err
     return c.var_types, c.def_vars
 
 
-_DECLARED = {
-    "b": "Boolean",
-    "i": "signed integer",
-    "u": "unsigned integer",
-    "r": "real",
-    "s": "string",
-    "a": "absolute time",
-    "rt": "relative time",
-}
+# properties of an activity statement (its refer by name) or a step, as strings
+_STATUS_PROPERTIES = ("confirmation status", "execution status")
 
 
 def _declared(code, vt):
@@ -319,7 +362,3 @@ def _declared(code, vt):
     if isinstance(code, tuple):
         return "enumerated " + str(code[1])
     return _DECLARED.get(code) or _show(vt)
-
-
-def _a(text):
-    return ("an " if text[:1] in "aeiouAEIOU" else "a ") + text

@@ -21,6 +21,7 @@ _KEYWORDS = {
     "log": "log",
     "inform": "inform user",
     "ctx": "in the context of",
+    "save": "save context",
 }
 
 

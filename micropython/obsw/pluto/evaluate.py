@@ -1,6 +1,6 @@
 """PLUTO expression evaluation and variable assignment (the interpreter's base class)."""
 
-from obsw.pluto import builtins, units
+from obsw.pluto import builtins, show, units
 from obsw.pluto.units import AbsTime, Quantity, compare
 
 
@@ -63,6 +63,20 @@ def _cmp(op, a, b):
     if op == "<=":
         return c <= 0
     return c >= 0
+
+
+_VERBS = {"+": "add", "-": "subtract", "*": "multiply", "/": "divide"}
+
+
+def mismatch(verb, e, a, b, cause):
+    """The run-time error for operands ``a`` and ``b`` of node ``e`` that do not go together:
+    "cannot compare speed of Wheel (5 deg/s) with 3 m: units deg/s and m differ"."""
+    x = show.operand(e[3], value=a)
+    y = show.operand(e[4], value=b)
+    ua, ub = show.unit_of_value(a), show.unit_of_value(b)
+    why = ("units %s and %s differ" % (ua or "none", ub or "none")) if ua or ub else str(cause)
+    link = " with " if verb == "compare" else " and "
+    return PlutoRuntimeError("cannot %s %s%s%s: %s" % (verb, x, link, y, why))
 
 
 def convert_answer(ans, code):
@@ -130,8 +144,15 @@ class Evaluator:
                 return units.arith(op, a, b)
             except ZeroDivisionError:
                 raise PlutoRuntimeError("division by zero") from None
+            except units.UnitError as x:
+                raise mismatch(_VERBS.get(op, "apply " + op + " to"), e, a, b, x) from None
         if k == "cmp":
-            return _cmp(e[2], self.eval(e[3]), self.eval(e[4]))
+            a = self.eval(e[3])
+            b = self.eval(e[4])
+            try:
+                return _cmp(e[2], a, b)
+            except units.UnitError as x:
+                raise mismatch("compare", e, a, b, x) from None
         if k == "l":
             a = self.eval(e[3])
             op = e[2]
@@ -199,12 +220,31 @@ class Evaluator:
             return v
         if kind == "a":
             return self.args[r[5]]
+        if kind == "st":
+            return self.status_property(*r[5])
         if kind == "s":
             h = self.refer.get(r[5])
             if h is None:
                 return "not initiated"
             return self.system.status(h) or "executing"
         raise PlutoRuntimeError("unresolved reference %s (procedure not checked)" % r[2][0])
+
+    def status_property(self, prop, name, what):
+        """``confirmation status`` (confirmed, not confirmed, aborted; "not available" before
+        the end) or ``execution status`` (not initiated, executing, completed) of an activity
+        statement's refer by name or of a step."""
+        if what == "act":
+            h = self.refer.get(name)
+            st = None if h is None else self.system.status(h)
+            started = h is not None
+        else:
+            st = getattr(self, "step_status", {}).get(name)
+            started = st is not None
+            if st == "executing":
+                st = None
+        if prop == "execution status":
+            return "completed" if st else "executing" if started else "not initiated"
+        return st or "not available"
 
     def assign(self, r, v):
         key = r[5]

@@ -6,8 +6,9 @@ dimension vector (numbers) or None. A relative time is ("r", TIME).
 """
 
 from obsw.pluto import units
-from obsw.pluto.builtins import FUNCTIONS
+from obsw.pluto.builtins import spec
 from obsw.pluto.lexer import PlutoError, line_col
+from obsw.pluto.show import source, unit_text
 
 NONE = units.NONE
 TIME = units.TIME
@@ -63,6 +64,23 @@ def _show(t):
     return {"b": "Boolean", "s": "string", "a": "absolute time", "e": "enumerated", "?": "?"}[b]
 
 
+_KINDS = (
+    ("N", "a number"),
+    ("D", "a dimensionless number or an angle"),
+    ("I", "an integer without units"),
+    ("S", "a string"),
+    ("A", "an absolute time"),
+    ("R", "a relative time"),
+)
+
+
+def _kind(k):
+    for key, text in _KINDS:
+        if key == k:
+            return text
+    return k
+
+
 def _num(t):
     return t[0] in "ir?"
 
@@ -112,24 +130,31 @@ class ExprChecker:
             return BOOL
         if k == "btw":
             t = self.expr(e[2], scopes)
-            self.comparable(e, t, self.expr(e[3], scopes), "<")
-            self.comparable(e, t, self.expr(e[4], scopes), "<")
+            lo, hi = self.expr(e[3], scopes), self.expr(e[4], scopes)
+            n = len(self.errors)  # one error per relation (the first bound that does not fit)
+            self.comparable(e, t, lo, "<", e[2], e[3])
+            if len(self.errors) == n:
+                self.comparable(e, t, hi, "<", e[2], e[4])
             return BOOL
         if k == "wi":
             t = self.expr(e[2], scopes)
             tol = type_of_value(e[3][2])
-            self.comparable(e, t, self.expr(e[5], scopes), "<")
+            self.comparable(e, t, self.expr(e[5], scopes), "<", e[2], e[5])
             if (
                 not _num(t)
                 or (e[4] and tol[1] != NONE)
                 or (not e[4] and tol[1] != NONE and t[0] != "?" and tol[1] != t[1])
             ):
-                self.fail(PlutoTypeError, "within needs numbers with matching units", e[1])
+                self.fail(PlutoTypeError, "within needs numbers with matching units: %s within %s"
+                          % (self.operand(e[2], t), source(e[3])), e[1])  # fmt: skip
             return BOOL
         if k == "in":
             t = self.expr(e[2], scopes)
+            n = len(self.errors)
             for x in e[3]:
-                self.comparable(e, t, self.expr(x, scopes), "=")
+                tx = self.expr(x, scopes)
+                if len(self.errors) == n:
+                    self.comparable(e, t, tx, "=", e[2], x)
             return BOOL
         if k == "f":
             return self.function(e, [self.expr(a, scopes) for a in e[3]])
@@ -141,20 +166,43 @@ class ExprChecker:
             return ("e", None) if isinstance(t, tuple) else type_of_code(t or "s")
         return ANY
 
-    def comparable(self, e, a, b, op):
+    def unit_name(self, e, t):
+        """The unit an operand is written in: a constant's or a declaration's, else SI."""
+        if e[0] == "c" and isinstance(e[2], units.Quantity):
+            return e[2].unit
+        if e[0] == "r":
+            if e[4] == "v":
+                return self.var_types[e[5]][1] or ""
+            if e[4] == "p":
+                return e[5][1] or ""
+        return unit_text(t[1]) if t[1] else ""
+
+    def operand(self, e, t):
+        """An operand as messages name it: "3 m", "speed of Wheel (deg/s)", "mode (string)"."""
+        if e[0] == "c":
+            return source(e)
+        u = self.unit_name(e, t)
+        return "%s (%s)" % (source(e), u if u and t[0] in "ir" else _show(t))
+
+    def comparable(self, e, a, b, op, x=None, y=None):
         if a[0] == "?" or b[0] == "?":
             return
-        ok = True
+        x = e[3] if x is None else x
+        y = e[4] if y is None else y
         if _num(a) and _num(b):
-            ok = a[1] == b[1] or a[1] == NONE or b[1] == NONE
-        elif a[0] in "se" and b[0] in "se":
-            ok = True
-        elif a[0] != b[0]:
-            ok = False
-        elif a[0] == "b" and op not in ("=", "!="):
-            ok = False
-        if not ok:
-            self.fail(PlutoTypeError, "cannot compare %s with %s" % (_show(a), _show(b)), e[1])
+            if a[1] == b[1] or a[1] == NONE or b[1] == NONE:
+                return
+            self.fail(PlutoTypeError, "cannot compare %s with %s: units %s and %s differ"
+                      % (self.operand(x, a), self.operand(y, b), self.unit_name(x, a),
+                         self.unit_name(y, b)), e[1])  # fmt: skip
+            return
+        if a[0] in "se" and b[0] in "se":
+            return
+        if a[0] == b[0] and (a[0] != "b" or op in ("=", "!=")):
+            return
+        self.fail(PlutoTypeError, "cannot compare %s with %s: types %s and %s differ"
+                  % (self.operand(x, a), self.operand(y, b), _show(a), _show(b)),
+                  e[1])  # fmt: skip
 
     def arith(self, e, a, b):
         op, p = e[2], e[1]
@@ -167,15 +215,21 @@ class ExprChecker:
                 return ABS
             if op == "+" and b == ABS and a[0] in "ir" and a[1] == TIME:
                 return ABS
-            self.fail(PlutoTypeError, "cannot apply %s to %s and %s" % (op, _show(a), _show(b)), p)
+            self.fail(PlutoTypeError, "cannot apply %s to %s and %s"
+                      % (op, self.operand(e[3], a), self.operand(e[4], b)), p)  # fmt: skip
             return ANY
         if not (_num(a) and _num(b)):
-            self.fail(PlutoTypeError, "cannot apply %s to %s and %s" % (op, _show(a), _show(b)), p)
+            self.fail(PlutoTypeError, "cannot apply %s to %s and %s"
+                      % (op, self.operand(e[3], a), self.operand(e[4], b)), p)  # fmt: skip
             return ANY
         base = "i" if a[0] == "i" and b[0] == "i" and op != "/" else "r"
         if op in "+-":
             if a[1] != b[1]:
-                self.fail(PlutoTypeError, "cannot apply %s to values with different units" % op, p)
+                x, y = e[3], e[4]
+                self.fail(PlutoTypeError, "cannot %s %s and %s: units %s and %s differ"
+                          % ("add" if op == "+" else "subtract", self.operand(x, a),
+                             self.operand(y, b), self.unit_name(x, a) or "none",
+                             self.unit_name(y, b) or "none"), p)  # fmt: skip
             return (base, a[1])
         if op == "**":
             if b[1] != NONE:
@@ -191,11 +245,11 @@ class ExprChecker:
         return (base, tuple(a[1][i] + k * b[1][i] for i in range(8)))
 
     def function(self, e, ts):
-        spec = FUNCTIONS.get(e[2])
-        if spec is None:
+        f = spec(e[2])
+        if f is None:
             self.fail(PlutoReferenceError, "unknown function %s" % e[2], e[1])
             return ANY
-        _, lo, hi, kinds, res = spec
+        lo, hi, kinds, res = f
         if len(ts) < lo or (hi >= 0 and len(ts) > hi):
             self.fail(PlutoTypeError, "%s takes %s arguments, got %d"
                       % (e[2], lo if lo == hi else "%d or more" % lo, len(ts)), e[1])  # fmt: skip
@@ -207,16 +261,43 @@ class ExprChecker:
             ok = (
                 (kind == "N" and _num(t))
                 or (kind == "D" and _num(t) and t[1] == NONE)
+                or (kind == "I" and t[0] == "i" and t[1] == NONE)
                 or (kind == "S" and t[0] in "se")
                 or (kind == "A" and t[0] == "a")
                 or (kind == "R" and _num(t) and t[1] == TIME)
             )
             if not ok:
-                self.fail(PlutoTypeError, "argument %d of %s is %s" % (i + 1, e[2], _show(t)),
+                self.fail(PlutoTypeError, "argument %d of %s, %s, is not %s"
+                          % (i + 1, e[2], self.operand(e[3][i], t), _kind(kind)),
                           e[1])  # fmt: skip
         first = ts[0] if ts else ANY
         if res == "=":
             return first
         if res == "i=":
             return ("i", first[1] if first[0] != "?" else NONE)
+        if res == "sqrt":
+            if first[0] == "?" or first[1] is None:
+                return ("r", NONE) if first[0] != "?" else ANY
+            for d in first[1]:
+                if d % 2:
+                    self.fail(PlutoTypeError, "sqrt of %s: its unit %s is not a square"
+                              % (self.operand(e[3][0], first), self.unit_name(e[3][0], first)),
+                              e[1])  # fmt: skip
+                    return ANY
+            return ("r", tuple([d // 2 for d in first[1]]))
         return type_of_code(res)
+
+
+_DECLARED = {
+    "b": "Boolean",
+    "i": "signed integer",
+    "u": "unsigned integer",
+    "r": "real",
+    "s": "string",
+    "a": "absolute time",
+    "rt": "relative time",
+}
+
+
+def _a(text):
+    return ("an " if text[:1] in "aeiouAEIOU" else "a ") + text

@@ -1,6 +1,7 @@
 """PLUTO expression parser: token helpers, names, references, constants with units, operators."""
 
 from obsw.pluto import units
+from obsw.pluto.builtins import FIRST_WORDS, FUNCTIONS, MAX_NAME_WORDS
 from obsw.pluto.lexer import ABST, EOF, NUM, OP, RELT, STR, WORD, PlutoSyntaxError, line_col
 
 # Words that end a multi-word name: every keyword that may follow a name or open a statement.
@@ -216,6 +217,13 @@ class ExprParser:
                 self.expect(")", after="to close ask user")
                 typ = self.typ() if self.take("expect") else None
                 return ("ask", p, q, dflt, typ)
+            f = self.function_name()
+            if f is not None:
+                return self.call(f, p)
+            if self.take("confirmation", "status", "of"):  # 'confirmation' opens a body too
+                r = self.ref()
+                r[2] = ("confirmation status",) + r[2]
+                return r
             if v not in RESERVED:
                 if v == "get" and self.tok(1)[0] == WORD and self.tok(1)[1] not in RESERVED:
                     self.i += 1
@@ -226,6 +234,30 @@ class ExprParser:
                 self.i = save
                 return self.ref()
         self.err("expected an expression, found %s" % _show(t))
+
+    def function_name(self):
+        """The longest standard function name (Annex C, words such as 'to' or 'of' included)
+        that starts here and is followed by '(', with its words taken; else None."""
+        w = self.toks[self.i][1]
+        if w not in FIRST_WORDS and w not in FUNCTIONS:  # 'log(' too: 'log' opens a statement
+            return None
+        words = []
+        best = None
+        for k in range(MAX_NAME_WORDS):
+            t = self.tok(k)
+            if t[0] != WORD:
+                break
+            words.append(t[1])
+            nt = self.tok(k + 1)
+            if nt[0] == OP and nt[1] == "(":
+                name = " ".join(words)
+                if name in FUNCTIONS or words[0] == "to":  # 'to ...(': a conversion, say so
+                    best = (name, k + 1)
+                break
+        if best is None:
+            return None
+        self.i += best[1]
+        return best[0]
 
     def call(self, fname, p):
         self.i += 1

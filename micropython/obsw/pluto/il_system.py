@@ -27,6 +27,7 @@ from obsw.pluto.names import (
     COMPONENT,
     KIND,
     PARAMS,
+    SIGNATURE,
     UNIT,
     Catalog,
     ParameterError,
@@ -172,6 +173,12 @@ class IlSystem(System):
             return ("parameter", e[CODE] or "?", e[UNIT])
         return (e[KIND], None, None)
 
+    def signature(self, path):
+        """The arguments the database declares for activity ``path``: [(name, type code,
+        unit)], or None (the load-time checker then takes any arguments)."""
+        e = self._find(path)
+        return e[SIGNATURE] if e is not None and e[KIND] == "activity" else None
+
     def get(self, path):
         target = self.target(path)
         try:
@@ -181,6 +188,13 @@ class IlSystem(System):
         self.reads += 1
         if isinstance(v, dict) and "value" in v and "unit" in v:
             return Quantity(v["value"], v["unit"])
+        p = self.catalog.calibrated.get(target)
+        if p is not None:  # the engineering value of a raw one, with its unit
+            try:
+                v = p.engineering(v)
+            except ValueError as e:
+                raise ParameterError(path, e) from None
+            return Quantity(v, p.unit) if p.unit and not isinstance(v, str) else v
         return v
 
     def arguments(self, path, args):

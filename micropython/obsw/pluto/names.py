@@ -7,6 +7,7 @@ finds ``CpduN.set_state_bits``); ``target_of`` turns a path into ``(component, m
 ``plain`` turns procedure values into what the interaction layer carries.
 """
 
+from obsw.pluto.system import argument_code, norm
 from obsw.pluto.units import AbsTime, Quantity, UnitError, isdigits
 from obsw.pluto.units import parse as parse_unit
 
@@ -18,11 +19,6 @@ class ParameterError(ValueError):
         super().__init__("%s: %s" % (path, cause))
         self.path = path
         self.cause = cause
-
-
-def norm(name):
-    """A name's spelling-free form: lower case, without spaces and underscores."""
-    return name.replace(" ", "").replace("_", "").lower()
 
 
 def type_code(t):
@@ -64,29 +60,32 @@ MEMBER = 2
 CODE = 3
 UNIT = 4
 PARAMS = 5
+SIGNATURE = 6
 
 
 class Catalog:
     """What is known about component members, by spelling-free (component, member) names.
 
-    An entry is ``[kind, component, member, type code, unit, params]``; ``kind`` is
-    "parameter", "activity" or "event"; ``params`` lists an operation's ``(name, unit)``.
+    An entry is ``[kind, component, member, type code, unit, params, signature]``; ``kind``
+    is "parameter", "activity" or "event"; ``params`` lists an operation's ``(name, unit)``;
+    ``signature`` the arguments the database declares, ``(name, type code, unit)``.
     """
 
     def __init__(self, sdb=None, interfaces=()):
         self.entries = {}
         self.interfaces = {}  # names of interfaces added
+        self.calibrated = {}  # "Component.attribute" -> sdb Parameter whose raw value differs
         self._paths = {}  # path -> entry or None, filled as paths are looked up
         if sdb is not None:
             self.add_sdb(sdb)
         for itf in interfaces or ():
             self.add_interface(itf)
 
-    def add(self, kind, comp, member, code=None, unit=None, params=None):
+    def add(self, kind, comp, member, code=None, unit=None, params=None, signature=None):
         key = (norm(comp), norm(member))
         e = self.entries.get(key)
         if e is None:
-            self.entries[key] = [kind, comp, member, code, _unit(unit), params]
+            self.entries[key] = [kind, comp, member, code, _unit(unit), params, signature]
         else:  # a second source fills in what the first left open
             if e[CODE] in (None, "?") and code:
                 e[CODE] = code
@@ -94,6 +93,8 @@ class Catalog:
                 e[UNIT] = _unit(unit)
             if e[PARAMS] is None and params is not None:
                 e[PARAMS] = params
+            if e[SIGNATURE] is None and signature is not None:
+                e[SIGNATURE] = signature
         self._paths = {}
 
     def add_interface(self, itf):
@@ -115,9 +116,16 @@ class Catalog:
             sdb = Sdb(sdb)
         for p in sdb.parameters.values():
             if p.component:
-                self.add("parameter", p.component, p.name, type_code(p.type_spec), p.unit)
+                code = type_code(p.type_spec)
+                if p.calibration or p.labels:  # PLUTO sees the engineering value
+                    self.calibrated[p.component + "." + p.name] = p
+                    code = "r" if p.calibration else "s"
+                self.add("parameter", p.component, p.name, code, p.unit)
         for op in sdb.operations.values():
-            self.add("activity", op.component, op.name, None, None, list(op.arguments))
+            sig = None
+            if op.signature is not None:
+                sig = [(n, argument_code(t), _unit(u)) for n, t, u in op.signature]
+            self.add("activity", op.component, op.name, None, None, list(op.arguments), sig)
         for e in sdb.events.values():
             if e.component:
                 self.add("event", e.component, e.name)

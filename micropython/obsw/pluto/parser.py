@@ -202,6 +202,8 @@ class Parser(ExprParser):
             return ("if", p, c, a, b)
         if self.take("in", "case"):
             return self.case(p)
+        if self.take("save", "context", "refer"):
+            return self.save_context(p)
         if self.take("while"):
             c = self.expr()
             to = self.timeout()
@@ -243,6 +245,22 @@ class Parser(ExprParser):
         if self.take(":="):
             return ("set", p, r, self.expr())
         return ("op", p, r, self.arguments_opt(("with",)))
+
+    def save_context(self, p):
+        """``save context refer to <reference> by <name> {, refer to ... by ...} [end context]``:
+        entries are [reference, name, variable key (set by the checker)]."""
+        items = []
+        while True:
+            self.expect("to", after="after 'save context refer'")
+            r = self.ref("a reporting data reference")
+            self.expect("by", after="after the saved reference")
+            items.append([r, self.name("a name for the saved value"), None])
+            if not self.isop(","):
+                break
+            self.i += 1
+            self.expect("refer", after="after ',' in save context")
+        self.take("end", "context")
+        return ("save", p, items)
 
     def expr_list(self):
         out = [self.expr()]

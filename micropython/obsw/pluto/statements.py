@@ -115,6 +115,12 @@ class Statements(Evaluator):
             yield from self._parallel(s)
         elif k == "ctx":
             yield from self._block(s[3])
+        elif k == "save":
+            vals = []
+            for item in s[2]:  # every value read first: one consistent snapshot
+                vals.append(self.eval(item[0]))
+            for i, item in enumerate(s[2]):
+                self.vars[item[2]] = vals[i]
 
     def _push(self, to, owner):
         e = [self.now + seconds(self.eval(to[0])), to[1], self.ts[1], owner]

@@ -288,6 +288,16 @@ def _civil_from_days(z):
     return yoe + era * 400 + (m <= 2), m, d
 
 
+def civil(days):
+    """(year, month, day) of a day count since 1970-01-01."""
+    return _civil_from_days(days)
+
+
+def days_from_civil(y, m, d):
+    """Day count since 1970-01-01 of a date of the proleptic Gregorian calendar."""
+    return _days_from_civil(y, m, d)
+
+
 class AbsTime:
     """An absolute time: seconds since 1970-01-01T00:00:00Z."""
 

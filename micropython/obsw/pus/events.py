@@ -26,7 +26,8 @@ class EventManager:
         self.listeners.append(app.event)
 
     def bind(self):
-        """Subscribe to every component event of the database on the node."""
+        """Watch every component event of the database on the node: a component that starts
+        later, or restarts, is subscribed (again) when it appears."""
         if self.node is None:
             return 0
         n = 0
@@ -35,11 +36,9 @@ class EventManager:
             if ev.component is None:
                 continue
             try:
-                self._subs.append(
-                    self.node.subscribe(ev.qualified, self._published, timeout=self.timeout)
-                )
+                self._subs.append(self.node.watch(ev.qualified, self._published))
                 n += 1
-            except InteractionError:
+            except InteractionError:  # an event the (local) component does not have
                 self.unbound.append(ev.qualified)
         return n
 

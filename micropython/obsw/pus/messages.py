@@ -114,6 +114,18 @@ TC_MEM_CHECK_OBJECT = (6, 7)
 TM_MEM_CHECK_OBJECT_REPORT = (6, 8)
 TC_MEM_CHECK_RAW = (6, 9)
 TM_MEM_CHECK_RAW_REPORT = (6, 10)
+TC_MEM_LOAD_RAW_ATOMIC = (6, 11)
+TC_MEM_ABORT_ALL_DUMPS = (6, 12)
+TC_MEM_ENABLE_SCRUBBING = (6, 13)
+TC_MEM_DISABLE_SCRUBBING = (6, 14)
+TC_MEM_ENABLE_WRITE_PROTECTION = (6, 15)
+TC_MEM_DISABLE_WRITE_PROTECTION = (6, 16)
+TC_MEM_CHECK_OBJECT_WHOLE = (6, 17)
+TM_MEM_CHECK_OBJECT_WHOLE_REPORT = (6, 18)
+TC_MEM_LOAD_RAW_BY_REFERENCE = (6, 19)
+TC_MEM_DUMP_RAW_TO_FILE = (6, 20)
+TC_MEM_LOAD_OBJECT_BY_REFERENCE = (6, 21)
+TC_MEM_DUMP_OBJECT_TO_FILE = (6, 22)
 
 # ST[08] function management
 TC_FUNCTION_PERFORM = (8, 1)
@@ -394,3 +406,11 @@ FAILURE_PATH = const(14)  # a path that escapes the filestore root or names no r
 FAILURE_FILESTORE = const(15)  # the filestore refused (no such file, exists, locked, full)
 FAILURE_OUT_OF_BOUNDS = const(16)  # an address or length outside the declared memory area
 FAILURE_OBCP_REJECTED = const(24)  # ST[18] procedure text that does not load (line, column)
+
+# project-defined failure codes of service 6 (memory management)
+FAILURE_ABORTED = const(32)  # the request was aborted by another one (TC[6,12])
+FAILURE_WRITE_PROTECTED = const(33)  # a load into a memory whose write protection is on
+FAILURE_READBACK = const(34)  # data read back after a load differ from the data loaded
+
+# project-defined failure codes of raw and engineering values (ST[20])
+FAILURE_OUT_OF_RANGE = const(30)  # a value outside the parameter's declared range

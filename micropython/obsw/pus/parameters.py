@@ -1,9 +1,11 @@
 """The parameter pool: PUS parameter values by id, cached from the interaction layer.
 
-Every attribute the spacecraft database maps to a parameter ID is subscribed to on the
+Every attribute the spacecraft database maps to a parameter ID is watched on the
 interaction layer node; each publication refreshes the cache, which is what housekeeping
-and service 20 read. Sets go through the node to the component (``aset`` from asyncio
-handlers, ``set`` from plain code), so the component stays the owner of its state.
+and service 20 read. A component that appears later, or comes back after a restart, is
+subscribed again and its values are read again (``bind``, then ``follow`` or ``refresh``).
+Sets go through the node to the component (``aset`` from asyncio handlers, ``set`` from
+plain code), so the component stays the owner of its state.
 Parameters of no component (the process's own counters) are served by getter functions.
 """
 
@@ -33,6 +35,8 @@ class ParameterPool:
         self._getters = {}  # pid -> (getter, setter) of process-local parameters
         self._by_topic = {}
         self._subs = []
+        self._routes = {}  # component -> the route its values were last read through
+        self.reads = 0  # attribute reads of components that (re)appeared, by follow()
         for p in sdb.parameters.values():
             if p.component is not None:
                 self._by_topic[(p.component, p.name)] = p.id
@@ -57,20 +61,82 @@ class ParameterPool:
         return p.id
 
     def bind(self):
-        """Subscribe to every component attribute on the node and read its current value."""
+        """Watch every component attribute on the node and read the current values of the
+        components that are there now; return how many attributes were read.
+
+        A component that is not there yet (it starts later) or that restarts is subscribed
+        again by the node's transport when it appears; ``refresh`` (or the ``follow`` task)
+        reads its values then, so PUS never keeps a frozen value of a component that came back.
+        """
+        if self.node is None:
+            return 0
+        if not self._subs:
+            for comp, member in self._by_topic:
+                self._subs.append(self.node.watch(comp + "." + member, self._published))
+        return self.refresh()
+
+    def _components(self):
+        out = {}
+        for (comp, member), pid in self._by_topic.items():
+            out.setdefault(comp, []).append((comp + "." + member, pid))
+        return out
+
+    def appeared(self):
+        """Components whose route is new since the last look (started, or restarted), and
+        refresh ``unbound`` (attributes of components that are not there now)."""
+        new = []
+        self.unbound = []
+        registry = self.node.registry
+        for comp, attrs in self._components().items():
+            route = registry.resolve(comp)
+            if route is None:
+                self._routes.pop(comp, None)
+                self.unbound.extend(name for name, _ in attrs)
+            elif self._routes.get(comp) is not route:
+                self._routes[comp] = route
+                new.append(comp)
+        return new
+
+    def _failed(self, comp, name):
+        self._routes.pop(comp, None)  # read again at the next look
+        self.unbound.append(name)
+
+    def refresh(self):
+        """Read the attributes of every component that (re)appeared (blocking calls)."""
         if self.node is None:
             return 0
         n = 0
-        self.unbound = []
-        for (comp, member), pid in self._by_topic.items():
-            name = comp + "." + member
-            try:
-                self._subs.append(self.node.subscribe(name, self._published, timeout=self.timeout))
-                self.values[pid] = self.node.get(name, timeout=self.timeout)
-                n += 1
-            except InteractionError:
-                self.unbound.append(name)
+        components = self._components()
+        for comp in self.appeared():
+            for name, pid in components[comp]:
+                try:
+                    self.values[pid] = self.node.get(name, timeout=self.timeout)
+                    n += 1
+                except InteractionError:
+                    self._failed(comp, name)
         return n
+
+    async def arefresh(self):
+        """``refresh`` for asyncio tasks: the reads are awaited."""
+        n = 0
+        components = self._components()
+        for comp in self.appeared():
+            for name, pid in components[comp]:
+                try:
+                    self.values[pid] = await self.node.aget(name, timeout=self.timeout)
+                    n += 1
+                except InteractionError:
+                    self._failed(comp, name)
+        self.reads += n
+        return n
+
+    async def follow(self, period=0.25):
+        """An asyncio task: every ``period`` seconds, read the components that (re)appeared."""
+        import asyncio  # only here: boards without asyncio still import this module
+
+        while True:
+            await self.arefresh()
+            await asyncio.sleep(period)
 
     def _published(self, pub):
         pid = self._by_topic.get((pub.component, pub.member))
@@ -126,3 +192,4 @@ class ParameterPool:
         for s in self._subs:
             s.cancel()
         self._subs = []
+        self._routes = {}

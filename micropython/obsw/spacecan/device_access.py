@@ -16,11 +16,26 @@ frame of packet-mode nodes to the controller and keeps the replies of raw-mode n
 A device is a SpaceCAN node id, or an id mapped to one by ``devices``. Errors reach the
 caller as ``ComponentError`` with the reason as its code. Sans-I/O; the time comes in with
 the frames and polls.
+
+The standard's device-level commands of PUS service 2 map onto packet-mode nodes through
+their node definitions (the controller's ``nodes``), with addresses made of the node id:
+
+- ``on_off(address)``, an on/off device command: ``address`` is node << 8 | on << 7 | line;
+  the node's ``set_bits`` (on) or ``clear_bits`` (off) function with the line's bit as mask;
+- ``load_register(address, value)`` and ``dump_register(address)``: a register is a node
+  parameter, ``address`` node << 16 | parameter id, ``value`` the parameter's encoded octets
+  as an unsigned integer (at most 4 octets); loaded with a parameter set (20,3), dumped with a
+  parameter request (20,1);
+- ``cpdu(line, duration)``, a CPDU command: ``line`` is node << 8 | output line, pulsed off
+  for ``duration`` ms by the node's ``power_cycle`` function;
+- ``check(kind, addresses)``: the first of ``addresses`` that names no such device, register
+  or line (``kind``: "on_off", "register", "cpdu"), or None.
 """
 
 from obsw.compat import const
 from obsw.il.errors import ComponentError
 from obsw.il.interface import LOW, Event, Interface, Operation
+from obsw.spacecan import encoding as enc
 from obsw.spacecan.fragment import Reassembler
 from obsw.spacecan.ids import FUNCTION_MASK, ID_REP, NODE_MASK
 from obsw.spacecan.requests import COMPLETED
@@ -40,10 +55,19 @@ DEVICE_ACCESS = Interface(
         Operation("command", 1, ("device", "data"), asynchronous=True),
         Operation("acquire", 2, ("device", "data"), asynchronous=True),
         Operation("request", 3, ("device", "service", "subtype", "data"), asynchronous=True),
+        Operation("on_off", 4, ("address",), asynchronous=True),
+        Operation("load_register", 5, ("address", "value"), asynchronous=True),
+        Operation("dump_register", 6, ("address",), asynchronous=True),
+        Operation("cpdu", 7, ("line", "duration"), asynchronous=True),
+        Operation("check", 8, ("kind", "addresses")),
         Event("device_timeout", 16, LOW, fields=("device",)),
     ],
     description="raw commands to equipment and their replies (PUS service 2)",
 )
+
+
+REGISTER_OCTETS = 4  # a register value is an unsigned integer of at most 4 octets
+_ON = 0x80
 
 
 def _frames(data):
@@ -51,6 +75,16 @@ def _frames(data):
     if not data:
         return [b""]
     return [data[i : i + 8] for i in range(0, len(data), 8)]
+
+
+def _no_result(req):
+    return None
+
+
+_CHECKS = {
+    "on_off": lambda a: "set_bits" if a & _ON else "clear_bits",
+    "cpdu": lambda a: "power_cycle",
+}
 
 
 class SpaceCanDeviceAccess:
@@ -106,7 +140,12 @@ class SpaceCanDeviceAccess:
             req = self.controller.request(node, service, subtype, bytes(data), self.now)
         except ValueError as e:
             raise ComponentError(BAD_REQUEST, str(e)) from None
-        self._requests[id(req)] = [job, node, []]
+        self._track(job, node, req)
+
+    def _track(self, job, node, req, result=None):
+        """Finish ``job`` when the node completes ``req``: with the report packets it sent,
+        or ``result(req)``."""
+        self._requests[id(req)] = [job, node, [], result]
         req.on_done = self._done
 
     def _done(self, req):
@@ -115,9 +154,91 @@ class SpaceCanDeviceAccess:
             return
         job = entry[0]
         if req.status == COMPLETED:
-            job.succeed(entry[2])
+            try:
+                job.succeed(entry[2] if entry[3] is None else entry[3](req))
+            except (ValueError, KeyError, TypeError) as e:
+                job.fail(ComponentError(BAD_REQUEST, str(e)))
         else:
             job.fail(ComponentError(req.status.upper(), req.error or req.status))
+
+    # -------------------------------------------------------------------------- PUS devices
+
+    def _definition(self, node):
+        nodedef = self.controller.nodes.get(node) if 1 <= node <= 127 else None
+        if nodedef is None:
+            raise ComponentError(UNKNOWN_DEVICE, "no node definition for node %d" % node)
+        return nodedef
+
+    def _line_function(self, address, name):
+        """(node, function, line) of an on/off address or CPDU line and its function."""
+        node = address >> 8
+        f = self._definition(node).function_by_name(name)
+        if f is None:
+            raise ComponentError(UNKNOWN_DEVICE, "node %d has no %s function" % (node, name))
+        return node, f, address & 0xFF
+
+    def _register(self, address):
+        """(node, parameter) of a register address."""
+        node, pid = address >> 16, address & 0xFFFF
+        p = self._definition(node).parameters.get(pid)
+        if p is None or p.encoding == "bool" or enc.size(p.encoding) > REGISTER_OCTETS:
+            raise ComponentError(UNKNOWN_DEVICE, "no register 0x%08X" % address)
+        return node, p
+
+    def _function_call(self, job, node, f, values):
+        args = {}
+        for a, v in zip(sorted(f.arguments), values):
+            args[a] = v
+        try:
+            req = self.controller.call_function(node, f.function_id, self.now, args)
+        except ValueError as e:
+            raise ComponentError(BAD_REQUEST, str(e)) from None
+        self._track(job, node, req, _no_result)
+
+    def on_off(self, job, address):
+        name = "set_bits" if address & _ON else "clear_bits"
+        node, f, line = self._line_function(address, name)
+        self._function_call(job, node, f, (1 << (line & 0x7F),))
+
+    def cpdu(self, job, line, duration):
+        node, f, output = self._line_function(line, "power_cycle")
+        self._function_call(job, node, f, (output, duration))
+
+    def load_register(self, job, address, value):
+        node, p = self._register(address)
+        width = enc.size(p.encoding)
+        if not 0 <= value < 1 << (8 * width):
+            raise ComponentError(BAD_REQUEST, "register value 0x%X: more than %d octets"
+                                 % (value, width))  # fmt: skip
+        try:
+            v = enc.decode(p.encoding, value.to_bytes(width, "big"))[0]
+            req = self.controller.set_parameters(node, {p.parameter_id: v}, self.now)
+        except ValueError as e:
+            raise ComponentError(BAD_REQUEST, str(e)) from None
+        self._track(job, node, req, _no_result)
+
+    def dump_register(self, job, address):
+        node, p = self._register(address)
+        try:
+            req = self.controller.request_parameters(node, [p.parameter_id], self.now)
+        except ValueError as e:
+            raise ComponentError(BAD_REQUEST, str(e)) from None
+
+        def value(r):
+            return int.from_bytes(enc.encode(p.encoding, r.result[p.parameter_id]), "big")
+
+        self._track(job, node, req, value)
+
+    def check(self, kind, addresses):
+        for a in addresses:
+            try:
+                if kind == "register":
+                    self._register(a)
+                else:
+                    self._line_function(a, _CHECKS[kind](a))
+            except (ComponentError, KeyError):
+                return a
+        return None
 
     # -------------------------------------------------------------------------- bus node
 

@@ -1,9 +1,10 @@
 """What every PUS service provider and service user shares, and the mission's field sizes.
 
-A provider subclasses ``Service``, names its service type and lists its handlers as
-``(message type, method name)`` pairs; a handler is a small method taking a ``Request``
-(``obsw.pus.app``), plain or ``async``. A user subclasses ``ServiceUser`` and lists the TM
-it decodes the same way; each decoder returns a dict of named values.
+A provider subclasses ``Service``, names its service type, lists its handlers as
+``(message type, method name)`` pairs and the TM types it emits as ``REPORTS``; a handler is
+a small method taking a ``Request`` (``obsw.pus.app``), plain or ``async``. A user subclasses
+``ServiceUser`` and lists the TM it decodes the same way; each decoder returns a dict of
+named values.
 
 The field types below are the packet layout choices ECSS-E-ST-70-41C leaves to the mission,
 named once. The defaults follow puslib's default policy so either side can talk to it.
@@ -38,6 +39,7 @@ class Service:
     SERVICE = 0
     NAME = None  # key in the context store; None keeps no state
     HANDLERS = ()  # ((service, subtype), "method name") pairs
+    REPORTS = ()  # the (service, subtype) TM types this provider emits (obsw pus coverage)
 
     def __init__(self):
         self.app = None

@@ -8,6 +8,7 @@ The user decodes the reports; the ground process matches them to its transaction
 
 from obsw.compat import const
 from obsw.pus.messages import (
+    FAILURE_ABORTED,
     FAILURE_BUSY,
     FAILURE_COMPONENT,
     FAILURE_EXECUTION,
@@ -15,11 +16,14 @@ from obsw.pus.messages import (
     FAILURE_ILLEGAL_APP_DATA,
     FAILURE_OBCP_REJECTED,
     FAILURE_OUT_OF_BOUNDS,
+    FAILURE_OUT_OF_RANGE,
     FAILURE_PATH,
+    FAILURE_READBACK,
     FAILURE_REFUSED,
     FAILURE_TIMEOUT,
     FAILURE_UNAVAILABLE,
     FAILURE_UNKNOWN_ID,
+    FAILURE_WRITE_PROTECTED,
     SERVICE_VERIFICATION,
     TM_VERIFY_ACCEPTANCE_FAILURE,
     TM_VERIFY_ACCEPTANCE_SUCCESS,
@@ -53,6 +57,10 @@ FAILURE_NAMES = {
     FAILURE_FILESTORE: "filestore refused",
     FAILURE_OUT_OF_BOUNDS: "out of bounds",
     FAILURE_OBCP_REJECTED: "OBCP rejected",
+    FAILURE_ABORTED: "aborted",
+    FAILURE_WRITE_PROTECTED: "write-protected",
+    FAILURE_READBACK: "read-back mismatch",
+    FAILURE_OUT_OF_RANGE: "out of range",
 }
 
 # stages of a request, in order
@@ -108,6 +116,17 @@ class Verification(Service):
     """The service 1 provider: builds and sends the reports the application process asks."""
 
     SERVICE = SERVICE_VERIFICATION
+    REPORTS = (
+        TM_VERIFY_ACCEPTANCE_SUCCESS,
+        TM_VERIFY_ACCEPTANCE_FAILURE,
+        TM_VERIFY_START_SUCCESS,
+        TM_VERIFY_START_FAILURE,
+        TM_VERIFY_PROGRESS_SUCCESS,
+        TM_VERIFY_PROGRESS_FAILURE,
+        TM_VERIFY_COMPLETION_SUCCESS,
+        TM_VERIFY_COMPLETION_FAILURE,
+        TM_VERIFY_ROUTING_FAILURE,
+    )
 
     def success(self, request_id, stage, destination=0, step=None):
         data = request_id.pack()

@@ -121,6 +121,7 @@ class ParameterStatistics(Service):
     """The service 4 provider, sampling a ``ParameterPool``."""
 
     SERVICE = SERVICE_PARAMETER_STATISTICS
+    REPORTS = (TM_STATS_REPORT, TM_STATS_DEFINITIONS_REPORT)
     NAME = "s04"
     HANDLERS = (
         (TC_STATS_REPORT, "report"),

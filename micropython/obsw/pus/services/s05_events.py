@@ -31,6 +31,13 @@ class EventReporting(Service):
     """The service 5 provider (see the module text)."""
 
     SERVICE = SERVICE_EVENT_REPORTING
+    REPORTS = (
+        TM_EVENT_INFORMATIVE,
+        TM_EVENT_LOW_SEVERITY,
+        TM_EVENT_MEDIUM_SEVERITY,
+        TM_EVENT_HIGH_SEVERITY,
+        TM_EVENT_DISABLED_LIST_REPORT,
+    )
     NAME = "s05"
     HANDLERS = (
         (TC_EVENT_ENABLE, "enable"),

@@ -1,13 +1,23 @@
-"""ST[09] time management: CUC time reports at a rate the ground sets.
+"""ST[09] time management: time reports, CUC or CDS, at a rate the ground sets.
 
-TM[9,2] carries the report rate exponent, the on-board time as a CUC (4 coarse, 2 fine
-octets, epoch of the TM time code) and the time reference status. A report goes out every
-``2 ** exponent`` seconds of on-board time, the first on the cycle after the rate is set.
-The exponent persists in the context store.
+The mission chooses the on-board time format once (``code``): TM[9,2] CUC time reports carry
+the report rate exponent, the on-board time as a CUC (4 coarse, 2 fine octets) and the time
+reference status; TM[9,3] CDS time reports carry the same with the time as a CDS (16-bit day,
+32-bit millisecond of day: PTC 9 PFC 1, CCSDS 301.0-B-4 3.3). Both count from the TM time
+code's epoch. TC[9,1] sets the rate: a report goes out every ``2 ** exponent`` seconds of
+on-board time (exponent 0 to ``MAX_EXPONENT``; above, the start of execution fails with
+``FAILURE_REFUSED`` and the rate is unchanged), the first on the cycle after the rate is set.
+Until a rate is set (``exponent`` None) no report goes out. The exponent persists in the
+context store.
 """
 
 from obsw.pus.fields import field
-from obsw.pus.messages import SERVICE_TIME_MANAGEMENT, TC_TIME_SET_REPORT_RATE, TM_TIME_CUC_REPORT
+from obsw.pus.messages import (
+    SERVICE_TIME_MANAGEMENT,
+    TC_TIME_SET_REPORT_RATE,
+    TM_TIME_CDS_REPORT,
+    TM_TIME_CUC_REPORT,
+)
 from obsw.pus.ptc_time import cuc_pfc
 from obsw.pus.services.base import E8, U8, Service, ServiceUser
 from obsw.pus.services.s01_verification import FAILURE_REFUSED, PusFailure
@@ -16,20 +26,27 @@ from obsw.pus.structure import Structure
 MAX_EXPONENT = 16  # once every 18 hours at the slowest
 RATE = Structure([("exponent", U8)])
 CUC_4_2 = field(9, cuc_pfc(4, 2))
+CDS_SHORT = field(9, 1)
 TIME_REPORT = Structure([("exponent", U8), ("time", CUC_4_2), ("status", E8)])
+CDS_TIME_REPORT = Structure([("exponent", U8), ("time", CDS_SHORT), ("status", E8)])
+CODES = {"cuc": (TM_TIME_CUC_REPORT, TIME_REPORT), "cds": (TM_TIME_CDS_REPORT, CDS_TIME_REPORT)}
 
 
 class TimeManagement(Service):
     """The service 9 provider; ``exponent`` is the initial report rate exponent (None: no
-    reports until the ground sets a rate)."""
+    reports until the ground sets a rate), ``code`` the time format, "cuc" or "cds"."""
 
     SERVICE = SERVICE_TIME_MANAGEMENT
+    REPORTS = (TM_TIME_CUC_REPORT, TM_TIME_CDS_REPORT)
     NAME = "s09"
     HANDLERS = ((TC_TIME_SET_REPORT_RATE, "set_rate"),)
 
-    def __init__(self, exponent=None):
+    def __init__(self, exponent=None, code="cuc"):
         super().__init__()
+        if code not in CODES:
+            raise ValueError("time report code %r; expected one of %s" % (code, sorted(CODES)))
         self.exponent = exponent
+        self.code = code
         self._next = None
         self.reports = 0
 
@@ -51,12 +68,12 @@ class TimeManagement(Service):
         self.persist()
 
     def time_report(self, destination=0):
-        t = self.app.time()
-        data = TIME_REPORT.pack(
-            {"exponent": self.exponent or 0, "time": t, "status": self.app.time_ref}
+        message_type, layout = CODES[self.code]
+        data = layout.pack(
+            {"exponent": self.exponent or 0, "time": self.app.time(), "status": self.app.time_ref}
         )
         self.reports += 1
-        return self.send(TM_TIME_CUC_REPORT, data, destination)
+        return self.send(message_type, data, destination)
 
     def cyclic(self, now):
         if self.exponent is None:
@@ -74,7 +91,7 @@ class TimeUser(ServiceUser):
     """The service 9 user; decoded times are seconds of the TM time code's epoch."""
 
     SERVICE = SERVICE_TIME_MANAGEMENT
-    DECODERS = ((TM_TIME_CUC_REPORT, "decode_time"),)
+    DECODERS = ((TM_TIME_CUC_REPORT, "decode_time"), (TM_TIME_CDS_REPORT, "decode_cds_time"))
 
     def set_rate(self, apid, exponent):
         return self.request(apid, TC_TIME_SET_REPORT_RATE, RATE.pack({"exponent": exponent}))
@@ -83,4 +100,10 @@ class TimeUser(ServiceUser):
         out = TIME_REPORT.unpack(tm.data)
         coarse, fine = out["time"]
         out["time"] = coarse + fine / 65536
+        return out
+
+    def decode_cds_time(self, tm):
+        out = CDS_TIME_REPORT.unpack(tm.data)
+        day, ms = out["time"][:2]
+        out["time"] = day * 86400 + ms / 1000
         return out

@@ -58,6 +58,12 @@ class TimeScheduling(Schedule):
     """The service 11 provider; ``margin`` in seconds (see ``Schedule`` for the rest)."""
 
     SERVICE = SERVICE_TIME_BASED_SCHEDULING
+    REPORTS = (
+        TM_SCHED_DETAIL_REPORT,
+        TM_SCHED_SUMMARY_REPORT,
+        TM_SCHED_SUBSCHEDULE_STATUS_REPORT,
+        TM_SCHED_GROUP_STATUS_REPORT,
+    )
     NAME = "s11"
     TAG = RELEASE_TIME
     OFFSET = TIME_OFFSET

@@ -78,6 +78,12 @@ class LargePacketTransfer(Service):
     """The service 13 provider (see the module text)."""
 
     SERVICE = SERVICE_LARGE_PACKET_TRANSFER
+    REPORTS = (
+        TM_LARGE_DOWNLINK_FIRST,
+        TM_LARGE_DOWNLINK_INTERMEDIATE,
+        TM_LARGE_DOWNLINK_LAST,
+        TM_LARGE_UPLINK_ABORTION,
+    )
     HANDLERS = (
         (TC_LARGE_UPLINK_FIRST, "first"),
         (TC_LARGE_UPLINK_INTERMEDIATE, "intermediate"),

@@ -1,24 +1,29 @@
 """ST[14] real-time forwarding control: which TM leaves the application process in real time.
 
-Three selections decide (ECSS-E-ST-70-41C 6.14): the report types (APID, service, subtype),
-the housekeeping structure IDs per APID for TM[3,25], and the event IDs per APID whose
-TM[5,x] are blocked. The provider is one of the application process's ``tm_filters``; what
-it withholds can still be stored by ST[15]. Initially every report of the process's own APID
-is forwarded. The three selections persist in the context store.
+Four selections decide (ECSS-E-ST-70-41C 6.14): the report types (APID, service, subtype),
+the housekeeping structure IDs per APID for TM[3,25], the diagnostic structure IDs per APID for
+TM[3,26], and the event IDs per APID whose TM[5,x] are blocked. The provider is one of the
+application process's ``tm_filters``; what it withholds can still be stored by ST[15].
+Initially every report of the process's own APID is forwarded. The selections persist in the
+context store.
 """
 
 from obsw.pus.messages import (
     SERVICE_REAL_TIME_FORWARDING,
     TC_FWD_ADD_BLOCKED_EVENTS,
+    TC_FWD_ADD_DIAG_STRUCTURES,
     TC_FWD_ADD_HK_STRUCTURES,
     TC_FWD_ADD_REPORT_TYPES,
     TC_FWD_DELETE_BLOCKED_EVENTS,
+    TC_FWD_DELETE_DIAG_STRUCTURES,
     TC_FWD_DELETE_HK_STRUCTURES,
     TC_FWD_DELETE_REPORT_TYPES,
     TC_FWD_REPORT_BLOCKED_EVENTS,
+    TC_FWD_REPORT_DIAG_STRUCTURES,
     TC_FWD_REPORT_HK_STRUCTURES,
     TC_FWD_REPORT_REPORT_TYPES,
     TM_FWD_BLOCKED_EVENTS_REPORT,
+    TM_FWD_DIAG_STRUCTURES_REPORT,
     TM_FWD_HK_STRUCTURES_REPORT,
     TM_FWD_REPORT_TYPES_REPORT,
 )
@@ -34,6 +39,7 @@ from obsw.pus.services.report_types import (
 from obsw.pus.structure import Structure
 
 EMPTY = Structure([])
+_DIAG_REPORT = (3, 26)
 
 
 def types_list(selection):
@@ -70,6 +76,12 @@ class ForwardingControl(Service):
     """The service 14 provider; ``forwards(header)`` is asked for every TM."""
 
     SERVICE = SERVICE_REAL_TIME_FORWARDING
+    REPORTS = (
+        TM_FWD_REPORT_TYPES_REPORT,
+        TM_FWD_HK_STRUCTURES_REPORT,
+        TM_FWD_DIAG_STRUCTURES_REPORT,
+        TM_FWD_BLOCKED_EVENTS_REPORT,
+    )
     NAME = "s14"
     HANDLERS = (
         (TC_FWD_ADD_REPORT_TYPES, "add_types"),
@@ -78,6 +90,9 @@ class ForwardingControl(Service):
         (TC_FWD_ADD_HK_STRUCTURES, "add_hk"),
         (TC_FWD_DELETE_HK_STRUCTURES, "delete_hk"),
         (TC_FWD_REPORT_HK_STRUCTURES, "report_hk"),
+        (TC_FWD_ADD_DIAG_STRUCTURES, "add_diag"),
+        (TC_FWD_DELETE_DIAG_STRUCTURES, "delete_diag"),
+        (TC_FWD_REPORT_DIAG_STRUCTURES, "report_diag"),
         (TC_FWD_ADD_BLOCKED_EVENTS, "add_blocked"),
         (TC_FWD_DELETE_BLOCKED_EVENTS, "delete_blocked"),
         (TC_FWD_REPORT_BLOCKED_EVENTS, "report_blocked"),
@@ -87,12 +102,14 @@ class ForwardingControl(Service):
         super().__init__()
         self.types = ReportTypes()
         self.hk = IdSelection()
+        self.diag = IdSelection()
         self.blocked = IdSelection()
         self.withheld = 0
 
     def attach(self, app):
         self.types.apids[app.apid] = {}
         self.hk.apids[app.apid] = set()
+        self.diag.apids[app.apid] = set()
         super().attach(app)
         app.tm_filters.append(self.forwards)
 
@@ -102,6 +119,11 @@ class ForwardingControl(Service):
         if not self.types.selects(h.apid, h.service, h.subtype):
             self.withheld += 1
             return False
+        if h.service == _DIAG_REPORT[0] and h.subtype == _DIAG_REPORT[1]:
+            if not self.diag.has(h.apid, h.sid()):
+                self.withheld += 1
+                return False
+            return True
         kind = hk_or_event_id(h)
         if kind is not None:
             if kind[0] == "hk":
@@ -116,17 +138,22 @@ class ForwardingControl(Service):
     # -------------------------------------------------------------------------- context
 
     def context(self):
-        return [self.types.context(), self.hk.context(), self.blocked.context()]
+        ctx = [self.types.context(), self.hk.context(), self.blocked.context()]
+        return ctx + [self.diag.context()]
 
     def restore(self, ctx):
-        types, hk, blocked = ctx
+        types, hk, blocked = ctx[:3]
         t = ReportTypes()
         t.restore(types)
         h = IdSelection()
         h.restore(hk)
         b = IdSelection()
         b.restore(blocked)
-        self.types, self.hk, self.blocked = t, h, b
+        d = self.diag
+        if len(ctx) > 3:  # contexts saved before diagnostic forwarding keep the initial one
+            d = IdSelection()
+            d.restore(ctx[3])
+        self.types, self.hk, self.blocked, self.diag = t, h, b, d
 
     # -------------------------------------------------------------------------- handlers
 
@@ -151,29 +178,45 @@ class ForwardingControl(Service):
         req.decode(EMPTY)
         req.report(TM_FWD_REPORT_TYPES_REPORT, REPORT_TYPES.pack({"apids": self.types.as_list()}))
 
-    def add_hk(self, req):
+    def _add_ids(self, req, selection):
         items = req.decode(HK_IDS)["apids"]
         req.start()
         for i in items:
-            self.hk.add(i["apid"], i["ids"])
+            selection.add(i["apid"], i["ids"])
         self.persist()
 
-    def delete_hk(self, req):
+    def _delete_ids(self, req, selection):
         items = req.decode(HK_IDS)["apids"]
         if not items:
             req.start()
-            self.hk.apids = {}
+            selection.apids = {}
         else:
             for i in items:
-                self.hk.check_delete(i["apid"], i["ids"])
+                selection.check_delete(i["apid"], i["ids"])
             req.start()
             for i in items:
-                self.hk.delete(i["apid"], i["ids"])
+                selection.delete(i["apid"], i["ids"])
         self.persist()
+
+    def add_hk(self, req):
+        self._add_ids(req, self.hk)
+
+    def delete_hk(self, req):
+        self._delete_ids(req, self.hk)
 
     def report_hk(self, req):
         req.decode(EMPTY)
         req.report(TM_FWD_HK_STRUCTURES_REPORT, HK_IDS.pack({"apids": self.hk.as_list()}))
+
+    def add_diag(self, req):
+        self._add_ids(req, self.diag)
+
+    def delete_diag(self, req):
+        self._delete_ids(req, self.diag)
+
+    def report_diag(self, req):
+        req.decode(EMPTY)
+        req.report(TM_FWD_DIAG_STRUCTURES_REPORT, HK_IDS.pack({"apids": self.diag.as_list()}))
 
     def add_blocked(self, req):
         items = req.decode(EVENT_IDS)["items"]
@@ -207,6 +250,7 @@ class ForwardingUser(ServiceUser):
     DECODERS = (
         (TM_FWD_REPORT_TYPES_REPORT, "decode_types"),
         (TM_FWD_HK_STRUCTURES_REPORT, "decode_hk"),
+        (TM_FWD_DIAG_STRUCTURES_REPORT, "decode_diag"),
         (TM_FWD_BLOCKED_EVENTS_REPORT, "decode_blocked"),
     )
 
@@ -234,6 +278,20 @@ class ForwardingUser(ServiceUser):
     def report_hk(self, apid):
         return self.request(apid, TC_FWD_REPORT_HK_STRUCTURES, b"", TM_FWD_HK_STRUCTURES_REPORT)
 
+    def add_diag(self, apid, selection):
+        """``selection`` is ``{apid: [diagnostic SIDs]}`` (an empty list: every SID)."""
+        data = HK_IDS.pack({"apids": ids_list(selection)})
+        return self.request(apid, TC_FWD_ADD_DIAG_STRUCTURES, data)
+
+    def delete_diag(self, apid, selection):
+        data = HK_IDS.pack({"apids": ids_list(selection)})
+        return self.request(apid, TC_FWD_DELETE_DIAG_STRUCTURES, data)
+
+    def report_diag(self, apid):
+        return self.request(
+            apid, TC_FWD_REPORT_DIAG_STRUCTURES, b"", TM_FWD_DIAG_STRUCTURES_REPORT
+        )
+
     def add_blocked(self, apid, selection):
         """``selection`` is ``{apid: [event IDs]}``."""
         data = EVENT_IDS.pack({"items": pairs_list(selection)})
@@ -251,6 +309,9 @@ class ForwardingUser(ServiceUser):
 
     def decode_hk(self, tm):
         return {"hk": {i["apid"]: i["ids"] for i in HK_IDS.unpack(tm.data)["apids"]}}
+
+    def decode_diag(self, tm):
+        return {"diag": {i["apid"]: i["ids"] for i in HK_IDS.unpack(tm.data)["apids"]}}
 
     def decode_blocked(self, tm):
         out = {}

@@ -70,3 +70,20 @@ RESIZE = Structure([("stores", Repeated(STORE_COUNT, [("store", STORE_ID), ("siz
 CHANGE_VC = Structure([("store", STORE_ID), ("vc", U8)])
 
 KIND_NAMES = {CIRCULAR: "circular", BOUNDED: "bounded"}
+
+# TC[15,24]: the packets of a time window of one store copied into another
+WINDOW_FROM_TO = 0  # time tag 1 <= storage time <= time tag 2
+WINDOW_AFTER = 1  # storage time >= time tag 1
+WINDOW_BEFORE = 2  # storage time <= time tag 2
+WINDOW_NAMES = {WINDOW_FROM_TO: "from-to", WINDOW_AFTER: "after", WINDOW_BEFORE: "before"}
+COPY_WINDOW = Structure(
+    [
+        ("window", E8),
+        ("tag1", TIME_TAG),
+        ("tag2", TIME_TAG),
+        ("source", STORE_ID),
+        ("target", STORE_ID),
+    ]
+)
+# TC[15,31], [15,32] and TM[15,38]: diagnostic structure IDs per APID, as for housekeeping
+STORE_DIAG = STORE_HK

@@ -8,7 +8,9 @@ refused when full). Retrieval sends the stored packets unchanged on the store's 
 channel (``ApplicationProcess.play``): by time range (TC[15,9]), by storage sequence numbers
 (TC[15,7], project-defined after PUS-A's packet range downlink) or as the open retrieval,
 which follows the store from a start time tag as packets arrive. ``rate`` packets per store
-go out per cycle of the application process. Store configuration and control persist in the
+go out per cycle of the application process. TC[15,24] copies a time window of one store into
+another, and diagnostic reports have their storage control as housekeeping reports do
+(``obsw.pus.services.s15_copy``). Store configuration and control persist in the
 context store; their content in log files of ``filestore`` (``obsw.pus.services
 .packet_store``), so the stores survive a restart.
 """
@@ -19,14 +21,17 @@ from obsw.pus.messages import (
     SERVICE_STORAGE_AND_RETRIEVAL,
     TC_STORE_ABORT_TIME_RANGE_RETRIEVAL,
     TC_STORE_ADD_BLOCKED_EVENTS,
+    TC_STORE_ADD_DIAG_STRUCTURES,
     TC_STORE_ADD_HK_STRUCTURES,
     TC_STORE_ADD_REPORT_TYPES,
     TC_STORE_CHANGE_OPEN_RETRIEVAL_START,
     TC_STORE_CHANGE_VIRTUAL_CHANNEL,
+    TC_STORE_COPY_BY_TIME_WINDOW,
     TC_STORE_CREATE,
     TC_STORE_DELETE,
     TC_STORE_DELETE_BLOCKED_EVENTS,
     TC_STORE_DELETE_CONTENT_UP_TO,
+    TC_STORE_DELETE_DIAG_STRUCTURES,
     TC_STORE_DELETE_HK_STRUCTURES,
     TC_STORE_DELETE_REPORT_TYPES,
     TC_STORE_DISABLE_STORAGE,
@@ -36,6 +41,7 @@ from obsw.pus.messages import (
     TC_STORE_REPORT_BLOCKED_EVENTS,
     TC_STORE_REPORT_CONFIGURATION,
     TC_STORE_REPORT_CONTENT_SUMMARY,
+    TC_STORE_REPORT_DIAG_STRUCTURES,
     TC_STORE_REPORT_HK_STRUCTURES,
     TC_STORE_REPORT_REPORT_TYPES,
     TC_STORE_REPORT_STATUS,
@@ -44,14 +50,15 @@ from obsw.pus.messages import (
     TC_STORE_RETRIEVE_SEQUENCE_RANGE,
     TC_STORE_START_TIME_RANGE_RETRIEVAL,
     TC_STORE_SUSPEND_OPEN_RETRIEVAL,
+    TM_HK_DIAG_REPORT,
     TM_STORE_BLOCKED_EVENTS_REPORT,
     TM_STORE_CONFIGURATION_REPORT,
     TM_STORE_CONTENT_SUMMARY_REPORT,
+    TM_STORE_DIAG_STRUCTURES_REPORT,
     TM_STORE_HK_STRUCTURES_REPORT,
     TM_STORE_REPORT_TYPES_REPORT,
     TM_STORE_STATUS_REPORT,
 )
-from obsw.pus.services.base import Service
 from obsw.pus.services.packet_store import BOUNDED, CIRCULAR, PacketStore
 from obsw.pus.services.report_types import (
     IdSelection,
@@ -59,6 +66,7 @@ from obsw.pus.services.report_types import (
     hk_or_event_id,
 )
 from obsw.pus.services.s01_verification import PusFailure
+from obsw.pus.services.s15_copy import CopyAndDiagnostics
 from obsw.pus.services.s15_layouts import (
     CHANGE_VC,
     CONFIGURATION,
@@ -85,16 +93,20 @@ def _failure(code, msg, sid):
 
 
 class Control:
-    """What one store keeps: report types, housekeeping SIDs, blocked event IDs."""
+    """What one store keeps: report types, housekeeping and diagnostic SIDs, blocked event
+    IDs."""
 
     def __init__(self):
         self.types = ReportTypes()
         self.hk = IdSelection()
         self.blocked = IdSelection()
+        self.diag = IdSelection()
 
     def selects(self, h):
         if not self.types.selects(h.apid, h.service, h.subtype):
             return False
+        if h.service == TM_HK_DIAG_REPORT[0] and h.subtype == TM_HK_DIAG_REPORT[1]:
+            return self.diag.has(h.apid, h.sid())
         kind = hk_or_event_id(h)
         if kind is None:
             return True
@@ -103,15 +115,22 @@ class Control:
         return not self.blocked.listed(h.apid, kind[1])
 
     def context(self):
-        return [self.types.context(), self.hk.context(), self.blocked.context()]
+        return [
+            self.types.context(),
+            self.hk.context(),
+            self.blocked.context(),
+            self.diag.context(),
+        ]
 
     def restore(self, ctx):
         self.types.restore(ctx[0])
         self.hk.restore(ctx[1])
         self.blocked.restore(ctx[2])
+        if len(ctx) > 3:  # contexts saved before diagnostic storage control have 3
+            self.diag.restore(ctx[3])
 
 
-class Storage(Service):
+class Storage(CopyAndDiagnostics):
     """The service 15 provider (see the module text).
 
     ``initial`` lists stores as dicts (``id``, ``size``, ``kind``, ``vc``, ``enabled``,
@@ -120,6 +139,15 @@ class Storage(Service):
     """
 
     SERVICE = SERVICE_STORAGE_AND_RETRIEVAL
+    REPORTS = (
+        TM_STORE_REPORT_TYPES_REPORT,
+        TM_STORE_CONTENT_SUMMARY_REPORT,
+        TM_STORE_STATUS_REPORT,
+        TM_STORE_CONFIGURATION_REPORT,
+        TM_STORE_HK_STRUCTURES_REPORT,
+        TM_STORE_BLOCKED_EVENTS_REPORT,
+        TM_STORE_DIAG_STRUCTURES_REPORT,
+    )
     NAME = "s15"
     HANDLERS = (
         (TC_STORE_ENABLE_STORAGE, "enable"),
@@ -149,6 +177,10 @@ class Storage(Service):
         (TC_STORE_ADD_BLOCKED_EVENTS, "add_blocked"),
         (TC_STORE_DELETE_BLOCKED_EVENTS, "delete_blocked"),
         (TC_STORE_REPORT_BLOCKED_EVENTS, "report_blocked"),
+        (TC_STORE_COPY_BY_TIME_WINDOW, "copy_window"),
+        (TC_STORE_ADD_DIAG_STRUCTURES, "add_diag"),
+        (TC_STORE_DELETE_DIAG_STRUCTURES, "delete_diag"),
+        (TC_STORE_REPORT_DIAG_STRUCTURES, "report_diag"),
     )
 
     def __init__(
@@ -189,6 +221,7 @@ class Storage(Service):
         self.stores[sid] = st
         c = self.controls[sid] = Control()
         c.hk.apids[self.app.apid] = set()  # every structure, as for real-time forwarding
+        c.diag.apids[self.app.apid] = set()
         return st
 
     # -------------------------------------------------------------------------- context

@@ -4,14 +4,17 @@ from obsw.pus.messages import (
     SERVICE_STORAGE_AND_RETRIEVAL,
     TC_STORE_ABORT_TIME_RANGE_RETRIEVAL,
     TC_STORE_ADD_BLOCKED_EVENTS,
+    TC_STORE_ADD_DIAG_STRUCTURES,
     TC_STORE_ADD_HK_STRUCTURES,
     TC_STORE_ADD_REPORT_TYPES,
     TC_STORE_CHANGE_OPEN_RETRIEVAL_START,
     TC_STORE_CHANGE_VIRTUAL_CHANNEL,
+    TC_STORE_COPY_BY_TIME_WINDOW,
     TC_STORE_CREATE,
     TC_STORE_DELETE,
     TC_STORE_DELETE_BLOCKED_EVENTS,
     TC_STORE_DELETE_CONTENT_UP_TO,
+    TC_STORE_DELETE_DIAG_STRUCTURES,
     TC_STORE_DELETE_HK_STRUCTURES,
     TC_STORE_DELETE_REPORT_TYPES,
     TC_STORE_DISABLE_STORAGE,
@@ -21,6 +24,7 @@ from obsw.pus.messages import (
     TC_STORE_REPORT_BLOCKED_EVENTS,
     TC_STORE_REPORT_CONFIGURATION,
     TC_STORE_REPORT_CONTENT_SUMMARY,
+    TC_STORE_REPORT_DIAG_STRUCTURES,
     TC_STORE_REPORT_HK_STRUCTURES,
     TC_STORE_REPORT_REPORT_TYPES,
     TC_STORE_REPORT_STATUS,
@@ -32,6 +36,7 @@ from obsw.pus.messages import (
     TM_STORE_BLOCKED_EVENTS_REPORT,
     TM_STORE_CONFIGURATION_REPORT,
     TM_STORE_CONTENT_SUMMARY_REPORT,
+    TM_STORE_DIAG_STRUCTURES_REPORT,
     TM_STORE_HK_STRUCTURES_REPORT,
     TM_STORE_REPORT_TYPES_REPORT,
     TM_STORE_STATUS_REPORT,
@@ -41,10 +46,12 @@ from obsw.pus.services.s14_forwarding import ids_list, pairs_list, types_dict, t
 from obsw.pus.services.s15_layouts import (
     CHANGE_VC,
     CONFIGURATION,
+    COPY_WINDOW,
     ONE_STORE,
     RESIZE,
     SEQUENCE_RANGE,
     STATUS_REPORT,
+    STORE_DIAG,
     STORE_EVENTS,
     STORE_HK,
     STORE_TYPES,
@@ -53,6 +60,9 @@ from obsw.pus.services.s15_layouts import (
     TIME_AND_STORES,
     TIME_RANGE,
     TIME_TAG,
+    WINDOW_AFTER,
+    WINDOW_BEFORE,
+    WINDOW_FROM_TO,
 )
 
 
@@ -74,6 +84,7 @@ class StorageUser(ServiceUser):
         (TM_STORE_CONFIGURATION_REPORT, "decode_configuration"),
         (TM_STORE_HK_STRUCTURES_REPORT, "decode_hk"),
         (TM_STORE_BLOCKED_EVENTS_REPORT, "decode_blocked"),
+        (TM_STORE_DIAG_STRUCTURES_REPORT, "decode_diag"),
     )
 
     def _stores(self, apid, message_type, stores, expect=None):
@@ -218,3 +229,46 @@ class StorageUser(ServiceUser):
         for i in out["items"]:
             blocked.setdefault(i["apid"], []).append(i["id"])
         return {"store": out["store"], "blocked": blocked}
+
+    # ---------------------------------------------------------------- TC[15,24], diagnostics
+
+    def copy_window(self, apid, source, target, start=None, end=None):
+        """TC[15,24]: copy the packets of ``source`` stored from ``start`` to ``end``
+        (seconds; one of them None for "after" or "before") into the empty ``target``."""
+        if start is None and end is None:
+            raise ValueError("a time window needs a start, an end or both")
+        if end is None:
+            window = WINDOW_AFTER
+        elif start is None:
+            window = WINDOW_BEFORE
+        else:
+            window = WINDOW_FROM_TO
+        values = {
+            "window": window,
+            "tag1": start or 0,
+            "tag2": end or 0,
+            "source": source,
+            "target": target,
+        }
+        return self.request(apid, TC_STORE_COPY_BY_TIME_WINDOW, COPY_WINDOW.pack(values))
+
+    def add_diag(self, apid, store, selection):
+        """TC[15,31]; ``selection`` is ``{apid: [structure IDs]}`` ([] for all)."""
+        data = STORE_DIAG.pack({"store": store, "apids": ids_list(selection)})
+        return self.request(apid, TC_STORE_ADD_DIAG_STRUCTURES, data)
+
+    def delete_diag(self, apid, store, selection):
+        """TC[15,32]."""
+        data = STORE_DIAG.pack({"store": store, "apids": ids_list(selection)})
+        return self.request(apid, TC_STORE_DELETE_DIAG_STRUCTURES, data)
+
+    def report_diag(self, apid, store):
+        """TC[15,37]; the reply is TM[15,38]."""
+        data = ONE_STORE.pack({"store": store})
+        return self.request(
+            apid, TC_STORE_REPORT_DIAG_STRUCTURES, data, TM_STORE_DIAG_STRUCTURES_REPORT
+        )
+
+    def decode_diag(self, tm):
+        out = STORE_DIAG.unpack(tm.data)
+        return {"store": out["store"], "diag": {i["apid"]: i["ids"] for i in out["apids"]}}

@@ -24,6 +24,7 @@ class ServiceTest(Service):
     """
 
     SERVICE = SERVICE_TEST
+    REPORTS = (TM_TEST_ARE_YOU_ALIVE_REPORT, TM_TEST_ON_BOARD_CONNECTION_REPORT)
     HANDLERS = (
         (TC_TEST_ARE_YOU_ALIVE, "are_you_alive"),
         (TC_TEST_ON_BOARD_CONNECTION, "connection_test"),

@@ -91,6 +91,7 @@ class ObcpManagement(Service):
     """
 
     SERVICE = SERVICE_OBCP
+    REPORTS = (TM_OBCP_STATUS_REPORT, TM_OBCP_ABORTED_REPORT)
     HANDLERS = (
         (TC_OBCP_LOAD_DIRECT, "load_direct"),
         (TC_OBCP_UNLOAD, "unload"),

@@ -7,8 +7,12 @@ application process; each request goes in through ``receive`` and is verified li
 ground TC, its reports going to its own source ID. An active sequence cannot be loaded
 again, unloaded or activated twice; aborting an inactive one is refused. Loaded sequences
 persist in the context store; after a restart every sequence is inactive. Loading by
-reference (TC[21,2], TC[21,8]) needs file management and is not provided. The checksum is
-the CRC-16/CCITT of the sequence's content as TC[21,12] reports it.
+reference (TC[21,2]; TC[21,8] loads and activates) takes the (request, delay) pairs from a
+file of the onboard filestore, named by repository and file as in ST[23]: the file holds
+them in the layout of TC[21,1] without the sequence ID (``SEQUENCE_FILE``;
+``RequestSequencingUser.sequence_file`` writes one). A file that is missing or locked fails
+with ``FAILURE_FILESTORE``, one that does not hold a sequence with ``FAILURE_REFUSED``. The
+checksum is the CRC-16/CCITT of the sequence's content as TC[21,12] reports it.
 """
 
 from binascii import hexlify, unhexlify
@@ -21,6 +25,8 @@ from obsw.pus.messages import (
     TC_SEQUENCE_ABORT_ALL,
     TC_SEQUENCE_ACTIVATE,
     TC_SEQUENCE_CHECKSUM,
+    TC_SEQUENCE_LOAD_AND_ACTIVATE,
+    TC_SEQUENCE_LOAD_BY_REFERENCE,
     TC_SEQUENCE_LOAD_DIRECT,
     TC_SEQUENCE_REPORT_CONTENT,
     TC_SEQUENCE_REPORT_STATUS,
@@ -33,6 +39,7 @@ from obsw.pus.messages import (
 from obsw.pus.packets import PusError
 from obsw.pus.ptc_time import cuc_pfc
 from obsw.pus.services.base import E8, U16, Service, ServiceUser
+from obsw.pus.services.file_refs import read_file, split_path
 from obsw.pus.services.s01_verification import (
     FAILURE_REFUSED,
     FAILURE_UNKNOWN_ID,
@@ -40,6 +47,7 @@ from obsw.pus.services.s01_verification import (
     app_data_error,
 )
 from obsw.pus.services.s11_scheduling import ticks
+from obsw.pus.services.s23_layouts import PATH
 from obsw.pus.services.schedule_user import describe_request, embed, request_bytes
 from obsw.pus.structure import Repeated, Structure
 from obsw.pus.tc import PusTc
@@ -53,12 +61,10 @@ DELAY = field(10, cuc_pfc(4, 2))
 
 EMPTY = Structure([])
 ID = Structure([("id", SEQUENCE_ID)])
-CONTENT = Structure(
-    [
-        ("id", SEQUENCE_ID),
-        ("items", Repeated(REQUEST_COUNT, [("request", REQUEST), ("delay", DELAY)])),
-    ]
-)
+ITEMS = Repeated(REQUEST_COUNT, [("request", REQUEST), ("delay", DELAY)])
+CONTENT = Structure([("id", SEQUENCE_ID), ("items", ITEMS)])
+SEQUENCE_FILE = Structure([("items", ITEMS)])  # the content of a file TC[21,2] loads
+BY_REFERENCE = Structure([("id", SEQUENCE_ID), ("repository", PATH), ("file", PATH)])
 STATUS_REPORT = Structure(
     [("items", Repeated(SEQUENCE_COUNT, [("id", SEQUENCE_ID), ("active", STATUS)]))]
 )
@@ -94,9 +100,17 @@ class RequestSequencing(Service):
     ``route(raw)`` takes requests for APIDs this process does not serve."""
 
     SERVICE = SERVICE_REQUEST_SEQUENCING
+    REPORTS = (
+        TM_SEQUENCE_STATUS_REPORT,
+        TM_SEQUENCE_CHECKSUM_REPORT,
+        TM_SEQUENCE_CONTENT_REPORT,
+        TM_SEQUENCE_ABORTED_REPORT,
+    )
     NAME = "s21"
     HANDLERS = (
         (TC_SEQUENCE_LOAD_DIRECT, "load"),
+        (TC_SEQUENCE_LOAD_BY_REFERENCE, "load_by_reference"),
+        (TC_SEQUENCE_LOAD_AND_ACTIVATE, "load_and_activate"),
         (TC_SEQUENCE_UNLOAD, "unload"),
         (TC_SEQUENCE_ACTIVATE, "activate"),
         (TC_SEQUENCE_ABORT, "abort"),
@@ -138,16 +152,41 @@ class RequestSequencing(Service):
             raise _id_failure(FAILURE_UNKNOWN_ID, "no sequence %r" % sid, sid)
         return s
 
+    def _requests(self, items):
+        return [PusTc.unpack(i["request"], self.app.config) for i in items]
+
     def load(self, req):
         try:
             tc = CONTENT.unpack(req.data)
-            tcs = [PusTc.unpack(i["request"], self.app.config) for i in tc["items"]]
+            tcs = self._requests(tc["items"])
         except PusError as e:
             raise app_data_error("request: %s" % e) from None
         except _DECODE_ERRORS as e:
             raise app_data_error(e) from None
         req.accept()
+        self._load(req, tc["id"], tc["items"], tcs)
+
+    def _from_file(self, req):
+        tc = req.decode(BY_REFERENCE)
         sid = tc["id"]
+        data = read_file(self.app, tc["repository"], tc["file"])
+        try:
+            items = SEQUENCE_FILE.unpack(data)["items"]
+            tcs = self._requests(items)
+        except (PusError,) + _DECODE_ERRORS as e:
+            raise _id_failure(FAILURE_REFUSED, "not a request sequence: %s" % e, sid) from None
+        return sid, items, tcs
+
+    def load_by_reference(self, req):
+        sid, items, tcs = self._from_file(req)
+        self._load(req, sid, items, tcs)
+
+    def load_and_activate(self, req):
+        sid, items, tcs = self._from_file(req)
+        self._load(req, sid, items, tcs)
+        self._activate(self.sequences[sid])
+
+    def _load(self, req, sid, entries, tcs):
         refused = None
         old = self.sequences.get(sid)
         if old is not None and old.active:
@@ -159,7 +198,7 @@ class RequestSequencing(Service):
         if refused:
             raise _id_failure(FAILURE_REFUSED, refused, sid)
         items = []
-        for i, t in zip(tc["items"], tcs):
+        for i, t in zip(entries, tcs):
             if t.apid not in self.app.apids and self.route is None:
                 raise _id_failure(FAILURE_UNKNOWN_ID, "no process %d" % t.apid, sid)
             c, f = i["delay"]
@@ -183,6 +222,9 @@ class RequestSequencing(Service):
         if s.active:
             raise _id_failure(FAILURE_REFUSED, "sequence %r is active" % s.id, s.id)
         req.start()
+        self._activate(s)
+
+    def _activate(self, s):
         s.active = True
         s.index = 0
         s.due = ticks(self.app.time())
@@ -272,6 +314,25 @@ class RequestSequencingUser(ServiceUser):
             "items": [{"request": request_bytes(r), "delay": d} for r, d in items],
         }
         return self.request(apid, TC_SEQUENCE_LOAD_DIRECT, CONTENT.pack(values))
+
+    def _by_reference(self, message_type, apid, sid, path):
+        repo, name = split_path(path)
+        data = BY_REFERENCE.pack({"id": sid, "repository": repo, "file": name})
+        return self.request(apid, message_type, data)
+
+    def load_by_reference(self, apid, sid, path):
+        """TC[21,2]: load sequence ``sid`` from a file (``SAT:/seq/warmup.seq``)."""
+        return self._by_reference(TC_SEQUENCE_LOAD_BY_REFERENCE, apid, sid, path)
+
+    def load_and_activate(self, apid, sid, path):
+        """TC[21,8]: load sequence ``sid`` from a file and activate it."""
+        return self._by_reference(TC_SEQUENCE_LOAD_AND_ACTIVATE, apid, sid, path)
+
+    @staticmethod
+    def sequence_file(items):
+        """The bytes of a file that TC[21,2] loads: ``items`` as for ``load``."""
+        values = [{"request": request_bytes(r), "delay": d} for r, d in items]
+        return SEQUENCE_FILE.pack({"items": values})
 
     def unload(self, apid, sid):
         return self._id(TC_SEQUENCE_UNLOAD, apid, sid)

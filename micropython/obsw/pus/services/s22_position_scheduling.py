@@ -4,12 +4,23 @@ The position is a parameter of the pool (e.g. the distance a rover has travelled
 navigation component publishes); an activity is released once the position reaches its tag.
 Tags are unsigned 32-bit integers in the parameter's unit and shifts signed 32-bit ones
 (both mission choices, ``POSITION`` and ``POSITION_OFFSET``). Everything else is the
-schedule shared with service 11 (``obsw.pus.services.schedule``). The orbit-number request
-TC[22,28] has no meaning for a rover and is not served.
+schedule shared with service 11 (``obsw.pus.services.schedule``).
+
+TC[22,28] sets the orbit number: the position parameter is set to it (through its component,
+so the component stays its owner), for a mission whose position is the orbit count (or a
+rover's odometer being re-based). The parameter must be writable and the value fit its type,
+else the request fails to start with ``FAILURE_REFUSED`` (the parameter ID in the data); a
+component that cannot be reached fails its completion as TC[20,3] does. Activities whose tag
+the new position has reached are released on the next cycle, as when the position moves.
 """
 
+from obsw.il.errors import CallTimeoutError, InteractionError, UnavailableError
 from obsw.pus.fields import field
 from obsw.pus.messages import (
+    FAILURE_COMPONENT,
+    FAILURE_REFUSED,
+    FAILURE_TIMEOUT,
+    FAILURE_UNAVAILABLE,
     SERVICE_POSITION_BASED_SCHEDULING,
     TC_POS_SCHED_CREATE_GROUPS,
     TC_POS_SCHED_DELETE_BY_FILTER,
@@ -31,6 +42,7 @@ from obsw.pus.messages import (
     TC_POS_SCHED_REPORT_GROUP_STATUS,
     TC_POS_SCHED_REPORT_SUBSCHEDULE_STATUS,
     TC_POS_SCHED_RESET,
+    TC_POS_SCHED_SET_ORBIT_NUMBER,
     TC_POS_SCHED_SUMMARY_REPORT_ALL,
     TC_POS_SCHED_SUMMARY_REPORT_BY_FILTER,
     TC_POS_SCHED_SUMMARY_REPORT_BY_ID,
@@ -39,17 +51,28 @@ from obsw.pus.messages import (
     TM_POS_SCHED_SUBSCHEDULE_STATUS_REPORT,
     TM_POS_SCHED_SUMMARY_REPORT,
 )
+from obsw.pus.parameters import ParameterError
+from obsw.pus.services.base import PARAMETER_ID
+from obsw.pus.services.s01_verification import PusFailure
 from obsw.pus.services.schedule import Schedule
 from obsw.pus.services.schedule_user import ScheduleUser
+from obsw.pus.structure import Structure
 
 POSITION = field(3, 14)
 POSITION_OFFSET = field(4, 14)
+ORBIT = Structure([("orbit", POSITION)])
 
 
 class PositionScheduling(Schedule):
     """The service 22 provider on ``pool``; ``parameter`` (ID or name) is the position."""
 
     SERVICE = SERVICE_POSITION_BASED_SCHEDULING
+    REPORTS = (
+        TM_POS_SCHED_DETAIL_REPORT,
+        TM_POS_SCHED_SUMMARY_REPORT,
+        TM_POS_SCHED_SUBSCHEDULE_STATUS_REPORT,
+        TM_POS_SCHED_GROUP_STATUS_REPORT,
+    )
     NAME = "s22"
     TAG = POSITION
     OFFSET = POSITION_OFFSET
@@ -82,6 +105,7 @@ class PositionScheduling(Schedule):
         (TC_POS_SCHED_ENABLE_GROUPS, "enable_groups"),
         (TC_POS_SCHED_DISABLE_GROUPS, "disable_groups"),
         (TC_POS_SCHED_REPORT_GROUP_STATUS, "report_groups"),
+        (TC_POS_SCHED_SET_ORBIT_NUMBER, "set_orbit"),
     )
 
     def __init__(self, pool, parameter, **options):
@@ -94,6 +118,33 @@ class PositionScheduling(Schedule):
             return self.pool.get(self.parameter)
         except KeyError:
             return None
+
+    def set_orbit(self, req):
+        orbit = req.decode(ORBIT)["orbit"]
+        pid = self.parameter
+        try:
+            p = self.pool.parameter(pid)
+            if not p.writable:
+                raise ParameterError("%s is read-only" % p.qualified, pid)
+            p.type.check(orbit)
+        except (ParameterError, ValueError) as e:
+            raise PusFailure(FAILURE_REFUSED, str(e), PARAMETER_ID.pack(pid)) from None
+        req.start()
+        if p.component is None or self.pool.node is None:
+            self.pool.set(pid, orbit)  # a process-local parameter: nothing to wait for
+            return None
+        return self._set_remote(pid, orbit)
+
+    async def _set_remote(self, pid, orbit):
+        try:
+            await self.pool.aset(pid, orbit)
+        except (InteractionError, ValueError) as e:
+            data = PARAMETER_ID.pack(pid)
+            if isinstance(e, CallTimeoutError):
+                raise PusFailure(FAILURE_TIMEOUT, e.message, data) from None
+            if isinstance(e, UnavailableError):
+                raise PusFailure(FAILURE_UNAVAILABLE, e.message, data) from None
+            raise PusFailure(FAILURE_COMPONENT, str(e), data) from None
 
 
 class PositionSchedulingUser(ScheduleUser):
@@ -138,3 +189,7 @@ class PositionSchedulingUser(ScheduleUser):
         "disable_groups": TC_POS_SCHED_DISABLE_GROUPS,
         "report_groups": TC_POS_SCHED_REPORT_GROUP_STATUS,
     }
+
+    def set_orbit(self, apid, orbit):
+        """TC[22,28]: set the orbit number (the position parameter) to ``orbit``."""
+        return self.request(apid, TC_POS_SCHED_SET_ORBIT_NUMBER, ORBIT.pack({"orbit": orbit}))

@@ -44,6 +44,7 @@ from obsw.pus.messages import (
     TC_FILE_SUSPEND_COPY_IN_PATH,
     TC_FILE_UNLOCK,
     TM_FILE_ATTRIBUTE_REPORT,
+    TM_FILE_COPY_STATUS_REPORT,
     TM_FILE_FOUND_REPORT,
     TM_FILE_REPOSITORY_SUMMARY_REPORT,
 )
@@ -99,6 +100,12 @@ class FileManagement(CopyOperations):
     """
 
     SERVICE = SERVICE_FILE_MANAGEMENT
+    REPORTS = (
+        TM_FILE_ATTRIBUTE_REPORT,
+        TM_FILE_FOUND_REPORT,
+        TM_FILE_REPOSITORY_SUMMARY_REPORT,
+        TM_FILE_COPY_STATUS_REPORT,
+    )
     NAME = "s23"
     HANDLERS = (
         (TC_FILE_CREATE, "create"),

@@ -1,0 +1,54 @@
+"""Every default of the mission configuration, in one place: section name -> key -> value.
+
+A mission file's section overrides these key by key (``section(config, "pus")``); nothing
+else in the OBC writes a default of its own.
+"""
+
+PUS = {
+    "period": 0.1,  # seconds per activity cycle
+    "playback_rate": 64,  # packets per second service 15 plays back
+    "device_timeout": 5.0,  # seconds service 2 waits for a device
+    "follow_period": 0.25,  # seconds between looks for components that (re)appeared
+    "time_code": "cuc",  # ST[09] time reports: "cuc" (TM[9,2]) or "cds" (TM[9,3])
+}
+CFDP = {"peers": {}}  # ports and ids: obsw_host.ports and obsw_host.ids (the mission's)
+OBCP = {"timeout": 2.0, "activity_timeout": 30.0, "level": 2, "step_period": 0.01}
+SPACECAN = {
+    "interface": "virtual",
+    "channels": ["can0", "can1"],
+    "heartbeat_period": 0.5,
+    "timeout": 0.5,
+    "retries": 2,
+    "simulate": False,
+}
+FRAMES = {
+    "uart_a": "pty",
+    "uart_b": "pty",
+    "tm_frame_length": 256,
+    "clcw_period": 0.5,
+    "uart_queue": 64,  # frames waiting for a UART; beyond, the oldest is dropped (counted)
+}
+PLATFORM = {
+    "heartbeat": 0.5,  # seconds between heartbeats
+    "deadline": 3.0,  # a process silent this long is hung: killed and restarted
+    "start_timeout": 20.0,  # a process's first heartbeat may take this long
+    "max_failures": 3,  # this many deaths or hangs of processes that ran healthy ...
+    "window": 60.0,  # ... within this many seconds: power-cycle the OBC
+    "power_cycle": {"component": "CpduN", "line": 0, "off_ms": 500},
+    "crash_loop": 3,  # this many deaths in a row before a first heartbeat: stop the process
+}
+SECTIONS = {
+    "pus": PUS,
+    "cfdp": CFDP,
+    "obcp": OBCP,
+    "spacecan": SPACECAN,
+    "frames": FRAMES,
+    "platform": PLATFORM,
+}
+
+
+def section(config, name):
+    """Section ``name`` of ``config`` over its defaults (a new dict)."""
+    out = dict(SECTIONS.get(name, {}))
+    out.update(config.section(name))
+    return out

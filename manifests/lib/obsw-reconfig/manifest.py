@@ -1,0 +1,27 @@
+metadata(
+    version="0.1.0",
+    description="the reconfiguration module: CPDU, safeguard memory, time, essential TC/TM",
+)
+
+require("obsw-base", library="obsw")
+require("obsw-frames", library="obsw")
+require("obsw-spacecan-node", library="obsw")
+
+package(
+    "obsw/reconfig",
+    files=[
+        "__init__.py",
+        "app.py",
+        "cpdu.py",
+        "ds3231.py",
+        "ecc.py",
+        "eeprom.py",
+        "essential.py",
+        "hal.py",
+        "mission.py",
+        "node.py",
+        "safeguard.py",
+        "watchdog.py",
+    ],
+    base_path="../../../micropython",
+)

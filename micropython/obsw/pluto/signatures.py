@@ -1,0 +1,91 @@
+"""PLUTO load-time checks of activity calls against their declared signatures (argument
+names, types and units from the spacecraft database or a simulated system's description)."""
+
+from obsw.pluto.exprcheck import (
+    _DECLARED,
+    NONE,
+    TIME,
+    PlutoReferenceError,
+    PlutoTypeError,
+    _a,
+    _show,
+)
+from obsw.pluto.system import norm
+from obsw.pluto.units import Quantity, dims
+
+
+class SignatureChecker:
+    """Mixed into the checker: ``fail``, ``expr``, ``argument``, ``operand`` and ``unit_name``
+    come from it."""
+
+    def signature(self, path, sig, args, scopes, p):
+        """Arguments against the activity's declared signature: names, count, types, units."""
+        takes = ", ".join([a[0] for a in sig]) or "none"
+        given = {}
+        for i, (name, v) in enumerate(args):
+            q = v[1] if isinstance(v, tuple) else p
+            if name is None:
+                if i >= len(sig):
+                    self.fail(PlutoTypeError, "activity %s takes %d arguments (%s), got %d"
+                              % (path, len(sig), takes, len(args)), q)  # fmt: skip
+                    self.argument(v, scopes)
+                    continue
+                decl = sig[i]
+            else:
+                decl = None
+                for d in sig:
+                    if norm(d[0]) == norm(name):
+                        decl = d
+                if decl is None:
+                    self.fail(PlutoReferenceError, "activity %s has no argument %s (takes: %s)"
+                              % (path, name, takes), q)  # fmt: skip
+                    self.argument(v, scopes)
+                    continue
+            if decl[0] in given:
+                self.fail(PlutoTypeError, "activity %s: argument %s given twice"
+                          % (path, decl[0]), q)  # fmt: skip
+            given[decl[0]] = True
+            if v[0] in ("rec", "arr"):
+                self.argument(v, scopes)
+                if decl[1] != "?":
+                    self.fail(PlutoTypeError, "activity %s: argument %s takes %s, got a%s"
+                              % (path, decl[0], _a(_DECLARED[decl[1]]),
+                                 " record" if v[0] == "rec" else "n array"), q)  # fmt: skip
+                continue
+            self.argument_type(path, decl, v, self.expr(v, scopes), q)
+        for d in sig:
+            if d[0] not in given:
+                self.fail(PlutoTypeError, "activity %s needs argument %s (takes: %s)"
+                          % (path, d[0], takes), p)  # fmt: skip
+
+    def argument_type(self, path, decl, v, et, p):
+        name, code, unit = decl
+        if code == "?" or et[0] == "?":
+            return
+        want = _DECLARED[code] + (" in " + unit if unit and code != "rt" else "")
+        why = None
+        if code in ("i", "u", "r"):
+            if et[0] not in "ir":
+                why = "types %s and %s differ" % (_show(et), _DECLARED[code])
+            elif code != "r" and et[0] == "r":
+                why = "a real is no integer"
+            elif et[1] != NONE and et[1] != (dims(unit) if unit else NONE):
+                why = "units %s and %s differ" % (self.unit_name(v, et), unit or "none")
+            elif code == "u" and v[0] == "c" and _below_zero(v[2]):
+                why = "it is negative"
+        elif code == "rt":
+            if not (et[0] in "ir" and et[1] == TIME):
+                why = "it is no relative time"
+        elif code == "s":
+            if et[0] not in "se":
+                why = "types %s and string differ" % _show(et)
+        elif et[0] != code:
+            why = "types %s and %s differ" % (_show(et), _DECLARED[code])
+        if why:
+            self.fail(PlutoTypeError, "activity %s: argument %s takes %s, got %s: %s"
+                      % (path, name, _a(want), self.operand(v, et), why), p)  # fmt: skip
+
+
+def _below_zero(v):
+    n = v.value if isinstance(v, Quantity) else v
+    return type(n) is not bool and isinstance(n, (int, float)) and n < 0

@@ -16,6 +16,7 @@ from obsw.frames.cltu import encode
 from obsw.frames.sdls_gcm import GcmSecurityAssociation
 from obsw.frames.tc import TcFrame
 from obsw_host.frames import keys
+from obsw_host.ids import MissionIds
 from obsw_host.sample import SDB_PATH
 from obsw_host.yamcs import database, instance, server
 from obsw_host.yamcs.spacecraft import ASM, SampleSpacecraft
@@ -24,7 +25,9 @@ MISSING = server.missing()
 pytestmark = pytest.mark.skipif(MISSING is not None, reason=str(MISSING))
 MISSION = "/obsw-demo"
 TIMEOUT = 30.0
-TM_VCS = (0, 1, instance.CFDP_VC, 6)
+IDS = MissionIds.sample()
+SCID = IDS.scid
+TM_VCS = tuple(sorted(set(IDS.tm_vcs.values()) | {IDS.cfdp_vc}))
 
 
 def free_port(kind=socket.SOCK_STREAM):
@@ -168,7 +171,7 @@ def test_forged_and_replayed_tc_refused_and_counted(secured):
     # a frame protected under a key that is not the mission's (same SPI)
     wrong = sdls.TcSecurity([GcmSecurityAssociation(1, 0, os.urandom(32))], False)
     ping = bytes((0x18, 0x64, 0xC0, 0, 0, 0x06, 0x21, 17, 1, 0, 0, 0, 0))
-    forged = TcFrame(instance.SCID, 0, wrong.apply(instance.SCID, 0, ping, True), 0, True)
+    forged = TcFrame(SCID, 0, wrong.apply(SCID, 0, ping, True), 0, True)
     out.sendto(encode(forged.pack()), ("127.0.0.1", port))
     out.sendto(replayed, ("127.0.0.1", port))
     end = time.monotonic() + TIMEOUT

@@ -4,6 +4,7 @@ then every start logs that commanding is unauthenticated)."""
 
 import json
 import os
+import shutil
 
 import pytest
 from obsw_host.cli import main
@@ -11,19 +12,21 @@ from obsw_host.frames import keys, policy
 from obsw_host.obc import config as obc_config
 from obsw_host.obc.frames_unit import FramesUnit
 from obsw_host.obc.topology import Topology
+from obsw_host.sample import MISSION_DIR, MISSION_PATH
 
 
 def mission(tmp_path, **frames):
-    with open(obc_config.SAMPLE) as f:
+    """A copy of the sample mission folder whose one process runs the frame processor."""
+    folder = tmp_path / "mission"
+    if not folder.exists():
+        shutil.copytree(MISSION_DIR, str(folder))
+    path = folder / "mission.json"
+    with open(MISSION_PATH) as f:
         doc = json.load(f)
-    base = os.path.dirname(obc_config.SAMPLE)
-    doc["sdb"] = os.path.join(base, doc["sdb"])
-    doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])
     os.makedirs(tmp_path / "state", exist_ok=True)
     doc["state"] = str(tmp_path / "state")
     doc["processes"] = {"frames": ["frames"]}
-    doc["frames"] = dict({"uart_a": "pty", "uart_b": "pty", "tm_port": 0}, **frames)
-    path = tmp_path / "mission.json"
+    doc["frames"] = dict({"uart_a": "pty", "uart_b": "pty"}, **frames)
     path.write_text(json.dumps(doc))
     return str(path)
 
@@ -41,7 +44,7 @@ def test_no_keys_refuses_to_start(tmp_path, capsys):
 
 
 def test_missing_or_open_key_file_refuses_to_start(tmp_path, capsys):
-    assert "does not exist" in refused(capsys, mission(tmp_path, keys="absent.keys"))
+    assert "absent.keys" in refused(capsys, mission(tmp_path, keys="absent.keys"))
     path = tmp_path / "tc.keys"
     keys.generate(str(path))
     os.chmod(path, 0o644)

@@ -39,6 +39,14 @@ PLATFORM = {
     "window": 60.0,  # ... within this many seconds: power-cycle the OBC
     "power_cycle": {"component": "CpduN", "line": 0, "off_ms": 500},
     "crash_loop": 3,  # this many deaths in a row before a first heartbeat: stop the process
+    # supervision (obsw_host.obc.supervision): the hardware watchdog and health telemetry
+    "watchdog": None,  # watchdog device (e.g. "/dev/watchdog"); None: no hardware watchdog
+    "watchdog_timeout": 15,  # seconds without a kick before the board resets (Pi: at most 15)
+    "critical": None,  # processes the watchdog waits for; None: every process
+    "health_period": 1.0,  # seconds between samples of the OBC's health telemetry
+    "health_root": "/",  # where /proc and /sys are (a simulated tree in tests)
+    "disk": None,  # the file system whose use is reported; None: the state folder's
+    "thermal_zone": "thermal_zone0",  # /sys/class/thermal/<zone>/temp: the SoC's sensor
 }
 SECTIONS = {
     "pus": PUS,

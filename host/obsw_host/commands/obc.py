@@ -170,8 +170,8 @@ def install_service(args):
         state = args.state or (config.state if "state" in config.doc else None)
         text = service.unit_text(
             mission=os.path.abspath(config.path),
-            obsw=args.obsw or os.path.join(os.path.dirname(os.path.abspath(sys.executable)),
-                                           "obsw"),  # fmt: skip
+            obsw=args.obsw
+            or os.path.join(os.path.dirname(os.path.abspath(sys.executable)), "obsw"),  # fmt: skip
             state=os.path.abspath(state) if state else None,
             user=args.user,
             watchdog_sec=args.watchdog_sec,

@@ -27,9 +27,7 @@ class Supervision:
         self.manager = manager
         settings = manager.settings
         critical = settings.get("critical")
-        self.critical = [
-            c for c in manager.children if critical is None or c.name in critical
-        ]
+        self.critical = [c for c in manager.children if critical is None or c.name in critical]
         device = settings.get("watchdog")
         self.watchdog = wd.Watchdog(device, settings.get("watchdog_timeout")) if device else None
         self.state = wd.WAITING if self.watchdog is not None else wd.DISABLED

@@ -2,7 +2,7 @@
 behaves as the kernel's watchdog does.
 
 ``SimulatedWatchdog(path, timeout).start()`` makes the FIFO and reads it in a thread: the
-first writer arms it, each write is a kick, ``V`` followed by the writer's close disarms it,
+first writer arms it, each write (one octet) is a kick, ``V`` followed by the writer's close disarms it,
 a close without ``V`` leaves it armed. When it is armed and no kick came for ``timeout``
 seconds it "resets the board": ``resets`` counts it, ``on_reset()`` is called, and it waits
 disarmed for the next writer (a rebooted OBC). Its clock is passed in for tests.
@@ -66,7 +66,7 @@ class SimulatedWatchdog:
         if not self.armed:
             self.armed = True
         self._magic = data.endswith(b"V")
-        self.kicks.append(now)
+        self.kicks.extend([now] * len(data))  # one octet per write: writes read together
         self._last = now
 
     def check(self):

@@ -290,7 +290,7 @@ def test_systemd_hears_ready_status_and_watchdog(notify_socket):
 
 
 def fake_tree(root, idle=800, busy=200, temp="48312\n"):
-    (root / "proc").mkdir(exist_ok=True)
+    (root / "proc").mkdir(parents=True, exist_ok=True)
     (root / "proc" / "stat").write_text(
         "cpu  %d 0 0 %d 0 0 0 0 0 0\ncpu0 1 2 3 4 5 6 7 8 0 0\n" % (busy, idle)
     )

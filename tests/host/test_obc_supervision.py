@@ -12,13 +12,19 @@ import sys
 import time
 
 import pytest
-from obsw_host.commands.obc import main as _unused  # noqa: F401  (the CLI imports cleanly)
+from obsw.il.clock import SimClock
+from obsw.pus.app import ApplicationProcess
+from obsw.pus.parameters import ParameterPool
+from obsw.pus.services.s12_monitoring import OnBoardMonitoring
+from obsw_host.obc import monitoring
 from obsw_host.obc import watchdog as wd
+from obsw_host.obc.config import ConfigError
 from obsw_host.obc.health import HostHealth, ObcHealth
 from obsw_host.obc.sdnotify import Notifier
 from obsw_host.obc.service import DEFAULTS, unit_text
 from obsw_host.obc.supervision import Supervision
 from obsw_host.obc.watchdog_sim import SimulatedWatchdog
+from obsw_host.sample import load_sdb
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 OBSW = os.path.join(os.path.dirname(sys.executable), "obsw")
@@ -423,3 +429,65 @@ def test_systemd_accepts_the_unit(tmp_path):
     path.write_text(unit_text(obsw="/bin/true", user="root"))
     r = subprocess.run(["systemd-analyze", "verify", str(path)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
+
+
+# ------------------------------------------------------------------------------ monitoring
+
+
+class FakeStore:
+    def __init__(self, saved=None):
+        self.saved = dict(saved or {})
+
+    def load(self, name, default=None):
+        return self.saved.get(name, default)
+
+    def save(self, name, value):
+        self.saved[name] = value
+
+
+def monitoring_app(store):
+    db = load_sdb()
+    app = ApplicationProcess(10, lambda raw: None, SimClock(0.0), store=store)
+    app.register(OnBoardMonitoring(ParameterPool(db), db.events))
+    return app, db
+
+
+SAMPLE_CHECKS = [
+    {"pmon": 43, "parameter": "Obc.temperature", "low": -40, "high": 80,
+     "low_event": "monitoring.obc_low", "high_event": "monitoring.obc_high", "interval": 10,
+     "repetitions": 3},
+    {"pmon": 40, "parameter": "Obc.cpu_load", "low": 0, "high": 95, "enabled": False},
+]  # fmt: skip
+
+
+def test_the_missions_limit_checks_are_installed_at_the_first_start_only():
+    store = FakeStore()
+    app, db = monitoring_app(store)
+    assert monitoring.install(app, db, SAMPLE_CHECKS) == 2
+    s12 = app.services[12]
+    t = s12.pmons[43]
+    assert t.enabled and (t.d["low"], t.d["high"]) == (-40, 80)
+    assert (t.d["interval"], t.d["repetitions"]) == (10, 3)
+    assert t.d["high_event"] == db.event("monitoring.obc_high").id
+    assert not s12.pmons[40].enabled
+    assert [d["pmon"] for d, _ in store.saved["s12"]["pmons"]] == [43, 40]
+    store.saved["s12"]["pmons"].pop()  # an operator deleted one: it stays deleted
+    again, _ = monitoring_app(store)
+    assert monitoring.install(again, db, SAMPLE_CHECKS) == 0
+    assert list(again.services[12].pmons) == [43]
+
+
+@pytest.mark.parametrize(
+    "entry, why",
+    [
+        ({"pmon": 1, "parameter": "Obc.nothing", "low": 0, "high": 1}, "Obc.nothing"),
+        ({"pmon": 1, "parameter": "Obc.cpu_load", "low": 5, "high": 1}, "low above high"),
+        ({"pmon": 1, "parameter": "Obc.cpu_load", "high": 1}, "low"),
+        ({"pmon": 1, "parameter": "Obc.cpu_load", "low": 0, "high": 1, "high_event": "x"}, "x"),
+    ],
+)
+def test_a_bad_limit_check_is_a_configuration_error_naming_the_entry(entry, why):
+    app, db = monitoring_app(FakeStore())
+    with pytest.raises(ConfigError) as e:
+        monitoring.install(app, db, [SAMPLE_CHECKS[0], entry])
+    assert str(e.value).startswith("pus.monitoring[1]: ") and why in str(e.value)

@@ -27,7 +27,8 @@ def mission(tmp_path, **platform):
 
 
 def ground_of(config, pm):
-    return Ground(pm.topology.sdb, target=("127.0.0.1", config.section("pus")["port"]), timeout=5.0)
+    port = config.section("pus")["port"]
+    return Ground(pm.topology.sdb, target=("127.0.0.1", port), timeout=5.0)
 
 
 def value(ground, key):
@@ -91,7 +92,7 @@ def settings(ground):
     return {
         "speed": value(ground, "SolarPanel.speed"),
         "distance": value(ground, "nav.distance"),
-        "monitors": [d["pmon"] for d in monitors.reply["items"]] if monitors.ok else None,
+        "monitors": sorted(d["pmon"] for d in monitors.reply["items"]) if monitors.ok else None,
         "actions": len(actions.reply["items"]) if actions.ok else None,
         "scheduled": len(scheduled.reply["activities"]) if scheduled.ok else None,
     }
@@ -114,7 +115,8 @@ def test_settings_survive_restarts_of_pus_of_a_component_and_of_the_obc(tmp_path
         assert ground.add_action("monitoring.speed_high", action).ok
         timed = ground.function_request("SolarPanel.set_angle", angle=15.0)
         assert ground.schedule_in(3600.0, timed).ok
-        made = {"speed": 8.0, "distance": 1234, "monitors": [1], "actions": 1, "scheduled": 1}
+        checks = [1, 40, 41, 42, 43]  # the operator's and the mission's limit checks
+        made = {"speed": 8.0, "distance": 1234, "monitors": checks, "actions": 1, "scheduled": 1}
         assert settings(ground) == made
 
         core = pm.child("core")

@@ -10,6 +10,7 @@ PUS = {
     "device_timeout": 5.0,  # seconds service 2 waits for a device
     "follow_period": 0.25,  # seconds between looks for components that (re)appeared
     "time_code": "cuc",  # ST[09] time reports: "cuc" (TM[9,2]) or "cds" (TM[9,3])
+    "monitoring": [],  # ST[12] limit checks installed at the first start (obc.monitoring)
 }
 CFDP = {"port": 5100, "peers": {}}
 OBCP = {"timeout": 2.0, "activity_timeout": 30.0, "level": 2, "step_period": 0.01}

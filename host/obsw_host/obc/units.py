@@ -24,6 +24,7 @@ from obsw.store import Store
 
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.il.transport import SocketTransport
+from obsw_host.obc import monitoring
 from obsw_host.obc.health import HostHealth, ObcHealth
 from obsw_host.obc.topology import OBC_HEALTH, PLATFORM, PLATFORM_EVENTS
 from obsw_host.pus.onboard import Onboard
@@ -146,6 +147,7 @@ class PusUnit:
         self.app = self.onboard.app
         self.obcp = self.app.services.get(18)
         self.node.provide(PLATFORM, PlatformEvents(self.app, sdb, self.health))
+        monitoring.install(self.app, sdb, opts["monitoring"])  # first start: the mission's
         self._running = False
 
     # -------------------------------------------------------------------------- building

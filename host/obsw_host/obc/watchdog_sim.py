@@ -3,9 +3,9 @@ behaves as the kernel's watchdog does.
 
 ``SimulatedWatchdog(path, timeout).start()`` makes the FIFO and reads it in a thread: the
 first writer arms it, each write (one octet) is a kick, ``V`` followed by the writer's close
-disarms it, a close without ``V`` leaves it armed. When it is armed and no kick came for ``timeout``
-seconds it "resets the board": ``resets`` counts it, ``on_reset()`` is called, and it waits
-disarmed for the next writer (a rebooted OBC). Its clock is passed in for tests.
+disarms it, a close without ``V`` leaves it armed. When it is armed and no kick came for
+``timeout`` seconds it "resets the board": ``resets`` counts it, ``on_reset()`` is called, and
+it waits disarmed for the next writer (a rebooted OBC). Its clock is passed in for tests.
 """
 
 import os

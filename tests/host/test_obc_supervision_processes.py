@@ -45,9 +45,7 @@ def test_watchdog_and_systemd_follow_the_health_of_every_process(tmp_path):
     fake_tree(tree)
     device = SimulatedWatchdog(str(tmp_path / "watchdog"), 30.0).start()
     systemd = FakeSystemd(str(tmp_path / "notify"))
-    config = mission(
-        tmp_path, watchdog=device.path, health_root=str(tree), health_period=0.2
-    )
+    config = mission(tmp_path, watchdog=device.path, health_root=str(tree), health_period=0.2)
     lines = []
     notifier = Notifier(systemd.path, 1_000_000)
     pm = PlatformManager(config, out=lines.append, notifier=notifier).start()

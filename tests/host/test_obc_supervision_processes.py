@@ -7,6 +7,8 @@ component, and of the whole OBC. Every wait has a deadline; nothing asserts on t
 import os
 import signal
 
+from obsw.il.node import Node
+from obsw_host.il.transport import SocketTransport
 from obsw_host.obc import config as obc_config
 from obsw_host.obc import watchdog as wd
 from obsw_host.obc.platform import PlatformManager
@@ -140,4 +142,63 @@ def test_settings_survive_restarts_of_pus_of_a_component_and_of_the_obc(tmp_path
     finally:
         if ground is not None:
             ground.close()
+        pm.stop()
+
+
+WORKER = '''
+import threading
+import time
+
+from obsw.il.interface import Interface, Operation
+
+Worker = Interface("Worker", 0x500, [Operation("freeze", 1, ())])
+
+
+class Work:
+    """A component whose work runs in a thread; freeze() blocks that thread for good."""
+
+    def __init__(self):
+        self.last = time.monotonic()
+        self.frozen = threading.Event()
+        threading.Thread(target=self._run, daemon=True).start()
+
+    def _run(self):
+        while True:
+            if self.frozen.is_set():
+                threading.Event().wait()  # a deadlock: the process lives, the work is stuck
+            self.last = time.monotonic()
+            time.sleep(0.05)
+
+    def freeze(self):
+        self.frozen.set()
+
+    def alive(self):
+        return time.monotonic() - self.last < 1.0
+'''
+
+
+def test_a_hung_unit_inside_a_live_process_is_restarted(tmp_path):
+    (tmp_path / "worker.py").write_text(WORKER)
+    doc = sample()
+    doc["processes"] = {"core": ["pus"], "work": ["Worker"]}
+    doc["components"]["Worker"] = {"module": "worker.py", "class": "Work"}
+    doc["pus"]["port"] = free_port()
+    doc["cfdp"]["port"] = free_port()
+    doc["platform"].update(heartbeat=0.2, deadline=1.5, max_failures=10)
+    path = write_config(tmp_path, doc)
+    config = obc_config.load(path)
+    lines = []
+    pm = PlatformManager(config, out=lines.append).start()
+    node = Node("test-user")
+    transport = SocketTransport(node, config.il_directory, listen=False)
+    try:
+        assert wait_for(pm.up), lines
+        work = pm.child("work")
+        old = work.pid
+        node.call("Worker.freeze", timeout=5.0)
+        assert wait_for(lambda: work.restarts == 1 and work.last_beat is not None), lines
+        assert work.pid != old  # the stuck process was killed and a new one answers
+        assert any("work" in t and "silent" in t for _, t in pm.log)
+    finally:
+        transport.close()
         pm.stop()

@@ -229,8 +229,10 @@ class PlatformManager:
 
     def _send_status(self):
         """Restarts and watchdog state to the PUS process's ``Obc`` health component."""
-        if not all(c.last_beat is not None for c in self.children if not c.stopped):
-            return  # a process is down: its heartbeat matters more than this figure
+        fresh = self.clock() - 2 * float(self.settings["heartbeat"])
+        if not all(c.last_beat is not None and c.last_beat >= fresh for c in self.children
+                   if not c.stopped):  # fmt: skip
+            return  # a process is down or late: its heartbeat matters more than this figure
         r = self.supervision.report()
         try:
             self.platform.status(r["restarts"], r["watchdog"])

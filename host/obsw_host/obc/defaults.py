@@ -12,7 +12,7 @@ PUS = {
     "time_code": "cuc",  # ST[09] time reports: "cuc" (TM[9,2]) or "cds" (TM[9,3])
     "monitoring": [],  # ST[12] limit checks installed at the first start (obc.monitoring)
 }
-CFDP = {"port": 5100, "peers": {}}
+CFDP = {"peers": {}}  # ports and ids: obsw_host.ports and obsw_host.ids (the mission's)
 OBCP = {"timeout": 2.0, "activity_timeout": 30.0, "level": 2, "step_period": 0.01}
 SPACECAN = {
     "interface": "virtual",
@@ -25,9 +25,6 @@ SPACECAN = {
 FRAMES = {
     "uart_a": "pty",
     "uart_b": "pty",
-    "scid": 0x42,
-    "tm_port": 4999,
-    "playback_vc": 1,
     "tm_frame_length": 256,
     "clcw_period": 0.5,
     "uart_queue": 64,  # frames waiting for a UART; beyond, the oldest is dropped (counted)

@@ -8,8 +8,7 @@ the figure is the time from the signal to the first heartbeat answered by the ne
 There is no peer: the reference rows are the goals (issue 26): under 2 s for a killed unit,
 under the deadline plus 2 s for a hung one. Medians of ``--runs`` runs with their spread.
 
-Usage: python tools/bench/supervision.py [--runs N] [--heartbeat S] [--deadline S] [--quick]
-       [--json]
+Usage: python tools/bench/supervision.py [--runs N] [--deadline S] [--quick] [--json]
 """
 
 import argparse

@@ -7,6 +7,7 @@ join them; ``units`` holds the units, ``assembly`` runs the units of one process
 heartbeat, ``platform`` starts and watches the processes; ``supervision`` watches the
 platform manager (the hardware ``watchdog``, systemd through ``sdnotify``, the unit file in
 ``service``); ``health`` is the OBC's health component and ``monitoring`` the mission's
-initial limit checks; ``state`` is the state folder and its lock. ``obsw obc serve [CONFIG]``
-runs it all; without a file, the sample spacecraft (``data/spacecraft.json``).
+initial limit checks; ``state`` is the state folder and its lock. ``obsw obc serve [MISSION]``
+runs it all, once ``obsw_host.mission`` has checked the whole mission folder (the sample
+spacecraft is ``examples/sample``).
 """

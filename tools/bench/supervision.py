@@ -27,6 +27,7 @@ sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
 from obsw_host.obc import config as obc_config  # noqa: E402
 from obsw_host.obc.platform import PlatformManager  # noqa: E402
+from obsw_host.sample import MISSION_DIR, MISSION_PATH  # noqa: E402
 
 KILLED_GOAL = 2.0  # seconds
 HUNG_MARGIN = 2.0  # seconds beyond the deadline
@@ -43,9 +44,9 @@ def free_port():
 
 def mission(folder, heartbeat, deadline):
     """The sample mission as two processes, its paths made absolute, state in ``folder``."""
-    with open(obc_config.SAMPLE) as f:
+    with open(MISSION_PATH) as f:
         doc = json.load(f)
-    base = os.path.dirname(obc_config.SAMPLE)
+    base = MISSION_DIR
     doc["sdb"] = os.path.join(base, doc["sdb"])
     doc.pop("obcp", None)
     doc["processes"] = {"core": ["pus"], "panel": ["SolarPanel"]}

@@ -45,6 +45,7 @@ RUNS = {
     "board": ("board.py", {}, "Reconfiguration module CPU budget (Cortex-M, QEMU)"),
     "chain": ("chain.py", {}, "The end-to-end chain"),
     "obc_start": ("obc_start.py", {}, "OBC cold start"),
+    "supervision": ("supervision.py", {}, "OBC recovery of a killed and a hung unit"),
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
 }
 # benchmarks whose figures do not depend on the host's load (instructions counted under QEMU)

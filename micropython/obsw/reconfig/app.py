@@ -9,10 +9,10 @@ for a while, and an unhealthy application stops kicking the watchdog.
 import struct
 
 from obsw.compat import const, micropython
+from obsw.reconfig import obclink
 from obsw.reconfig.cpdu import Cpdu
 from obsw.reconfig.ds3231 import DS3231, TimeSync
 from obsw.reconfig.eeprom import M24512
-from obsw.reconfig import obclink
 from obsw.reconfig.essential import (
     DECISION_APID,
     HPC_POWER_CYCLE,

@@ -180,7 +180,8 @@ class Recovery:
             self.active = 1 - self.active
         elif kind != FAILED:
             self.failures.append(now)
-        self._due = now + (self.deadline if kind == FAILED else self.off_ms / 1000 + self.boot_grace)
+        wait = self.deadline if kind == FAILED else self.off_ms / 1000 + self.boot_grace
+        self._due = now + wait
         self.count += 1
         return Decision(
             kind,

@@ -3,8 +3,14 @@
 from hal_pyb import PybHal
 from obsw.reconfig.app import ReconfigApp
 from obsw.reconfig.essential import security_from_file
+from obsw.reconfig.recovery import settings_from_file
 
 hal = PybHal()
 # TC frames are authenticated with the SDLS key file on the board's flash, when there is one
-app = ReconfigApp(hal, essential_security=security_from_file("tc.keys"))
+# the mission's recovery thresholds (`obsw board deploy` copies recovery.json), else the defaults
+app = ReconfigApp(
+    hal,
+    essential_security=security_from_file("tc.keys"),
+    recovery=settings_from_file("recovery.json"),
+)
 app.run()

@@ -98,6 +98,26 @@ class TestPolicy(unittest.TestCase):
         self.assertIsNone(p.poll(4.3, 0x001))
         self.assertEqual(p.poll(4.5, 0x001)[0], R.POWER_CYCLE)
 
+    def test_the_other_controllers_recoveries_count(self):
+        p = R.Recovery(FAST)
+        p.start(0.0)
+        p.poll(1.0, 0x001)
+        p.poll(1.1, 0x000)  # a power cycle by the other controller
+        p.poll(1.3, 0x001)
+        self.assertEqual(len(p.failures), 1)
+        self.assertEqual(p.poll(3.6, 0x001)[0], R.POWER_CYCLE)
+        d = p.done(3.6, None)  # the other controller power-cycled first
+        self.assertEqual((d.kind, d.failures), (R.STOOD_DOWN, 2))
+        self.assertEqual(p.poll(5.9, 0x001)[0], R.SWITCH_OVER)  # the third: switch over
+        d = p.done(5.9, None)  # the other controller switched first
+        self.assertEqual((d.kind, d.obc, p.active, p.failures), (R.STOOD_DOWN, 1, 1, []))
+        p2 = R.Recovery(FAST)
+        p2.start(0.0)
+        p2.poll(1.0, 0x001)
+        p2.poll(1.1, 0x000)
+        p2.poll(1.3, 0x002)  # switched over by the other controller
+        self.assertEqual((p2.failures, p2.active), ([], 1))
+
     def test_disabled(self):
         p = R.Recovery({"enabled": False})
         p.start(0.0)

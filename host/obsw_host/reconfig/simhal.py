@@ -240,7 +240,10 @@ def main(argv):
         security = security_from_file(argv[9])
         if security is None:
             raise OSError("no SDLS key file %s" % argv[9])
-    app = ReconfigApp(hal, essential_security=security)
+    from obsw.reconfig.recovery import settings_from_file
+
+    settings = settings_from_file(argv[6] + "/recovery.json")  # None: recovery left off
+    app = ReconfigApp(hal, essential_security=security, recovery=settings or {"enabled": False})
     tag = "NR"[role]
 
     def log(text):

@@ -19,6 +19,8 @@ package(
         "essential.py",
         "hal.py",
         "node.py",
+        "obclink.py",
+        "recovery.py",
         "safeguard.py",
         "watchdog.py",
     ],

@@ -9,11 +9,14 @@ decision the OBC gets ``off_ms`` plus ``boot_grace`` seconds to send its first h
 The OBC is "active" on the line that is on in the latched CPDU state; with no OBC line on the
 ground has switched the OBC off on purpose and the policy waits. A line change the policy did
 not make (the other controller's recovery, a ground command) restarts the wait for a
-heartbeat, so two controllers watching one OBC do not act twice in a row; two decisions at the
+heartbeat and counts in the window (a power cycle) or empties it (a switch-over), so two
+controllers watching one OBC do not act twice in a row and agree on when to switch over; two
+decisions at the
 same instant are kept apart by the CPDU's Dekker arbitration with a compare step
 (`Cpdu.write(..., expect=...)`): the second finds the line already changed and stands down.
 """
 
+import json
 import struct
 
 from obsw.compat import const
@@ -134,8 +137,14 @@ class Recovery:
         if bits is None:
             return
         obc = self._obc_bits(bits)
-        if self._bits is not None and obc != self._bits:
+        was = self._bits
+        if was is not None and obc != was:
             self._due = now + self.off_ms / 1000 + self.boot_grace
+            if self._pending is None:  # not our own action: the other controller's, the ground's
+                if was and obc and not obc & was:
+                    self.failures = []  # a switch-over
+                elif was >> self.active & 1 and not obc >> self.active & 1:
+                    self.failures.append(now)  # the active OBC's line off: a power cycle
         self._bits = obc
         if obc == 1 or obc == 3:
             self.active = 0
@@ -175,11 +184,12 @@ class Recovery:
             kind = STOOD_DOWN
         elif not result:
             kind = FAILED
-        if kind == SWITCH_OVER:
-            self.failures = []
-            self.active = 1 - self.active
-        elif kind != FAILED:
-            self.failures.append(now)
+        if result is not False:
+            if act[0] == SWITCH_OVER:  # made here or by the other controller: a new window
+                self.failures = []
+                self.active = 1 - self.lines.index(line)
+            else:
+                self.failures.append(now)
         wait = self.deadline if kind == FAILED else self.off_ms / 1000 + self.boot_grace
         self._due = now + wait
         self.count += 1
@@ -192,6 +202,19 @@ class Recovery:
             silence_ms,
             int(uptime_s),
         )
+
+
+def settings_from_file(path):
+    """The mission's recovery settings as delivered to the board (JSON), or None if absent."""
+    try:
+        f = open(path)
+    except OSError:
+        return None
+    with f:
+        d = json.load(f)
+    if not isinstance(d, dict):
+        raise ValueError("%s: recovery settings are a JSON object" % path)
+    return d
 
 
 def log_pack(entries):

@@ -115,7 +115,9 @@ class TestPolicy(unittest.TestCase):
         p2.start(0.0)
         p2.poll(1.0, 0x001)
         p2.poll(1.1, 0x000)
-        p2.poll(1.3, 0x002)  # switched over by the other controller
+        p2.poll(1.3, 0x001)
+        self.assertEqual(len(p2.failures), 1)
+        p2.poll(1.5, 0x002)  # switched over by the other controller
         self.assertEqual((p2.failures, p2.active), ([], 1))
 
     def test_disabled(self):

@@ -4,6 +4,8 @@ A mission file's section overrides these key by key (``section(config, "pus")``)
 else in the OBC writes a default of its own.
 """
 
+from obsw.reconfig import recovery as _recovery
+
 PUS = {
     "period": 0.1,  # seconds per activity cycle
     "playback_rate": 64,  # packets per second service 15 plays back
@@ -40,6 +42,9 @@ PLATFORM = {
     "power_cycle": {"component": "CpduN", "line": 0, "off_ms": 500},
     "crash_loop": 3,  # this many deaths in a row before a first heartbeat: stop the process
 }
+# the reconfiguration module's autonomous recovery of the OBC (delivered to the board as
+# recovery.json); the module's own fallback is the same table, in the core
+RECOVERY = dict(_recovery.DEFAULTS, lines=list(_recovery.DEFAULTS["lines"]))
 SECTIONS = {
     "pus": PUS,
     "cfdp": CFDP,
@@ -47,6 +52,7 @@ SECTIONS = {
     "spacecan": SPACECAN,
     "frames": FRAMES,
     "platform": PLATFORM,
+    "recovery": RECOVERY,
 }
 
 

@@ -106,6 +106,35 @@ def roots():
     return core, host
 
 
+def descendants(pid):
+    """The pids of a process's children, grandchildren, ... (Linux /proc; [] elsewhere)."""
+    out = []
+    todo = [pid]
+    while todo:
+        p = todo.pop()
+        try:
+            tasks = os.listdir("/proc/%d/task" % p)
+        except OSError:
+            continue
+        for t in tasks:
+            try:
+                with open("/proc/%d/task/%s/children" % (p, t)) as f:
+                    kids = [int(x) for x in f.read().split()]
+            except (OSError, ValueError):
+                continue
+            out += kids
+            todo += kids
+    return out
+
+
+def _signal_all(pids, sig):
+    for pid in pids:
+        try:
+            os.kill(pid, sig)
+        except OSError:
+            pass
+
+
 class _Proc:
     def __init__(self, name, popen, sim):
         self.name = name
@@ -126,9 +155,13 @@ class _Proc:
     def alive(self):
         return self.popen.poll() is None
 
+    def signal_tree(self, sig):
+        """``sig`` to the process and all it started (a hang or a power cut stops them all)."""
+        _signal_all([self.popen.pid] + descendants(self.popen.pid), sig)
+
     def kill(self):
         if self.popen.poll() is None:
-            self.popen.send_signal(signal.SIGKILL)
+            self.signal_tree(signal.SIGKILL)
         try:
             self.popen.wait(5.0)
         except subprocess.TimeoutExpired:
@@ -425,8 +458,10 @@ class ReconfigSim:
     def hang_obc(self):
         """The OBC hangs (SIGSTOP): alive to the kernel, silent on every link."""
         if self.obc is not None:
-            self.obc.popen.send_signal(signal.SIGSTOP)
-            self.log("fault: OBC process stopped (pid %d)" % self.obc.popen.pid)
+            self.obc.signal_tree(signal.SIGSTOP)
+            self.log(
+                "fault: OBC stopped, with every process it started (pid %d)" % self.obc.popen.pid
+            )
 
     def stick_req(self, role):
         """Firmware fault in a controller: CPDU_REQ driven high, main loop hung."""

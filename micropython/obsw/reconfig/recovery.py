@@ -112,10 +112,9 @@ class Recovery:
         self._due = now + self.boot_grace
 
     def heartbeat(self, source, now):
+        """A heartbeat at ``now``: the boot grace, if any, is over."""
         self.last_seen[source] = now
-        due = now + self.deadline
-        if self._due is None or due > self._due:
-            self._due = due
+        self._due = now + self.deadline
 
     def silence(self, now):
         """Seconds since the last heartbeat from any source (None: never heard)."""

@@ -345,9 +345,11 @@ class ReconfigApp:
         last = r.health[r.monitor.active].last_heartbeat
         if last is not None:
             self._last_heartbeat = last
-            if last != self._can_heartbeat:
-                self._can_heartbeat = last
-                self.recovery.heartbeat(SOURCE_CAN, last)
+        for h in r.health:  # the OBC's heartbeat on either bus keeps it alive
+            t = h.last_heartbeat
+            if t is not None and (self._can_heartbeat is None or t > self._can_heartbeat):
+                self._can_heartbeat = t
+                self.recovery.heartbeat(SOURCE_CAN, t)
 
     # -- the OBC: UART link and autonomous recovery -------------------------------------------
 

@@ -106,15 +106,20 @@ class Recovery:
         self._due = None  # when silence becomes a fault
         self._bits = None  # the OBC lines as last seen
         self._pending = None
+        self._since = 0  # the last start or change of the OBC lines
 
     def start(self, now):
         """At the controller's boot: the OBC may be booting too."""
         self._due = now + self.boot_grace
+        self._since = now
 
     def heartbeat(self, source, now):
-        """A heartbeat at ``now``: the boot grace, if any, is over."""
-        self.last_seen[source] = now
-        self._due = now + self.deadline
+        """A heartbeat sent at ``now``: the boot grace, if any, is over. One older than the
+        last start or line change (a bus's stale record) moves nothing."""
+        if self.last_seen[source] is None or now > self.last_seen[source]:
+            self.last_seen[source] = now
+        if now >= self._since:
+            self._due = now + self.deadline
 
     def silence(self, now):
         """Seconds since the last heartbeat from any source (None: never heard)."""
@@ -139,6 +144,7 @@ class Recovery:
         was = self._bits
         if was is not None and obc != was:
             self._due = now + self.off_ms / 1000 + self.boot_grace
+            self._since = now
             if self._pending is None:  # not our own action: the other controller's, the ground's
                 if was and obc and not obc & was:
                     self.failures = []  # a switch-over

@@ -45,6 +45,7 @@ RUNS = {
     "chain": ("chain.py", {}, "The end-to-end chain"),
     "obc_start": ("obc_start.py", {}, "OBC cold start"),
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
+    "recovery": ("recovery.py", {}, "Autonomous recovery of a hung OBC"),
 }
 # benchmarks whose figures do not depend on the host's load (instructions counted under QEMU)
 EXACT = ("board",)

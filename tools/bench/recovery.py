@@ -37,8 +37,10 @@ def hang_recoveries(deadline, hangs):
                 t = time.monotonic()
                 sim.hang_obc()
                 ok = sim.wait_for(
-                    lambda b=boots: sim.obc_boots > b
-                    and sum(1 for _, e in sim.events if "[OBC] up on line" in e) > b,
+                    lambda b=boots: (
+                        sim.obc_boots > b
+                        and sum(1 for _, e in sim.events if "[OBC] up on line" in e) > b
+                    ),
                     deadline + BOOT + 60,
                 )
                 if not ok:

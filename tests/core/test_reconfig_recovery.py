@@ -7,6 +7,7 @@ import unittest
 
 from obsw.frames.asm import CaduDecoder
 from obsw.frames.tm_demux import TmDemultiplexer
+from obsw.reconfig import mission
 from obsw.reconfig import obclink as L
 from obsw.reconfig import recovery as R
 from obsw.reconfig.app import ReconfigApp
@@ -133,6 +134,24 @@ class TestPolicy(unittest.TestCase):
         log = R.log_unpack(R.log_pack([d, e]))
         self.assertEqual(len(log), 2)
         self.assertRaises(ValueError, R.Decision.unpack, b"\x01")
+
+
+class TestMissionFile(unittest.TestCase):
+    DOC = {"scid": 66, "nodes": [10, 11], "essential_map": 63, "hptm_vc": 6}
+
+    def test_thresholds_delivered_with_the_ids(self):
+        doc = dict(self.DOC, recovery={"deadline": 20.0, "max_failures": 2, "lines": [0, 1]})
+        opts = mission.parse(doc)
+        self.assertEqual(opts["recovery"]["deadline"], 20.0)
+        self.assertEqual(R.Recovery(opts["recovery"]).max_failures, 2)
+        self.assertTrue("recovery" not in mission.parse(dict(self.DOC)))
+
+    def test_bad_thresholds_named(self):
+        for bad in ({"deadline": 0}, {"lines": [3, 3]}, {"enabled": 1}, {"dead_line": 5}):
+            with self.assertRaises(mission.MissionFileError) as cm:
+                mission.parse(dict(self.DOC, recovery=bad))
+            self.assertEqual(cm.exception.key, "recovery." + list(bad)[0])
+        self.assertRaises(mission.MissionFileError, mission.parse, dict(self.DOC, recovery=[]))
 
 
 def both_at_once(seed, mask, value, expect):

@@ -10,7 +10,6 @@ controllers recover the OBC by themselves (`obsw.reconfig.recovery`); the sample
 to them over the OBC UARTs too (heartbeats, context, DS3231 time).
 """
 
-import json
 import os
 import platform
 import shutil
@@ -26,13 +25,15 @@ from obsw.frames import cltu, tc
 from obsw.frames.asm import CaduDecoder
 from obsw.frames.errors import FrameError
 from obsw.frames.tm_demux import TmDemultiplexer
-from obsw.reconfig.essential import ESSENTIAL_MAP, Report
+from obsw.reconfig.essential import Report
 from obsw.reconfig.hal import RESET_NAMES, RESET_POWER, RESET_STUCK, RESET_WATCHDOG
 from obsw.reconfig.models import Tps3813Model
 
 import obsw_host
 from obsw_host.frames import keys
 from obsw_host.frames.links import open_pty_pair
+from obsw_host.ids import MissionIds
+from obsw_host.reconfig import board_file
 from obsw_host.reconfig import simhal as W
 from obsw_host.reconfig.canhub import CanHub
 
@@ -177,7 +178,7 @@ class ReconfigSim:
         self,
         directory=None,
         obc_calls=(),
-        scid=0x42,
+        scid=None,
         obc_line=0,
         obc_lines=None,
         recovery=None,
@@ -192,10 +193,22 @@ class ReconfigSim:
         out=None,
         key_file=None,
         obc_command=None,
+        ids=None,
     ):
         self.own_dir = directory is None
         self.dir = directory or tempfile.mkdtemp(prefix="obsw-reconfig-")
         os.makedirs(self.dir, exist_ok=True)
+        # the mission's ids (default: the sample's), on the controllers' "flash" as on a board
+        self.ids = ids = ids or MissionIds.sample()
+        settings = None  # the recovery thresholds, on the "flash" too (None: recovery off)
+        if recovery is not None:
+            settings = dict(recovery)
+            lines = list(settings.get("lines", obc_lines or (obc_line,)))
+            settings["lines"] = lines if len(lines) == 2 else [lines[0], 1 - lines[0]]
+        board_file(ids, self.dir, recovery=settings)
+        self.nodes = ids.reconfig_nodes
+        self.essential_map = ids.maps["essential"]
+        scid = ids.scid if scid is None else scid
         self.obc_calls = list(obc_calls)
         self.obc_command = obc_command  # callable(sim) -> argv of the OBC, or the sample OBC
         self.scid = scid
@@ -270,12 +283,6 @@ class ReconfigSim:
         with open(self.wire_path, "wb") as f:
             f.write(W.initial_wire(self.initial_lines))
         self._wire_fd = os.open(self.wire_path, os.O_RDWR)
-        if self.recovery is not None:
-            settings = dict(self.recovery)
-            lines = list(settings.get("lines", self.obc_lines))
-            settings["lines"] = lines if len(lines) == 2 else [lines[0], 1 - lines[0]]
-            with open(os.path.join(self.dir, "recovery.json"), "w") as f:
-                json.dump(settings, f)
         self.hub = CanHub().start()
         self.mpy_dir = os.path.join(self.dir, "mpy")
         if not compile_controller(self.mpy_dir):
@@ -357,6 +364,7 @@ class ReconfigSim:
         else:
             cmd = [sys.executable, "-m", "obsw_host.reconfig.obc"]
             cmd += [str(self.hub.ports[0]), str(self.hub.ports[1])]
+            cmd += ["--nodes", "%d,%d" % self.nodes]
             cmd += ["--line", str(self.obc_lines[which])]
             if self.recovery is not None:
                 fds = tuple(self.obc_uart)
@@ -471,7 +479,7 @@ class ReconfigSim:
 
     def send_hpc(self, hpc):
         """Send an HPC as a signed BD frame on the essential MAP to both controllers' COM UARTs."""
-        seg = tc.Segment(ESSENTIAL_MAP, hpc.packet(seq_count=self._seq)).pack()
+        seg = tc.Segment(self.essential_map, hpc.packet(seq_count=self._seq)).pack()
         seg = self.security.apply(self.scid, 0, seg, True)  # signed with the essential MAP's SA
         frame = tc.TcFrame(self.scid, 0, seg, self._seq & 0xFF, bypass=True).pack()
         self._seq += 1

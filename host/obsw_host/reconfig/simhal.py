@@ -240,10 +240,11 @@ def main(argv):
         security = security_from_file(argv[9])
         if security is None:
             raise OSError("no SDLS key file %s" % argv[9])
-    from obsw.reconfig.recovery import settings_from_file
+    from obsw.reconfig import mission
 
-    settings = settings_from_file(argv[6] + "/recovery.json")  # None: recovery left off
-    app = ReconfigApp(hal, essential_security=security, recovery=settings or {"enabled": False})
+    ids = mission.load(argv[6] + "/" + mission.FILE) or {}  # as on a board's flash
+    ids.setdefault("recovery", {"enabled": False})  # a board's default is on; a sim's is off
+    app = ReconfigApp(hal, essential_security=security, **ids)
     tag = "NR"[role]
 
     def log(text):

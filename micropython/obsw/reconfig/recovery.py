@@ -16,7 +16,6 @@ same instant are kept apart by the CPDU's Dekker arbitration with a compare step
 (`Cpdu.write(..., expect=...)`): the second finds the line already changed and stands down.
 """
 
-import json
 import struct
 
 from obsw.compat import const
@@ -207,19 +206,6 @@ class Recovery:
             silence_ms,
             int(uptime_s),
         )
-
-
-def settings_from_file(path):
-    """The mission's recovery settings as delivered to the board (JSON), or None if absent."""
-    try:
-        f = open(path)
-    except OSError:
-        return None
-    with f:
-        d = json.load(f)
-    if not isinstance(d, dict):
-        raise ValueError("%s: recovery settings are a JSON object" % path)
-    return d
 
 
 def log_pack(entries):

@@ -39,8 +39,8 @@ PLATFORM = {
     "power_cycle": {"component": "CpduN", "line": 0, "off_ms": 500},
     "crash_loop": 3,  # this many deaths in a row before a first heartbeat: stop the process
 }
-# the reconfiguration module's autonomous recovery of the OBC (delivered to the board as
-# recovery.json); the module's own fallback is the same table, in the core
+# the reconfiguration module's autonomous recovery of the OBC (delivered to the boards in their
+# mission.json, obsw.reconfig.mission); the module's own fallback is the same table, in the core
 RECOVERY = dict(_recovery.DEFAULTS, lines=list(_recovery.DEFAULTS["lines"]))
 SECTIONS = {
     "pus": PUS,

@@ -43,6 +43,12 @@ def add_parser(sub):
                 "--march",
                 help="mpy-cross architecture (default: the board's own, else armv7emsp)",
             )
+            q.add_argument("--keys", help="the board's SDLS key file, installed as tc.keys")
+            q.add_argument(
+                "--insecure",
+                action="store_true",
+                help="no keys: let the board take essential TCs unauthenticated (logged)",
+            )
         if name == "test":
             q.add_argument(
                 "files", nargs="*", help="test files (default: the reconfiguration core tests)"
@@ -94,9 +100,20 @@ def _qemu(args):
 def _deploy(args):
     from obsw_host import board
 
-    return _guard(
-        lambda: print("%d modules deployed" % len(board.deploy(args.port, march=args.march)))
-    )
+    def go():
+        names = board.deploy(args.port, march=args.march, keys=args.keys, insecure=args.insecure)
+        print("%d modules deployed" % len(names))
+        if args.keys:
+            print("SDLS keys installed on the board as tc.keys (from %s)" % args.keys)
+        elif args.insecure:
+            print("SDLS OFF on the board (tc.insecure): essential TCs accepted unauthenticated")
+        else:
+            print(
+                "SDLS keys NOT installed (no --keys): unless the board already has tc.keys, "
+                "it refuses every essential TC"
+            )
+
+    return _guard(go)
 
 
 def _flash(args):

@@ -47,6 +47,7 @@ RUNS = {
     "obc_start": ("obc_start.py", {}, "OBC cold start"),
     "supervision": ("supervision.py", {}, "OBC recovery of a killed and a hung unit"),
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
+    "recovery": ("recovery.py", {}, "Autonomous recovery of a hung OBC"),
 }
 # benchmarks whose figures do not depend on the host's load (instructions counted under QEMU)
 EXACT = ("board",)

@@ -4,6 +4,8 @@ A mission file's section overrides these key by key (``section(config, "pus")``)
 else in the OBC writes a default of its own.
 """
 
+from obsw.reconfig import recovery as _recovery
+
 PUS = {
     "period": 0.1,  # seconds per activity cycle
     "playback_rate": 64,  # packets per second service 15 plays back
@@ -46,6 +48,9 @@ PLATFORM = {
     "disk": None,  # the file system whose use is reported; None: the state folder's
     "thermal_zone": "thermal_zone0",  # /sys/class/thermal/<zone>/temp: the SoC's sensor
 }
+# the reconfiguration module's autonomous recovery of the OBC (delivered to the boards in their
+# mission.json, obsw.reconfig.mission); the module's own fallback is the same table, in the core
+RECOVERY = dict(_recovery.DEFAULTS, lines=list(_recovery.DEFAULTS["lines"]))
 SECTIONS = {
     "pus": PUS,
     "cfdp": CFDP,
@@ -53,6 +58,7 @@ SECTIONS = {
     "spacecan": SPACECAN,
     "frames": FRAMES,
     "platform": PLATFORM,
+    "recovery": RECOVERY,
 }
 
 

@@ -41,6 +41,7 @@ STATUS_FAILED = const(4)  # CPDU access failed
 ESSENTIAL_MAP = const(63)
 HPTM_VCID = const(6)
 HPTM_APID = const(0x07E)
+DECISION_APID = const(0x07D)  # HPTM: the recovery decisions (obsw.reconfig.recovery.Decision)
 HPC_PRIORITY = const(3)  # CPDU battle priority of an HPC (above SpaceCAN's 0)
 
 _ARGS = {
@@ -327,12 +328,18 @@ class Essential:
         """The app could not get the CPDU for the last write."""
         self.last_status = STATUS_FAILED
 
+    def later(self, due, mask, value):
+        """Queue a line change for ``due`` (the second half of a power cycle)."""
+        self._writes.append([due, mask & CPDU_MASK, value])
+
     def report(self, report):
         """CADUs carrying one HPTM packet with ``report`` (a Report) for the COM UART."""
         self.report_requested = False
-        pkt = SpacePacket(
-            0, self.hptm_apid, report.pack(), False, 3, self.seq.next(self.hptm_apid)
-        )
+        return self.packet(self.hptm_apid, report.pack())
+
+    def packet(self, apid, data):
+        """CADUs carrying one HPTM packet of ``apid`` with ``data`` on the HPTM channel."""
+        pkt = SpacePacket(0, apid, data, False, 3, self.seq.next(apid))
         self.mux.channel(self.hptm_vcid).push(pkt.pack())
         out = []
         while True:

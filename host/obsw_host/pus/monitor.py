@@ -14,6 +14,7 @@ from obsw.pus.services.s01_verification import describe
 from obsw.utc import format_utc
 
 from obsw_host.pus import text
+from obsw_host.pus.display import tm_seconds
 from obsw_host.pus.onboard import TAI_MINUS_UNIX
 
 _COLOURS = {"TC": "36", "fail": "31", "high": "31", "medium": "33", "low": "33", "ok": "32"}
@@ -47,8 +48,11 @@ class Display:
         )
         return self._paint(line, "TC")
 
-    def tm(self, tm, decoded):
-        when = format_utc(tm.time) if isinstance(tm.time, (int, float)) and tm.time else utc_now()
+    def tm(self, tm, decoded, when=None, config=None):
+        """One line for a TM: its on-board time in UTC, else ``when`` (a logged time), else
+        now."""
+        tai = tm_seconds(tm, config)
+        when = format_utc(tai) if tai else (when or utc_now())
         head = "%s  TM apid %4d seq %5d  TM[%d,%d] " % (
             when,
             tm.apid,
@@ -166,4 +170,4 @@ def replay(path, sdb=None, colour=False):
                         raw.hex(),
                     )
                 else:
-                    yield display.tm(result[0], result[1])
+                    yield display.tm(result[0], result[1], record.get("utc"), g.proc.config)

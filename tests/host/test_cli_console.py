@@ -116,6 +116,7 @@ def test_console_in_a_terminal_pings_reads_a_parameter_and_keeps_history(obc, tm
         os.write(master, b"\r")
         shown = _read_until(master, "deg/s")
         assert "SolarPanel.speed = " in shown
+        _read_until(master, "obsw-demo>")  # (typed ahead, Ctrl-D would be the tty's EOF)
         os.write(master, b"\x04")  # Ctrl-D leaves
         assert proc.wait(BOUND) == 0
     finally:

@@ -193,7 +193,7 @@ def test_readable_replies(obc):
     assert "2031-01-01T00:00:00.000Z" in listing and "TC[17,1] are-you-alive" in listing
     failed = obsw("ground", "--port", port, "function", "SolarPanel.set_angle", "angle=5")
     assert failed.returncode == 1
-    assert "completion failure: component error (code 13) (function SolarPanel.set_angle)" in (
+    assert "completion failure: component error (code 13) (function SolarPanel.set_angle: " in (
         failed.stdout
     )
     hk = obsw("ground", "--port", port, "hk", "report", "1").stdout

@@ -343,7 +343,7 @@ def _list(args):
 
 
 def _run(args, fn):
-    from obsw_host.pus import text
+    from obsw_host.pus import display, text
     from obsw_host.pus.ground import PusTimeout
 
     with _ground(args) as g:
@@ -353,7 +353,7 @@ def _run(args, fn):
             tx = e.transaction
         sdb = g.sdb
     result = text.transaction(tx)
-    detail = text.failure_detail(tx, sdb)
+    detail = display.failure_detail(tx, sdb)  # the component's error by name
     if args.json:
         if detail:
             result["failure_detail"] = detail
@@ -364,7 +364,7 @@ def _run(args, fn):
             line = "%s (%s)" % (line.split(" data ")[0], detail)
         print("  " + line)
     for reply in tx.replies:
-        print(text.readable(reply, sdb))
+        print(display.readable(reply, sdb))  # names, units, UTC times, tables
     if not tx.done:
         print(_no_answer(args, tx))
     return 0 if tx.ok else 1

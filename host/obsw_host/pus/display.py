@@ -9,12 +9,19 @@ the state that `obsw ground watch` shows; ``snapshot()`` is its JSON-able form.
 """
 
 import collections
+import json
 
+from obsw import cbor
 from obsw.pus.config import DEFAULT
 from obsw.pus.services.s05_events import SEVERITY_NAMES
+from obsw.pus.services.s08_functions import functions
+from obsw.pus.services.s12_layouts import CHECK_NAMES, STATUS_NAMES
+from obsw.pus.services.s20_parameters import values_layout
+from obsw.pus.tc import PusTc
 from obsw.utc import format_utc
 
 from obsw_host.pus import text
+from obsw_host.pus.catalog import table
 
 LIMIT_STATES = ("ok", "warning", "critical", "out of range")
 STAGES = {1: "accepted", 3: "started", 5: "progress", 7: "completed"}
@@ -164,3 +171,154 @@ class Picture:
             "commands": [dict(r) for r in reversed(self.commands.values())],
             "received": self.received,
         }
+
+
+# ------------------------------------------------------------------------------ replies by name
+
+
+def parameter_name(sdb, pid):
+    p = parameter_of(sdb, pid)
+    return p.qualified if p is not None else str(pid)
+
+
+def event_name(sdb, eid):
+    if not eid:
+        return "-"
+    try:
+        return sdb.event(eid).qualified
+    except (KeyError, ValueError, TypeError, AttributeError):
+        return str(eid)
+
+
+def request_text(raw, sdb=None):
+    """A TC (bytes or hex) as an operator reads it: its type, name and decoded arguments."""
+    try:
+        tc = PusTc.unpack(bytes.fromhex(raw) if isinstance(raw, str) else bytes(raw))
+    except ValueError:
+        return "(undecodable TC %s)" % (raw if isinstance(raw, str) else bytes(raw).hex())
+    head = "TC[%d,%d] %s" % (tc.service, tc.subtype, text.name(tc.service, tc.subtype))
+    try:
+        detail = _request_detail(tc, sdb)
+    except (ValueError, KeyError, TypeError, IndexError):
+        detail = tc.data.hex()
+    return head + (": " + detail if detail else "")
+
+
+def _request_detail(tc, sdb):
+    if sdb is None:
+        return tc.data.hex()
+    if (tc.service, tc.subtype) == (8, 1):
+        fid = int.from_bytes(bytes(tc.data[:2]), "big")
+        fn = functions(sdb).get(fid)
+        if fn is None:
+            return "function %d" % fid
+        names = {a[0]: a[1] for a in fn.arguments}
+        given = fn.layout.unpack(tc.data)["args"]
+        args = ", ".join(
+            "%s=%s" % (names.get(a["id"], a["id"]), number(a["value"])) for a in given
+        )
+        return "%s(%s)" % (fn.name, args)
+    if (tc.service, tc.subtype) == (20, 3):
+        layout = values_layout(lambda pid: sdb.parameter(pid).type)
+        items = layout.unpack(tc.data)["items"]
+        return ", ".join(
+            "%s=%s" % (parameter_name(sdb, i["id"]), number(i["value"])) for i in items
+        )
+    return tc.data.hex()
+
+
+def _limit_text(sdb, pid, value):
+    p = parameter_of(sdb, pid)
+    unit = (" " + p.unit) if p is not None and p.unit else ""
+    return "%s%s" % (number(value), unit)
+
+
+def named_row(row, sdb=None):
+    """One row of a report (monitoring definitions, out-of-limits, event-actions, ..) with its
+    ids, codes and times by name: parameters, events, check types and states, UTC times,
+    decoded TCs, values with units."""
+    out = collections.OrderedDict()
+    pid = row.get("parameter")
+    for key, value in row.items():
+        if key in ("parameter", "validity") and isinstance(value, int):
+            if key == "validity" and not value:
+                continue
+            value = parameter_name(sdb, value)
+        elif key in ("validity_mask", "validity_value") and not row.get("validity"):
+            continue
+        elif key == "check" and isinstance(value, int):
+            value = CHECK_NAMES.get(value, value)
+        elif key in ("previous", "current", "checking", "status") and isinstance(value, int):
+            value = STATUS_NAMES.get(value, value)
+        elif (key == "event" or key.endswith("_event")) and isinstance(value, int):
+            value = event_name(sdb, value)
+        elif key == "time" and isinstance(value, (int, float)):
+            key, value = "time (UTC)", utc(value)
+        elif key == "request":
+            value = request_text(value, sdb)
+        elif key in ("value", "limit", "low", "high", "expected") and isinstance(
+            value, (int, float)
+        ):
+            value = _limit_text(sdb, pid, value)
+        elif key == "type" and isinstance(value, list) and len(value) == 2:
+            continue  # the type of the embedded request: its text says it
+        elif isinstance(value, bool):
+            value = "yes" if value else "no"
+        elif isinstance(value, (dict, list)):
+            value = json.dumps(text.plain(value))
+        out[key] = value
+    return out
+
+
+def _files(v):
+    rows = [{"name": n, "type": "directory"} for n in v.get("directories", [])]
+    rows += [{"name": n, "type": "file"} for n in v.get("files", [])]
+    if not rows:
+        rows = [{"name": o.get("name"), "type": o.get("type")} for o in v.get("objects", [])]
+    listing = table(rows) if rows else "(empty)"
+    return "%s\n%s" % (v.get("repository", ""), listing)
+
+
+def readable(value, sdb=None):
+    """A reply as an operator reads it: tables of rows by name where the reply is a list of
+    items (see ``named_row``), a directory listing as a table; else ``text.readable``."""
+    v = text.plain(value)
+    if isinstance(v, dict):
+        if "repository" in v and ("files" in v or "objects" in v):
+            return _files(v)
+        items = v.get("items")
+        if isinstance(items, list) and items and all(isinstance(x, dict) for x in items):
+            return table([named_row(x, sdb) for x in items])
+        if isinstance(v.get("obcps"), list):
+            return table([named_row(x, sdb) for x in v["obcps"]]) or "(no OBCPs)"
+    return text.readable(value, sdb)
+
+
+def component_said(data):
+    """``CODE: message (name=value, ..)`` from a component error record (CBOR), or ''."""
+    try:
+        code, message, detail = cbor.loads(bytes(data))
+    except (ValueError, TypeError):
+        return ""
+    out = "%s" % code
+    if message and message != code:
+        out += ": %s" % message
+    if isinstance(detail, dict) and detail:
+        out += " (%s)" % ", ".join("%s=%s" % (k, number(v)) for k, v in detail.items())
+    elif detail is not None:
+        out += " (%s)" % number(detail)
+    return out
+
+
+def failure_detail(tx, sdb=None):
+    """What a failure report's data means for the TC it verifies: for a function, its name and
+    what the component said; else ``text.failure_detail``."""
+    failure = getattr(tx, "failure", None)
+    data = failure.get("data") if isinstance(failure, dict) else None
+    if sdb is None or not data or tx.tc.service != 8 or len(data) < 2:
+        return text.failure_detail(tx, sdb)
+    fid = int.from_bytes(bytes(data[:2]), "big")
+    fn = functions(sdb).get(fid)
+    out = "function %s" % (fn.name if fn else fid)
+    said = component_said(data[2:]) if len(data) > 2 else ""
+    return out + (": " + said if said else "")

@@ -67,6 +67,13 @@ class Display:
             body, kind = self._verification(decoded)
         elif tm.service == 5 and "severity" in decoded:
             body, kind = self._event(decoded)
+        elif tm.service == 9 and isinstance(decoded.get("time"), (int, float)):
+            body = "%s: %s UTC, rate 2**%s s, status %s" % (
+                text.name(tm.service, tm.subtype) or "time report",
+                format_utc(decoded["time"]),
+                decoded.get("exponent", "?"),
+                decoded.get("status", "?"),
+            )
         else:
             body = text.name(tm.service, tm.subtype)
             summary = self.values(decoded)

@@ -45,6 +45,7 @@ import argparse
 import json
 import sys
 
+from obsw_host.commands import arguments
 from obsw_host.errors import UserError
 from obsw_host.net import DEFAULT_HOST
 
@@ -107,7 +108,7 @@ def add_parser(sub):
     x.add_argument("interval", type=int)
     x.set_defaults(func=_hk_interval)
     x = hk.add_parser("listen", help="print periodic reports")
-    x.add_argument("--seconds", type=float, default=3.0)
+    x.add_argument("--seconds", type=arguments.seconds, default=3.0)
     x.set_defaults(func=_listen, listen=(3, 25))
     ground_services.add_to_hk(hk)  # obsw ground hk append
 
@@ -128,7 +129,7 @@ def add_parser(sub):
         x.add_argument("names", nargs="+")
         x.set_defaults(func=_events_switch, ev_action=name)
     x = ev.add_parser("listen", help="print event reports")
-    x.add_argument("--seconds", type=float, default=3.0)
+    x.add_argument("--seconds", type=arguments.seconds, default=3.0)
     x.set_defaults(func=_listen, listen=(5, None))
 
     _add_automation(s)
@@ -139,7 +140,7 @@ def add_parser(sub):
     x.add_argument("exponent", type=int)
     x.set_defaults(func=_time_rate)
     x = ti.add_parser("listen", help="print time reports (CUC TM[9,2] or CDS TM[9,3])")
-    x.add_argument("--seconds", type=float, default=3.0)
+    x.add_argument("--seconds", type=arguments.seconds, default=3.0)
     x.set_defaults(func=_listen, listen=(9, None))
 
 
@@ -186,8 +187,8 @@ def _add_automation(s):
         description="Without ACTION: print every TM as it arrives until Ctrl-C (or --seconds, "
         "--count). With ACTION: service 12 on-board monitoring.",
     )
-    mo.add_argument("--seconds", type=float, help="stop after this many seconds")
-    mo.add_argument("--count", type=int, help="stop after this many TM packets")
+    mo.add_argument("--seconds", type=arguments.seconds, help="stop after this many seconds")
+    mo.add_argument("--count", type=arguments.count, help="stop after this many TM packets")
     mo.add_argument("--colour", choices=("auto", "always", "never"), default="auto")
     mo.add_argument("--log", metavar="FILE", default=argparse.SUPPRESS, help="session log")
     mo.set_defaults(func=_monitor_live)

@@ -29,7 +29,7 @@ from rich.console import Console, Group
 from rich.live import Live
 from rich.table import Table
 
-from obsw_host.commands import ground
+from obsw_host.commands import arguments, ground
 from obsw_host.errors import user_message
 from obsw_host.obc.state import default_state
 from obsw_host.pus import catalog
@@ -51,9 +51,9 @@ def add_to_ground(s):
         "the latest events, and commands with their verification stages.",
     )
     x.add_argument("--once", action="store_true", help="print one frame and exit")
-    x.add_argument("--count", type=_positive_int, help="print this many frames and exit")
-    x.add_argument("--every", type=_positive, default=1.0, help="seconds between frames")
-    x.add_argument("--seconds", type=_positive, help="stop after this many seconds")
+    x.add_argument("--count", type=arguments.count, help="print this many frames and exit")
+    x.add_argument("--every", type=arguments.seconds, default=1.0, help="seconds between frames")
+    x.add_argument("--seconds", type=arguments.seconds, help="stop after this many seconds")
     x.set_defaults(func=_watch)
     x = s.add_parser(
         "console",
@@ -63,26 +63,6 @@ def add_to_ground(s):
     )
     x.add_argument("--history", metavar="FILE", help="history file (default: see above)")
     x.set_defaults(func=_console)
-
-
-def _positive(text):
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError("%r is not a number" % text) from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError("%s: expected a number of seconds > 0" % text)
-    return value
-
-
-def _positive_int(text):
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError("%r is not an integer" % text) from None
-    if value < 1:
-        raise argparse.ArgumentTypeError("%s: expected an integer >= 1" % text)
-    return value
 
 
 # ------------------------------------------------------------------------------ watch

@@ -1,5 +1,7 @@
 """`obsw board`: build, deploy, flash, repl and test the reconfiguration module's Pyboard."""
 
+import signal
+
 
 def add_parser(sub):
     p = sub.add_parser("board", help="Pyboard firmware for the reconfiguration module")
@@ -79,6 +81,10 @@ def _qemu(args):
 
     def go():
         q = board.qemu(args.qemu_args)
+        # SIGTERM (a service manager, `kill`) ends QEMU too, as Ctrl-C does, not only this
+        # process; SIGHUP (the terminal closed) likewise
+        for signum in (signal.SIGTERM, signal.SIGHUP):
+            signal.signal(signum, _interrupt)
         print("QEMU board on %s (obsw board deploy|test|repl --port %s); Ctrl-C ends it"
               % (q.pty, q.pty), flush=True)  # fmt: skip
         try:
@@ -89,6 +95,10 @@ def _qemu(args):
             q.close()
 
     return _guard(go)
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
 
 
 def _deploy(args):

@@ -4,6 +4,7 @@ and signing (SDLS)."""
 import binascii
 import json
 
+from obsw_host.errors import UserError, user_message
 from obsw_host.net import DEFAULT_HOST
 
 
@@ -113,7 +114,7 @@ def processor(args):
             db = sdb_module.load(args.sdb or SDB_PATH)
             security = security_options(args.keys, db, args.key_state)
         except (OSError, ValueError, KeyError) as e:
-            raise SystemExit("obsw frames processor: %s" % e) from None
+            raise _mistake("processor", e) from None
     try:
         host = FrameProcessorHost(
             args.uart_a,
@@ -129,7 +130,7 @@ def processor(args):
             **security,
         )
     except ValueError as e:
-        raise SystemExit("obsw frames processor: %s" % e) from None
+        raise _mistake("processor", e) from None
     for link in host.links:
         link.port.baudrate = args.baudrate
     print("frame processor: %s + %s, TC to UDP %s:%d+APID, TM on UDP %d (VC %d), playback "
@@ -164,7 +165,7 @@ def keygen(args):
             args.ahead,
         )
     except (OSError, ValueError) as e:
-        raise SystemExit("obsw frames keygen: %s" % e) from None
+        raise _mistake("keygen", e) from None
     for sa in sas:
         print("SA %d: VC %d MAP %s, HMAC-SHA-256 MAC %d octets, window %d" % (
             sa.spi, sa.vcid, "any" if sa.map_id is None else sa.map_id, sa.mac_length,
@@ -185,7 +186,7 @@ def sign_frame(args):
         )
         state.save()
     except (OSError, ValueError) as e:
-        raise SystemExit("obsw frames sign: %s" % e) from None
+        raise _mistake("sign", e) from None
     print(binascii.hexlify(encode(frame) if args.cltu else frame).decode())
     return 0
 
@@ -216,7 +217,7 @@ def cltu_decode(args):
         data, fixed = decode(_hex(args.hex), args.randomize)
         frame = TcFrame.unpack(data, trailing=True)
     except FrameError as e:
-        raise SystemExit("obsw frames cltu decode: %s" % e) from None
+        raise _mistake("cltu decode", e) from None
     out = _frame_json(frame)
     out["corrected_bits"] = fixed
     print(json.dumps(out))
@@ -238,7 +239,7 @@ def tm_decode(args):
     try:
         frame = TmFrame.unpack(raw)
     except FrameError as e:
-        raise SystemExit("obsw frames tm decode: %s" % e) from None
+        raise _mistake("tm decode", e) from None
     out = {
         "scid": frame.scid,
         "vcid": frame.vcid,
@@ -267,10 +268,16 @@ def verify_frame(args):
             raw, _ = decode(raw)
         frame = TcFrame.unpack(raw, trailing=True)
     except (OSError, FrameError) as e:
-        raise SystemExit("obsw frames verify: %s" % e) from None
+        raise _mistake("verify", e) from None
     outcome, sa, sn, clear = security.process(raw, len(frame))
     out = _frame_json(frame)
     out.update(outcome=OUTCOME_NAMES[outcome], spi=None if sa is None else sa.spi, sn=sn)
     out["data"] = None if clear is None else binascii.hexlify(clear).decode()
     print(json.dumps(out))
     return 0 if clear is not None else 1
+
+
+def _mistake(action, e):
+    """A bad key file, path or input of ``action`` as one line (exit status 2), the errno
+    spelled out as every command spells it (``obsw_host.errors.user_message``)."""
+    return UserError("%s: %s" % (action, user_message(e) or e))

@@ -2,6 +2,8 @@
 
 import json
 import os
+import shutil
+import signal
 import sys
 import tempfile
 import threading
@@ -32,7 +34,7 @@ def add_parser(sub):
     _instance_options(x)
     x.add_argument("--files", help="the on-board CFDP filestore (default: DIR/sat)")
     x.add_argument("--seconds", type=float, help="stop after this many seconds")
-    x.set_defaults(func=run)
+    x.set_defaults(func=run_in_temp)
 
 
 def _instance_options(x):
@@ -160,3 +162,20 @@ def run(args):
     finally:
         sat.close()
     return 0
+
+
+def run_in_temp(args):
+    """``run``; without ``--dir`` its instance (Yamcs' data, some MB) lives in a new temporary
+    folder that is removed when Yamcs stops, by Ctrl-C, SIGTERM, ``--seconds`` or an error."""
+    signal.signal(signal.SIGTERM, _interrupt)
+    if args.dir:
+        return run(args)
+    args.dir = tempfile.mkdtemp(prefix="obsw-yamcs-")
+    try:
+        return run(args)
+    finally:
+        shutil.rmtree(args.dir, ignore_errors=True)
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt

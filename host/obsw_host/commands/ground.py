@@ -71,11 +71,12 @@ def add_parser(sub):
 
     obcp.add_to_ground(s)
     cfdp.add_parser(s)  # obsw ground cfdp put|get|status|serve
-    from obsw_host.commands import ground_console, ground_memory, ground_services
+    from obsw_host.commands import ground_console, ground_data, ground_memory, ground_services
 
     ground_services.add_to_ground(s)  # obsw ground device|diag|functional|forward (2, 3, 14)
     ground_memory.add_to_ground(s)  # obsw ground memory ..|store ..
     ground_console.add_to_ground(s)  # obsw ground watch|console
+    ground_data.add_to_ground(s)  # obsw ground stats|store ..|file (services 4, 15, 23)
 
     _add_operator(s)
     s.add_parser("ping", help="TC[17,1] are-you-alive").set_defaults(func=_ping)

@@ -279,19 +279,68 @@ def _files(v):
     return "%s\n%s" % (v.get("repository", ""), listing)
 
 
+TIME_KEYS = ("time", "start", "end", "oldest", "newest", "open_start")
+
+
+def _is_time(key):
+    return key in TIME_KEYS or key.endswith("_time")
+
+
+def _rows(items):
+    return isinstance(items, list) and items and all(isinstance(x, dict) for x in items)
+
+
 def readable(value, sdb=None):
-    """A reply as an operator reads it: tables of rows by name where the reply is a list of
-    items (see ``named_row``), a directory listing as a table; else ``text.readable``."""
+    """A reply as an operator reads it: lists of items as tables of rows by name (see
+    ``named_row``), statistics per parameter, a directory listing as a table, found paths one a
+    line, times in UTC; else ``text.readable``."""
     v = text.plain(value)
-    if isinstance(v, dict):
-        if "repository" in v and ("files" in v or "objects" in v):
-            return _files(v)
-        items = v.get("items")
-        if isinstance(items, list) and items and all(isinstance(x, dict) for x in items):
-            return table([named_row(x, sdb) for x in items])
-        if isinstance(v.get("obcps"), list):
-            return table([named_row(x, sdb) for x in v["obcps"]]) or "(no OBCPs)"
+    if not isinstance(v, dict):
+        return text.readable(value, sdb)
+    if "repository" in v and ("files" in v or "objects" in v):
+        return _files(v)
+    if isinstance(v.get("paths"), list):
+        return "\n".join(v["paths"]) or "(nothing found)"
+    if isinstance(v.get("statistics"), dict):
+        rows = []
+        for name, st in v["statistics"].items():
+            row = collections.OrderedDict(parameter=name)
+            for k, x in st.items():
+                if _is_time(k):
+                    row[k + " (UTC)"] = utc(x) or "-"
+                else:
+                    row[k] = number(x) if k == "samples" else _limit_text(sdb, name, x)
+            rows.append(row)
+        head = "from %s to %s" % (utc(v.get("start")) or "-", utc(v.get("end")) or "-")
+        return head + "\n" + (table(rows) if rows else "(no statistics)")
+    lists = [k for k, x in v.items() if _rows(x)]
+    if lists:
+        parts = []
+        for k, x in v.items():
+            if k not in lists and not isinstance(x, (list, dict)):
+                parts.append("%s: %s" % (k, utc(x) if _is_time(k) else x))
+        for k in lists:
+            parts.append(table([_timed(named_row(x, sdb)) for x in v[k]]))
+        return "\n".join(parts)
+    if isinstance(v.get("obcps"), list):
+        return "(no OBCPs)"
+    if all(not isinstance(x, (list, dict)) for x in v.values()) and len(v) > 1:
+        return "\n".join(
+            "%s: %s" % (k, (utc(x) or "-") if _is_time(k) else _cell(x)) for k, x in v.items()
+        )
     return text.readable(value, sdb)
+
+
+def _timed(row):
+    """Times of a row (TAI seconds) in UTC; 0 as '-'."""
+    for k in list(row):
+        if _is_time(k) and isinstance(row[k], (int, float)):
+            row[k] = utc(row[k]) or "-"
+    return row
+
+
+def _cell(x):
+    return ("yes" if x else "no") if isinstance(x, bool) else number(x)
 
 
 def component_said(data):

@@ -64,3 +64,24 @@ def test_files_created_copied_found_and_deleted(obc):  # noqa: F811
     assert ok(port, "file", "find", "SAT:/ops", "*.txt") == ["SAT:/ops/a.txt"]
     r = ground(port, "file", "delete", "SAT:/ops/none.txt")
     assert r.returncode == 1 and "failure" in r.stdout
+
+
+def test_tc_by_name_checked_against_types_and_ranges_before_sending(obc):  # noqa: F811
+    port, log = obc
+    ok(port, "tc", "SolarPanel.deploy")
+    ok(port, "tc", "SolarPanel.set_angle", "angle=15")
+    ok(port, "tc", "SolarPanel.speed=7.5")
+    assert ok(port, "params", "get", "SolarPanel.speed") == ["SolarPanel.speed = 7.5 deg/s"]
+    for args, says in (
+        (("SolarPanel.set_angle", "angle=1e40"), "float32"),  # the type cannot carry it
+        (("SolarPanel.set_angle", "angel=3"), "no argument 'angel'; expected angle"),
+        (("SolarPanel.set_angle",), "needs angle"),
+        (("SolarPanel.speed=25",), "outside the database's range; expected 0.1 to 20"),
+        (("SolarPanel.angle=3",), "read-only"),
+        (("Nope.x",), "expected one of `obsw ground list functions`"),
+        (("17",), "expected SERVICE SUBTYPE [HEX]"),
+    ):
+        r = ground(port, "-v", "tc", *args)
+        assert r.returncode == 2 and says in r.stderr, (args, r.stderr)
+        assert "TC ->" not in r.stderr  # nothing was sent
+    assert ok(port, "params", "get", "SolarPanel.speed") == ["SolarPanel.speed = 7.5 deg/s"]

@@ -20,6 +20,7 @@ Times are UTC (YYYY-MM-DDTHH:MM:SS[.fff]Z); replies print by name, as tables.
 
 import argparse
 
+from obsw.pus.sdb import field_type
 from obsw.utc import parse_utc
 
 from obsw_host.commands import ground
@@ -223,3 +224,65 @@ def _file(args):
         return sg.issue(files.delete_directory(apid, args.path))
 
     return ground._run(args, go)
+
+
+# ------------------------------------------------------------------------------ tc by name
+
+
+def checked(field, value, what, valid=None):
+    """``value`` if its type ``field`` can carry it and it is within ``valid`` ([low, high],
+    the database's range), else UserError: nothing wrong is sent."""
+    try:
+        field.pack(value)
+    except (ValueError, TypeError) as e:
+        raise UserError("%s = %r: %s" % (what, value, e)) from None
+    if valid and not isinstance(value, bool) and isinstance(value, (int, float)):
+        low, high = valid
+        if (low is not None and value < low) or (high is not None and value > high):
+            raise UserError(
+                "%s = %s is outside the database's range" % (what, value),
+                expected="%s to %s" % (low, high),
+            )
+    return value
+
+
+def tc_by_name(args):
+    """`obsw ground tc FUNCTION ARG=VALUE..` or `tc PARAMETER=VALUE..`, checked first."""
+    words = [args.what] + list(args.rest)
+
+    def go(g):
+        sdb = g.sdb
+        if "=" in args.what:
+            values = {}
+            for name, value in ground._assignments(words).items():
+                p = sdb.parameter(name)
+                if not p.writable:
+                    raise UserError("parameter %s is read-only" % p.qualified)
+                values[p.qualified] = checked(p.type, value, p.qualified, p.range)
+            return g.set_parameters(values)
+        fn = _function(sdb, args.what)
+        given = {str(k): v for k, v in ground._assignments(args.rest).items()}
+        declared = {a[1]: a for a in fn.arguments}
+        for name, value in given.items():
+            if name not in declared:
+                raise UserError(
+                    "%s has no argument %r" % (fn.name, name),
+                    expected=", ".join(declared) or "no arguments",
+                )
+            checked(field_type(declared[name][2]), value, "%s %s" % (fn.name, name))
+        missing = [n for n, a in declared.items() if n not in given and a[3] is None]
+        if missing:
+            raise UserError("%s needs %s" % (fn.name, ", ".join(missing)), expected="ARG=VALUE")
+        return g.perform(fn.name, **given)
+
+    return ground._run(args, go)
+
+
+def _function(sdb, name):
+    for fn in sdb.functions.values():
+        if fn.name == name:
+            return fn
+    raise UserError(
+        "no function or parameter assignment %r" % name,
+        expected="one of `obsw ground list functions`, or PARAMETER=VALUE",
+    )

@@ -10,6 +10,7 @@ from obsw.cfdp import msgs
 from obsw.cfdp.defs import CONDITION_NAMES, DIR_NAK
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity, packet_type_for
+from obsw_host.sample import load_sdb
 
 GROUND = 1
 ONBOARD = 2
@@ -40,12 +41,15 @@ def _run(work, out, size, loss, seed, timeout):
     onboard = make_entity(
         ONBOARD, [GROUND], ofs, segment=512, ack_interval=0.3, nak_interval=0.3, persist=False
     )
+    apid = load_sdb().apid("cfdp")  # the sample spacecraft's CFDP APID
     g = UdpEntity(
-        ground, ("127.0.0.1", 0), {}, packet_type=packet_type_for(False), loss=loss, seed=seed
-    )
+        ground, ("127.0.0.1", 0), {}, apid=apid, packet_type=packet_type_for(False), loss=loss,
+        seed=seed,
+    )  # fmt: skip
     o = UdpEntity(
-        onboard, ("127.0.0.1", 0), {}, packet_type=packet_type_for(True), loss=loss, seed=seed + 1
-    )
+        onboard, ("127.0.0.1", 0), {}, apid=apid, packet_type=packet_type_for(True), loss=loss,
+        seed=seed + 1,
+    )  # fmt: skip
     g.peers[ONBOARD] = o.address
     o.peers[GROUND] = g.address
     shown = {"nak": 0}

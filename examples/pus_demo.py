@@ -1,4 +1,4 @@
-"""PUS demo: an on-board process and a ground process on loopback UDP (port 5000 + APID).
+"""PUS demo: an on-board process and a ground process on loopback UDP (port base + APID).
 
 ``run(out=print)`` pings the on-board process and prints every packet decoded on the ground
 side, one line each; then housekeeping of the solar panel, a parameter set, an event, and
@@ -8,6 +8,7 @@ an action (service 19), and a time-tagged TC (service 11) runs at its release ti
 
 import sys
 
+from obsw_host.ports import app_port
 from obsw_host.sample import SDB_PATH, load_sdb  # noqa: F401
 
 
@@ -16,8 +17,8 @@ def _start_onboard(sdb, out, components):
 
     try:
         return Onboard(sdb, components=components).start()
-    except OSError as e:  # port 5000 + APID taken (another demo running): any free port
-        out("  (port %d busy: %s; using a free port)" % (5000 + sdb.apid("pus"), e.strerror))
+    except OSError as e:  # port base + APID taken (another demo running): any free port
+        out("  (port %d busy: %s; using a free port)" % (app_port(sdb.apid("pus")), e.strerror))
         return Onboard(sdb, port=0, components=components).start()
 
 

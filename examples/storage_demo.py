@@ -30,9 +30,10 @@ from obsw.spp import TYPE_TC, TYPE_TM
 from obsw.store import Store
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity
+from obsw_host.ids import MissionIds
 
 HK_STORE = 1
-SCID = 0x2A
+SCID = MissionIds.sample().scid  # the sample spacecraft's
 
 
 class Segment:
@@ -67,11 +68,12 @@ class Segment:
             ground_id, [sat_id], self.ground_fs, segment=segment, persist=False, **timers
         )
         local = ("127.0.0.1", 0)
+        apid = sdb.apid("cfdp")
         self.sat_udp = UdpEntity(
-            self.sat_entity, local, {}, packet_type=TYPE_TM, loss=loss, seed=seed
+            self.sat_entity, local, {}, apid=apid, packet_type=TYPE_TM, loss=loss, seed=seed
         )
         self.ground_udp = UdpEntity(
-            self.ground_entity, local, {}, packet_type=TYPE_TC, loss=loss, seed=seed + 1
+            self.ground_entity, local, {}, apid=apid, packet_type=TYPE_TC, loss=loss, seed=seed + 1
         )
         self.sat_udp.peers[ground_id] = self.ground_udp.address
         self.ground_udp.peers[sat_id] = self.sat_udp.address

@@ -1,10 +1,16 @@
 """Start the reconfiguration application on this board (frozen; main.py imports it)."""
 
 from hal_pyb import PybHal
+from obsw.reconfig import mission
 from obsw.reconfig.app import ReconfigApp
 from obsw.reconfig.essential import security_from_file
 
 hal = PybHal()
+# the mission's SCID, node ids, essential MAP and HPTM VC from mission.json on the board's flash
+ids = mission.load()
+if ids is None:
+    print("no mission.json on the board: the reconfiguration module's built-in ids")
+    ids = {}
 # TC frames are authenticated with the SDLS key file on the board's flash, when there is one
-app = ReconfigApp(hal, essential_security=security_from_file("tc.keys"))
+app = ReconfigApp(hal, essential_security=security_from_file("tc.keys"), **ids)
 app.run()

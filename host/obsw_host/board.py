@@ -21,6 +21,8 @@ import sys
 import tempfile
 import time
 
+from obsw_host.manifest import Manifest
+
 BOARD = "OBSW_RECONFIG"
 
 
@@ -59,33 +61,9 @@ def _run(cmd, runner=subprocess.call, **kw):
 
 def frozen_modules():
     """(source path, module path) of everything manifests/reconfig.py freezes."""
-    root = repo_root()
-    manifest = os.path.join(root, "manifests", "reconfig.py")
-    out = []
-    here = [os.path.dirname(manifest)]
-
-    def base(b):
-        return os.path.normpath(os.path.join(here[-1], b))
-
-    def module(path, base_path="."):
-        out.append((os.path.join(base(base_path), path), path))
-
-    def package(path, files=None, base_path="."):
-        top = os.path.join(base(base_path), path)
-        names = files or sorted(
-            os.path.relpath(os.path.join(d, f), top)
-            for d, _, fs in os.walk(top)
-            for f in fs
-            if f.endswith(".py")
-        )
-        for f in names:
-            out.append((os.path.join(top, f), os.path.join(path, f)))
-
-    env = {"metadata": lambda **kw: None, "module": module, "package": package}
-    env["include"] = env["require"] = lambda *a, **kw: None
-    with open(manifest) as f:
-        exec(compile(f.read(), manifest, "exec"), env)
-    return out
+    m = Manifest()
+    m.execute(os.path.join(repo_root(), "manifests", "reconfig.py"))
+    return [(str(path), name) for path, name in m.modules]
 
 
 def firmware_tools():

@@ -122,6 +122,8 @@ class TestChecks(unittest.TestCase):
             transitions(loop),
             [(2, UNCHECKED, WITHIN), (2, WITHIN, BELOW_LOW), (2, BELOW_LOW, INVALID)],
         )
+        item = loop.unsolicited(12, 12)[1]["items"][0]  # the check's mask, then the value
+        self.assertEqual((item["mask"], item["value"], item["limit"]), (0x0F, 0x13, 2))
         self.assertEqual([e["id"] for e in loop.unsolicited(5, 3)], [4])
 
     def test_delta_check_on_the_mean_of_consecutive_deltas(self):

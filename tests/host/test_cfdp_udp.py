@@ -12,6 +12,7 @@ import pytest
 from obsw.cfdp.defs import NO_ERROR
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity
+from obsw_host.sample import load_sdb
 
 ROOT = os.path.join(os.path.dirname(__file__), "..", "..")
 ENV = dict(
@@ -123,7 +124,11 @@ def test_receiver_killed_mid_transfer_completes_after_restart(tmp_path, kill_at)
     gfs.write_bytes("big.bin", data)
     ent = make_entity(1, [2], gfs, ack_interval=0.5, nak_interval=0.5, limit=60, persist=False)
     udp = UdpEntity(
-        ent, ("127.0.0.1", ground_port), {2: ("127.0.0.1", onboard_port)}, rate=2_000_000
+        ent,
+        ("127.0.0.1", ground_port),
+        {2: ("127.0.0.1", onboard_port)},
+        apid=load_sdb().apid("cfdp"),  # `obsw cfdp serve` runs the sample mission's entity
+        rate=2_000_000,
     )
     fin = []
     udp.on_indication = lambda i: fin.append(i.info) if i.kind == "finished" else None

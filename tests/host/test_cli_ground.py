@@ -212,7 +212,7 @@ def test_onboard_log_one_line_per_tc(obc):
 @pytest.mark.parametrize(
     "kind, expected",
     [
-        ("parameters", "2 SolarPanel.speed float32 deg/s yes"),
+        ("parameters", "2 SolarPanel.speed float32 deg/s yes [0.1, 20]"),
         ("functions", "2 SolarPanel.set_angle angle: float32"),
         ("events", "2 SolarPanel.deployed low hinges: uint8"),
         ("hk", "1 10 yes SolarPanel.angle, SolarPanel.speed, SolarPanel.is_deployed"),

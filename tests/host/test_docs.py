@@ -2,6 +2,7 @@
 benchmark pages say what their saved data says, and the conventions page lists the modules
 the imports check allows."""
 
+import importlib.util
 import json
 import pathlib
 import re
@@ -10,11 +11,20 @@ import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
-sys.path.insert(0, str(ROOT / "tools" / "bench"))
 
 import check_imports  # noqa: E402
-import report  # noqa: E402
 from obsw_host.obc.config import MissionConfig  # noqa: E402
+
+
+def _load(name, path):
+    """A tool module by its file: tools/bench on sys.path would shadow peers (spacecan.py)."""
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+report = _load("bench_report", ROOT / "tools" / "bench" / "report.py")
 
 README_MAX = 15_000  # bytes: a front page, the rest lives in docs/
 

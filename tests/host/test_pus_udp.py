@@ -4,10 +4,13 @@ import argparse
 import json
 
 import pytest
+from obsw.pus.messages import FAILURE_OUT_OF_RANGE
+from obsw.pus.services.s20_parameters import RangeError
 from obsw.store import Store
 from obsw_host.commands import ground as ground_command
+from obsw_host.ports import app_port
 from obsw_host.pus.ground import Ground, PusTimeout
-from obsw_host.pus.onboard import Onboard, port_for
+from obsw_host.pus.onboard import Onboard
 from obsw_host.sample import load_sdb
 from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 
@@ -32,7 +35,7 @@ def system(tmp_path):
 
 def test_port_convention():
     sdb = load_sdb()
-    assert port_for(sdb.apid("pus")) == 5000 + sdb.apid("pus")
+    assert app_port(sdb.apid("pus")) == 5000 + sdb.apid("pus")
     assert Onboard(sdb).port == 5000 + sdb.apid("pus")
 
 
@@ -58,8 +61,12 @@ def test_housekeeping_and_parameters(system):
     tx = ground.get_parameters("SolarPanel.speed", "pus.tc_received")
     assert tx.reply["values"]["SolarPanel.speed"] == 7.5
     assert tx.reply["values"]["pus.tc_received"] == 3  # this request included
-    tx = ground.set_parameter("SolarPanel.speed", 50.0)  # the panel refuses
-    assert tx.failure["stage"] == 4 and not tx.ok
+    with pytest.raises(RangeError):  # the database's range [0.1, 20]: refused on the ground
+        ground.set_parameter("SolarPanel.speed", 50.0)
+    data = ground.params.layout.pack({"items": [{"id": 2, "value": 50.0}]})
+    tx = ground.wait(ground.send(ground.apid, 20, 3, data))  # and on board, if sent anyway
+    assert (tx.failure["stage"], tx.failure["code"]) == (2, FAILURE_OUT_OF_RANGE)
+    assert panel.speed == 7.5
     tx = ground.set_parameter("SolarPanel.angle", 1.0)  # read-only
     assert tx.failure["stage"] == 2
 

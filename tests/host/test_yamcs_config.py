@@ -208,7 +208,7 @@ def test_cli_writes_the_xtce_and_the_instance(tmp_path, capsys):
     assert main(["yamcs", "xtce", SDB_PATH, "-o", str(tmp_path / "m.xml")]) == 0
     assert ET.parse(str(tmp_path / "m.xml")).getroot().get("name") == "obsw-demo"
     assert main(["yamcs", "config", str(tmp_path / "y"), "--mode", "frames"]) == 0
-    text = (tmp_path / "y" / "etc" / "yamcs.obsw.yaml").read_text()
+    text = (tmp_path / "y" / "etc" / "yamcs.sample-spacecraft.yaml").read_text()  # the mission
     assert "UdpTcFrameLink" in text and "useCop1: true" in text
     assert '"CRC-16-CCIIT"' in text and "implicitPField: 30" in text  # CUC 4+2, TAI epoch
     server_yaml = (tmp_path / "y" / "etc" / "yamcs.yaml").read_text()

@@ -105,6 +105,7 @@ class Obsw:
 
     def transfer(self, name, data):
         from obsw_host.cfdp.client import CfdpClient
+        from obsw_host.sample import load_sdb
 
         with open(os.path.join(self.tx_root, name), "wb") as f:
             f.write(data)
@@ -112,6 +113,7 @@ class Obsw:
             1,
             {2: ("127.0.0.1", self.rx_port)},
             self.tx_root,
+            apid=load_sdb().apid("cfdp"),  # `obsw cfdp serve` runs the sample mission's entity
             cls=2,
             segment=SEGMENT,
             port=self.tx_port,

@@ -193,8 +193,10 @@ def main():
     probe.bind(("127.0.0.1", 0))
     http_port = probe.getsockname()[1]
     probe.close()
-    gateway = PacketGateway(tcp_ports={"pus": 0, "cfdp": 0}, apids={"cfdp": [100]}, tm_port=0)
-    write_instance(folder, database.load(), "packets", gateway.ports, http_port)
+    spacecraft = database.load()  # the sample's, its CFDP APID included
+    cfdp = [spacecraft.required_apid("cfdp")]
+    gateway = PacketGateway(tcp_ports={"pus": 0, "cfdp": 0}, apids={"cfdp": cfdp}, tm_port=0)
+    write_instance(folder, spacecraft, "packets", gateway.ports, http_port)
     gateway.start()
     yamcs = server.Yamcs(folder, http_port)
     results = {}

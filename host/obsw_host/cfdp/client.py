@@ -1,7 +1,7 @@
 """A CFDP client for scripts and the `obsw cfdp` command: put, get and status, returning results.
 
     from obsw_host.cfdp.client import CfdpClient
-    with CfdpClient(1, {2: ("127.0.0.1", 5100)}, root="ground-files") as c:
+    with CfdpClient(1, {2: ("127.0.0.1", 5100)}, root="ground-files", apid=100) as c:
         result = c.put("patch.bin")          # a Result: result.delivered, result.condition
         print(result.line())                 # "delivered patch.bin to entity 2: 1024 B in .."
 
@@ -136,6 +136,7 @@ class CfdpClient:
         peers,
         root=None,
         *,
+        apid,
         cls=2,
         segment=1024,
         port=0,
@@ -160,6 +161,7 @@ class CfdpClient:
             self.entity,
             ("127.0.0.1", port),
             self.peers,
+            apid=apid,
             packet_type=packet_type_for(False),
             loss=loss,
         )

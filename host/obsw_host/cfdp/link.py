@@ -1,10 +1,10 @@
-"""A CFDP entity over UDP: each PDU travels in one space packet with the CFDP APID.
+"""A CFDP entity over UDP: each PDU travels in one space packet with the mission's CFDP APID
+(the spacecraft database's ``apids.cfdp``, passed in by the caller).
 
 The entity itself is the core's sans-I/O ``CfdpEntity``; this module only moves bytes and reads
 the clock.
 """
 
-import os
 import random
 import select
 import socket
@@ -15,9 +15,6 @@ from obsw.cfdp.mib import Mib, RemoteEntity
 from obsw.spp import TYPE_TC, TYPE_TM, SpacePacket, SppError
 
 from obsw_host.net import DEFAULT_HOST
-
-CFDP_APID = int(os.environ.get("OBSW_CFDP_APID", "100"))
-BASE_PORT = 5000  # the project's convention: UDP port 5000 + APID
 
 
 def parse_peer(text):
@@ -42,7 +39,7 @@ class PeerError(ValueError):
 
 
 class UdpEntity:
-    """Moves PDUs between a CfdpEntity and a UDP socket.
+    """Moves PDUs between a CfdpEntity and a UDP socket, in space packets of APID ``apid``.
 
     ``loss`` drops that fraction of outgoing PDUs (for demonstrations); ``rate`` caps the
     outgoing file data in octets per second (None: as fast as the socket takes them).
@@ -54,7 +51,7 @@ class UdpEntity:
         bind,
         peers,
         *,
-        apid=CFDP_APID,
+        apid,
         packet_type=TYPE_TM,
         loss=0.0,
         seed=1,

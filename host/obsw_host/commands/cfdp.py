@@ -1,27 +1,33 @@
-"""`obsw cfdp`: put and get files over CFDP, ask a remote entity for status, run an entity."""
+"""`obsw cfdp`: put and get files over CFDP, ask a remote entity for status, run an entity.
 
+Entity ids, the CFDP APID and the ports come from the mission (``--mission DIR``, see
+``obsw_host.ids``): a ground client is the ground filestore's entity and talks to the onboard
+one on the mission's CFDP port; ``serve`` runs the onboard entity, its peer the ground's.
+"""
+
+import argparse
 import os
 import sys
 import time
 
+from obsw_host import ids as mission_ids
 from obsw_host.net import DEFAULT_HOST
 
-DEFAULT_PEER = "2=127.0.0.1:5100"
 
-
-def _common(p, local_id, port):
+def _common(p):
+    mission_ids.add_arguments(p)
     p.add_argument(
         "--id",
         type=int,
-        default=int(os.environ.get("OBSW_CFDP_ID", local_id)),
-        help="local entity id (default %(default)s, or $OBSW_CFDP_ID)",
+        default=int(os.environ["OBSW_CFDP_ID"]) if os.environ.get("OBSW_CFDP_ID") else None,
+        help="local entity id (default: $OBSW_CFDP_ID, else the mission's filestore entity)",
     )
-    p.add_argument("--port", type=int, default=port, help="local UDP port (0: any)")
+    p.add_argument("--port", type=int, help="local UDP port (0: any; default: the mission's)")
     p.add_argument(
         "--peer",
         action="append",
         metavar="ID=HOST:PORT",
-        help="a remote entity and its UDP address (default %s)" % DEFAULT_PEER,
+        help="a remote entity and its UDP address (default: the mission's other entity)",
     )
     p.add_argument(
         "--root", default=None, help="filestore directory (default $OBSW_FILESTORE or ./filestore)"
@@ -50,23 +56,26 @@ def _common(p, local_id, port):
 
 def add_parser(sub):
     p = sub.add_parser(
-        "cfdp", help="CFDP file transfer (put, get, status, serve)", description=__doc__
+        "cfdp",
+        help="CFDP file transfer (put, get, status, serve)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
     put = s.add_parser("put", help="send a local file to a remote entity")
     put.add_argument("source", help="file name in the local filestore")
     put.add_argument("dest", nargs="?", help="file name at the remote entity")
-    _common(put, 1, 0)
+    _common(put)
     put.set_defaults(func=cmd_put)
     get = s.add_parser("get", help="fetch a remote file (proxy put)")
     get.add_argument("source", help="file name at the remote entity")
     get.add_argument("dest", nargs="?", help="file name in the local filestore")
-    _common(get, 1, 0)
+    _common(get)
     get.set_defaults(func=cmd_get)
     st = s.add_parser("status", help="ask a remote entity about a transaction or a directory")
     st.add_argument("what", help="SOURCE:SEQ of a transaction, or a directory name")
-    _common(st, 1, 0)
+    _common(st)
     st.set_defaults(func=cmd_status)
     sv = s.add_parser("serve", help="run a CFDP entity process (the onboard one by default)")
     _serve_args(sv)
@@ -74,24 +83,54 @@ def add_parser(sub):
 
 
 def _serve_args(p):
-    _common(p, 2, 5000 + 100)
+    _common(p)
     p.add_argument(
         "--host", default=DEFAULT_HOST, help="address to listen on (default %(default)s)"
     )
     p.add_argument("--ground", action="store_true", help="send TC packets (default TM)")
 
 
+class Endpoints:
+    """The local entity id, UDP port, peers and APID of a command, from the mission unless
+    the command line says otherwise. ``onboard``: the onboard entity (``serve``)."""
+
+    def __init__(self, args, onboard):
+        ids = mission_ids.from_args(args)
+        sat, ground = ids.cfdp_entities
+        host = getattr(args, "host", DEFAULT_HOST)
+        self.apid = ids.apid("cfdp")
+        if onboard:
+            default_id, port, peer = sat, ids.ports.cfdp, (ground, ids.ports.cfdp_ground)
+        else:
+            # the ground entity's port of the mission: where the onboard entity sends to it
+            default_id, port, peer = ground, ids.ports.cfdp_ground, (sat, ids.ports.cfdp)
+        self.id = args.id if args.id is not None else default_id
+        self.port = args.port if args.port is not None else port
+        if args.peer:
+            self.peers = dict(_parse_peer(t) for t in args.peer)
+        else:
+            self.peers = {peer[0]: (host, peer[1])}
+
+
+def _parse_peer(text):
+    from obsw_host.cfdp.link import parse_peer
+
+    return parse_peer(text)
+
+
 def _setup(args, onboard=False):
     from obsw_host.cfdp.filestore import RootedFilestore
-    from obsw_host.cfdp.link import UdpEntity, make_entity, packet_type_for, parse_peer
+    from obsw_host.cfdp.link import UdpEntity, make_entity, packet_type_for
 
-    peers = dict(parse_peer(t) for t in (args.peer or [DEFAULT_PEER]))
+    ends = Endpoints(args, onboard=onboard)
+    peers = ends.peers
     fs = RootedFilestore(args.root)
-    ent = make_entity(args.id, peers, fs, mode=2 - args.cls, segment=args.segment, persist=onboard)
+    ent = make_entity(ends.id, peers, fs, mode=2 - args.cls, segment=args.segment, persist=onboard)
     udp = UdpEntity(
         ent,
-        (getattr(args, "host", DEFAULT_HOST), args.port),
+        (getattr(args, "host", DEFAULT_HOST), ends.port),
         peers,
+        apid=ends.apid,
         packet_type=packet_type_for(onboard),
         loss=args.loss,
     )
@@ -128,16 +167,16 @@ class Progress:
 
 def _client(args):
     from obsw_host.cfdp.client import CfdpClient
-    from obsw_host.cfdp.link import parse_peer
 
-    peers = dict(parse_peer(t) for t in (args.peer or [DEFAULT_PEER]))
+    ends = Endpoints(args, onboard=False)
     return CfdpClient(
-        args.id,
-        peers,
+        ends.id,
+        ends.peers,
         args.root,
+        apid=ends.apid,
         cls=args.cls,
         segment=args.segment,
-        port=args.port,
+        port=ends.port,
         loss=args.loss,
         timeout=args.timeout,
         answer_timeout=args.answer_timeout,
@@ -206,7 +245,7 @@ def cmd_serve(args):
     n = ent.restore(time.monotonic())
     print(
         "cfdp entity %d on udp %s:%d, filestore %s, %d transaction(s) restored"
-        % (args.id, udp.address[0], udp.address[1], ent.fs.root, n),
+        % (ent.mib.entity_id, udp.address[0], udp.address[1], ent.fs.root, n),
         flush=True,
     )
 

@@ -1,9 +1,11 @@
 """`obsw frames`: the frame processor on two UARTs, CLTU and TM frame tools, TC security keys
-and signing (SDLS)."""
+and signing (SDLS). The spacecraft id, virtual channels, MAP IDs and ports come from the
+mission (``--mission DIR``) unless an option gives them."""
 
 import binascii
 import json
 
+from obsw_host import ids as mission_ids
 from obsw_host.errors import UserError, user_message
 from obsw_host.net import DEFAULT_HOST
 
@@ -18,27 +20,27 @@ def add_parser(sub):
     proc = s.add_parser("processor", help="run the frame processor on two serial ports")
     proc.add_argument("--uart-a", required=True, help="first link (serial device)")
     proc.add_argument("--uart-b", required=True, help="second, hot-redundant link")
-    proc.add_argument("--scid", type=lambda v: int(v, 0), default=0x2A, help="spacecraft id")
+    mission_ids.add_arguments(proc)
+    proc.add_argument("--scid", type=_int, help="spacecraft id (default: the mission's)")
     proc.add_argument("--baudrate", type=int, default=115200)
     proc.add_argument(
         "--host", default=DEFAULT_HOST, help="where the application processes are (%(default)s)"
     )
-    proc.add_argument("--port-base", type=int, default=5000, help="TC packets go to base+APID")
-    proc.add_argument("--tm-port", type=int, default=4999, help="UDP port receiving TM packets")
+    proc.add_argument("--port-base", type=int, help="TC packets go to base+APID (the mission's)")
+    proc.add_argument("--tm-port", type=int, help="UDP port receiving TM packets (the mission's)")
     proc.add_argument(
         "--playback-port", type=int, default=None,
-        help="UDP port whose packets go on the playback VC (default: TM port + 1)",
+        help="UDP port whose packets go on the playback VC (default: the mission's)",
     )  # fmt: skip
-    for role, vcid in (("realtime", 0), ("playback", 1), ("essential", 6)):
+    for role in ("realtime", "playback", "essential"):
         proc.add_argument(
-            "--%s-vc" % role, type=int, default=vcid, help="TM VC of %s TM (%d)" % (role, vcid)
+            "--%s-vc" % role, type=int, help="TM VC of %s TM (default: the mission's)" % role
         )
     proc.add_argument("--frame-length", type=int, default=256, help="TM frame length")
     proc.add_argument("--essential-map", type=int, default=None, help="MAP ID of HPCs")
     proc.add_argument("--duration", type=float, default=None, help="stop after N seconds")
     proc.add_argument("--keys", help="SDLS key file: authenticate every TC frame")
     proc.add_argument("--key-state", help="sequence number state file (default KEYS.state)")
-    proc.add_argument("--sdb", help="spacecraft database for the event APID and IDs (sample)")
     proc.set_defaults(func=processor)
 
     kg = s.add_parser("keygen", help="write a new SDLS key file (outside any repository)")
@@ -55,9 +57,10 @@ def add_parser(sub):
     sign.add_argument("hex", help="the TC packet")
     sign.add_argument("--keys", required=True, help="SDLS key file")
     sign.add_argument("--key-state", help="sequence number state file (default KEYS.state)")
-    sign.add_argument("--scid", type=lambda v: int(v, 0), default=0x2A, help="spacecraft id")
-    sign.add_argument("--vcid", type=int, default=0)
-    sign.add_argument("--map", type=int, default=1, help="MAP ID (1)")
+    mission_ids.add_arguments(sign)
+    sign.add_argument("--scid", type=_int, help="spacecraft id (default: the mission's)")
+    sign.add_argument("--vcid", type=int, help="TC VC (default: the mission's)")
+    sign.add_argument("--map", type=int, help="MAP ID (default: the mission's packets MAP)")
     sign.add_argument("--ad", action="store_true", help="Type-AD frame (default BD)")
     sign.add_argument("--seq", type=int, default=0, help="frame sequence number N(S)")
     sign.add_argument("--cltu", action="store_true", help="print the CLTU instead")
@@ -89,6 +92,10 @@ def add_parser(sub):
     tdec.set_defaults(func=tm_decode)
 
 
+def _int(text):
+    return int(text, 0)
+
+
 def _hex(text):
     from obsw_host.errors import hex_bytes
 
@@ -98,35 +105,42 @@ def _hex(text):
 def processor(args):
     from obsw_host.frames.processor import FrameProcessorHost
 
-    plan = {"realtime": args.realtime_vc, "playback": args.playback_vc}
-    plan["essential"] = args.essential_vc
+    ids = mission_ids.from_args(args)
+    ports = ids.ports
+    plan = dict(ids.tm_vcs)
+    for role in plan:
+        given = getattr(args, "%s_vc" % role)
+        if given is not None:
+            plan[role] = given
+    port_base = args.port_base if args.port_base is not None else ports.pus - ids.pus_apid
+    tm_port = args.tm_port if args.tm_port is not None else ports.tm
     playback = args.playback_port
     if playback is None:
-        playback = args.tm_port + 1 if args.tm_port else 0
+        playback = tm_port + 1 if args.tm_port is not None else ports.playback
+    scid = args.scid if args.scid is not None else ids.scid
     security = {}
     if args.keys:
-        from obsw.pus import sdb as sdb_module
-
         from obsw_host.frames.processor import security_options
-        from obsw_host.sample import SDB_PATH
 
         try:
-            db = sdb_module.load(args.sdb or SDB_PATH)
-            security = security_options(args.keys, db, args.key_state)
+            security = security_options(args.keys, ids.sdb, args.key_state)
         except (OSError, ValueError, KeyError) as e:
             raise _mistake("processor", e) from None
     try:
         host = FrameProcessorHost(
             args.uart_a,
             args.uart_b,
-            args.scid,
+            scid,
             host=args.host,
-            port_base=args.port_base,
-            tm_port=args.tm_port,
-            vc_ports={args.playback_vc: playback},
+            port_base=port_base,
+            tm_port=tm_port,
+            vc_ports={plan["playback"]: playback},
             tm_frame_length=args.frame_length,
             essential_map=args.essential_map,
             tm_plan=plan,
+            tm_channels=ids.tm_channels() if plan == ids.tm_vcs else None,
+            tm_vc_of_apid=ids.tm_vc_of_apid() if plan == ids.tm_vcs else None,
+            tc_vcids=(ids.tc_vc,),
             **security,
         )
     except ValueError as e:
@@ -135,8 +149,8 @@ def processor(args):
         link.port.baudrate = args.baudrate
     print("frame processor: %s + %s, TC to UDP %s:%d+APID, TM on UDP %d (VC %d), playback "
           "TM on UDP %d (VC %d)" % (
-        args.uart_a, args.uart_b, args.host, args.port_base, host.tm_port, args.realtime_vc,
-        host.playback_port, args.playback_vc))  # fmt: skip
+        args.uart_a, args.uart_b, args.host, port_base, host.tm_port, plan["realtime"],
+        host.playback_port, plan["playback"]))  # fmt: skip
     if args.keys:
         print("TC security: %d SA(s) from %s, events on APID %d" % (
             len(security["security"].sas), args.keys, security["event_apid"]))  # fmt: skip
@@ -179,10 +193,14 @@ def sign_frame(args):
 
     from obsw_host.frames import keys
 
+    ids = mission_ids.from_args(args)
+    scid = args.scid if args.scid is not None else ids.scid
+    vcid = args.vcid if args.vcid is not None else ids.tc_vc
+    map_id = args.map if args.map is not None else ids.maps["packets"]
     try:
         security, state = keys.load(args.keys, args.key_state)
         frame = keys.signed_frame(
-            security, args.scid, args.vcid, _hex(args.hex), args.map, args.seq, not args.ad
+            security, scid, vcid, _hex(args.hex), map_id, args.seq, not args.ad
         )
         state.save()
     except (OSError, ValueError) as e:

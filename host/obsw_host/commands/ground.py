@@ -9,6 +9,7 @@
     obsw ground hk listen --seconds 3       periodic reports as they come
     obsw ground params get SolarPanel.speed
     obsw ground params set SolarPanel.speed=7.5
+    obsw ground params definitions | define SolarPanel.speed 1 4096 [--object ID]
     obsw ground events disabled | enable NAME.. | disable NAME.. | listen
     obsw ground time rate 0 | listen
     obsw ground connection 10
@@ -24,6 +25,9 @@
     obsw ground list obcps | files [REPOSITORY]         from the on-board process
     obsw ground monitor add 1 SolarPanel.speed 0.5 10 --high-event monitoring.speed_high
     obsw ground monitor list | out-of-limits | enable 1 | disable 1 | delete 1
+    obsw ground fmon add 7 1 2 --failing 1 --event monitoring.speed_high
+    obsw ground fmon list | status | enable 7 | disable 7 | protect 7 | unprotect 7 | delete 7
+    obsw ground fmon enable-function | disable-function
     obsw ground action add monitoring.speed_high set SolarPanel.speed=5
     obsw ground action list | enable EVENT | disable EVENT | delete EVENT
     obsw ground sequence load warmup "0 ping" "2 function SolarPanel.set_angle angle=10"
@@ -39,12 +43,17 @@ Every ground client receives all TM the on-board process sends (events, verifica
 housekeeping), whichever client's TC caused it. ``--log FILE`` appends every TC and TM of the
 command (raw and decoded) to a session log. ``--json`` prints one JSON object per command (per
 packet for ``monitor``) instead of text; ``-v`` shows every packet.
+
+Parameter values are engineering values (calibrated, with their unit, or an enumeration's
+label; limits of ``monitor add`` too); ``--raw`` shows and takes raw values instead. A value
+outside a parameter's range is refused before anything is sent. ``--json`` carries raw values.
 """
 
 import argparse
 import json
 import sys
 
+from obsw_host import ids as mission_ids
 from obsw_host.commands import arguments
 from obsw_host.errors import UserError
 from obsw_host.net import DEFAULT_HOST
@@ -57,14 +66,17 @@ def add_parser(sub):
         description=__doc__,
         formatter_class=_raw(),
     )
-    p.add_argument("--sdb", help="spacecraft database JSON (default: the sample database)")
+    mission_ids.add_arguments(p)
     p.add_argument("--host", default=DEFAULT_HOST, help="on-board host (default %(default)s)")
-    p.add_argument("--port", type=int, help="on-board UDP port (default 5000 + APID)")
+    p.add_argument("--port", type=int, help="on-board UDP port (default: the mission's)")
     p.add_argument("--apid", type=int, help="on-board APID (default: the database's 'pus')")
     p.add_argument("--timeout", type=float, default=2.0, help="seconds per request")
     p.add_argument("--json", action="store_true", help="print JSON for scripts")
     p.add_argument("-v", "--verbose", action="store_true", help="print every packet")
     p.add_argument("--log", metavar="FILE", help="append every TC and TM to this session log")
+    p.add_argument(
+        "--raw", action="store_true", help="raw parameter values (default: engineering values)"
+    )
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
     from obsw_host.commands import cfdp, obcp
@@ -121,6 +133,7 @@ def add_parser(sub):
     x = pa.add_parser("set", help="TC[20,3] set values")
     x.add_argument("assignments", nargs="+", metavar="NAME=VALUE")
     x.set_defaults(func=_params_set)
+    _add_values_commands(s, pa)
 
     ev = s.add_parser("events", help="service 5 events").add_subparsers(dest="events")
     ev.required = True
@@ -250,7 +263,9 @@ def _add_operator(s):
         choices=("parameters", "functions", "events", "hk", "obcps", "files"),
         help="what to list (obcps and files ask the on-board process)",
     )
-    x.add_argument("repository", nargs="?", default="SAT:/", help="for files (default SAT:/)")
+    x.add_argument(
+        "repository", nargs="?", help="for files (default: the mission's onboard filestore)"
+    )
     x.set_defaults(func=_list)
 
 
@@ -261,16 +276,30 @@ def _raw():
 def _ground(args):
     from obsw_host.pus.ground import Ground
     from obsw_host.pus.monitor import SessionLog
-    from obsw_host.pus.onboard import port_for
-    from obsw_host.sample import load_sdb
 
-    sdb = load_sdb(args.sdb)
-    apid = args.apid if args.apid is not None else sdb.apid("pus")
-    target = (args.host, args.port if args.port is not None else port_for(apid))
+    ids = mission_ids.from_args(args)
+    apid = args.apid if args.apid is not None else ids.pus_apid
+    target = (args.host, _port(args, ids, apid))
     log = (lambda s: print(s, file=sys.stderr)) if args.verbose else None
     session = SessionLog(args.log) if getattr(args, "log", None) else None
-    g = Ground(sdb, apid=apid, target=target, timeout=args.timeout, log=log, session=session)
+    g = Ground(
+        ids.sdb,
+        apid=apid,
+        target=target,
+        timeout=args.timeout,
+        log=log,
+        session=session,
+        source_id=ids.source_id,
+        config=ids.pus_config,
+    )
     return _fresh(g)
+
+
+def _port(args, ids, apid):
+    """The on-board UDP port: ``--port``, else the mission's port of process ``apid``."""
+    if args.port is not None:
+        return args.port
+    return ids.ports.pus if apid == ids.apid("pus") else ids.ports.app(apid)
 
 
 def _colour(args):
@@ -287,7 +316,7 @@ def _monitor_live(args):
 
     seen = [0]
     with _ground(args) as g:
-        display = Display(g.sdb, _colour(args))
+        display = Display(g.sdb, _colour(args), getattr(args, "raw", False))
 
         def show(tm, decoded, tx):
             seen[0] += 1
@@ -319,9 +348,8 @@ def _monitor_live(args):
 
 def _replay(args):
     from obsw_host.pus.monitor import replay
-    from obsw_host.sample import load_sdb
 
-    for line in replay(args.session_log, load_sdb(args.sdb), _colour(args)):
+    for line in replay(args.session_log, mission_ids.from_args(args).sdb, _colour(args)):
         print(line)
     return 0
 
@@ -330,9 +358,7 @@ def _list(args):
     from obsw_host.pus.catalog import KINDS, catalog, table
 
     if args.kind in KINDS:
-        from obsw_host.sample import load_sdb
-
-        rows = catalog(load_sdb(args.sdb), args.kind)
+        rows = catalog(mission_ids.from_args(args).sdb, args.kind)
         print(json.dumps(rows) if args.json else table(rows))
         return 0
     if args.kind == "obcps":
@@ -341,7 +367,8 @@ def _list(args):
         return _run(args, lambda g: ObcpGround(g).report_status())
     from obsw_host.pus.storage_ground import StorageGround
 
-    return _run(args, lambda g: StorageGround(g).directory(args.repository))
+    repository = args.repository or "%s:/" % mission_ids.from_args(args).local_prefix
+    return _run(args, lambda g: StorageGround(g).directory(repository))
 
 
 def _run(args, fn):
@@ -354,6 +381,7 @@ def _run(args, fn):
         except PusTimeout as e:
             tx = e.transaction
         sdb = g.sdb
+        target = g.target
     result = text.transaction(tx)
     detail = display.failure_detail(tx, sdb)  # the component's error by name
     if args.json:
@@ -366,23 +394,17 @@ def _run(args, fn):
             line = "%s (%s)" % (line.split(" data ")[0], detail)
         print("  " + line)
     for reply in tx.replies:
-        print(display.readable(reply, sdb))  # names, units, UTC times, tables
+        print(display.readable(reply, sdb, getattr(args, "raw", False)))  # names, tables
     if not tx.done:
-        print(_no_answer(args, tx))
+        print(_no_answer(args, tx, target))
     return 0 if tx.ok else 1
 
 
-def _port(apid):
-    from obsw_host.pus.onboard import port_for
-
-    return port_for(apid)
-
-
-def _no_answer(args, tx):
+def _no_answer(args, tx, target):
     if not tx.verification():
         return "no report from %s:%s within %ss: is `obsw obc serve` running there?" % (
-            args.host,
-            args.port if args.port is not None else 5000 + tx.tc.apid,
+            target[0],
+            target[1],
             args.timeout,
         )
     return "no completion report within %ss" % args.timeout
@@ -442,7 +464,7 @@ def _params_set(args):
         if not sep:
             raise UserError("parameter assignment %r" % a, expected="NAME=VALUE")
         values[_key(name)] = _value(value)
-    return _run(args, lambda g: g.set_parameters(values))
+    return _run(args, lambda g: g.set_parameters(values, raw=args.raw))
 
 
 def _events_disabled(args):
@@ -470,7 +492,7 @@ def _listen(args):
     service, subtype = args.listen
     n = 0
     with _ground(args) as g:
-        display = Display(g.sdb)
+        display = Display(g.sdb, raw=getattr(args, "raw", False))
         g.subscribe()
         print(
             "listening for TM[%s,%s] from %s:%d for %gs"
@@ -628,6 +650,7 @@ def _monitor_add(args):
             _key(args.high_event),
             repetitions=args.repetitions,
             interval=args.interval,
+            raw=args.raw,
         )
 
     return _run(args, go)
@@ -690,3 +713,65 @@ def _sequence_named(args):
         "unload": "unload_sequence",
     }[args.what]
     return _run(args, lambda g: getattr(g, method)(args.name))
+
+
+# ------------------------------------- parameter definitions (20), functional monitoring (12)
+
+
+def _add_values_commands(s, params):
+    x = params.add_parser("definitions", help="TC[20,6] where parameters live (all if none)")
+    x.add_argument("names", nargs="*")
+    x.set_defaults(func=_params_definitions)
+    x = params.add_parser("define", help="TC[20,4] place a parameter in a memory area")
+    x.add_argument("name")
+    x.add_argument("memory", type=int, help="memory ID (the database's memories)")
+    x.add_argument("address", type=int, help="absolute address (--object: offset in it)")
+    x.add_argument(
+        "--object", type=int, metavar="ID", help="TC[20,5]: in object ID (0: the whole area)"
+    )
+    x.set_defaults(func=_params_define)
+    fm = s.add_parser("fmon", help="service 12 functional monitoring").add_subparsers(dest="fm")
+    fm.required = True
+    x = fm.add_parser("add", help="TC[12,23] an FMON over PMONs (disabled)")
+    x.add_argument("fmon", type=int)
+    x.add_argument("pmons", type=int, nargs="+")
+    x.add_argument("--failing", type=int, default=1, help="minimum failing PMONs")
+    x.add_argument("--event", default="0", help="event raised when it fails")
+    x.set_defaults(func=_fmon_add)
+    fm.add_parser("list", help="TC[12,25]").set_defaults(func=_fmon_report, what="list")
+    fm.add_parser("status", help="TC[12,27]").set_defaults(func=_fmon_report, what="status")
+    for action in ("enable-function", "disable-function"):
+        fm.add_parser(action).set_defaults(func=_fmon_action, what=action)
+    for action in ("enable", "disable", "protect", "unprotect", "delete"):
+        x = fm.add_parser(action)
+        x.add_argument("ids", type=int, nargs="+")
+        x.set_defaults(func=_fmon_action, what=action)
+
+
+def _params_definitions(args):
+    return _run(args, lambda g: g.parameter_definitions([_key(n) for n in args.names]))
+
+
+def _params_define(args):
+    if args.object is None:
+        item = (_key(args.name), args.memory, args.address)
+    else:
+        item = (_key(args.name), args.memory, args.object, args.address)
+    return _run(args, lambda g: g.define_parameters([item], args.object is not None))
+
+
+def _fmon_add(args):
+    return _run(
+        args,
+        lambda g: g.add_functional_monitor(args.fmon, args.pmons, args.failing, _key(args.event)),
+    )
+
+
+def _fmon_report(args):
+    if args.what == "list":
+        return _run(args, lambda g: g.functional_monitors())
+    return _run(args, lambda g: g.functional_status())
+
+
+def _fmon_action(args):
+    return _run(args, lambda g: g.functional_request(args.what, getattr(args, "ids", ())))

@@ -1,7 +1,7 @@
 """`obsw obcp` (also `obsw ground obcp`): PLUTO OBCPs on board through PUS service 18.
 
     obsw obcp serve [--files DIR]           on-board process with service 18, the OBCP engine
-                                            and the solar panel (UDP 5000 + APID)
+                                            and the solar panel (UDP base + APID)
     obsw obcp load NAME FILE [--arg N=V]..  upload a procedure (TC[18,1]); --arg declares an
                                             argument with its default value (V: JSON or text,
                                             "30 deg" for a quantity)
@@ -25,6 +25,7 @@ import json
 import sys
 import threading
 
+from obsw_host import ids as mission_ids
 from obsw_host.net import DEFAULT_HOST
 
 _SIMPLE = {
@@ -55,7 +56,7 @@ def add_parser(sub):
 
 def add_to_ground(ground_actions):
     """``obsw ground obcp ...``: call with the ``ground`` command's subparsers (its client
-    options --sdb, --host, --port, --apid, --timeout, --json and -v are used)."""
+    options --mission, --sdb, --host, --port, --apid, --timeout, --json and -v are used)."""
     p = ground_actions.add_parser(
         "obcp", help="service 18 OBCPs", description=__doc__, formatter_class=_raw()
     )
@@ -65,9 +66,9 @@ def add_to_ground(ground_actions):
 
 
 def add_client_options(p):
-    p.add_argument("--sdb", help="spacecraft database JSON (default: the sample database)")
+    mission_ids.add_arguments(p)
     p.add_argument("--host", default=DEFAULT_HOST, help="on-board host (default %(default)s)")
-    p.add_argument("--port", type=int, help="on-board UDP port (default 5000 + APID)")
+    p.add_argument("--port", type=int, help="on-board UDP port (default: the mission's)")
     p.add_argument("--apid", type=int, help="on-board APID (default: the database's 'pus')")
     p.add_argument("--timeout", type=float, default=2.0, help="seconds per request")
     p.add_argument("--json", action="store_true", help="print JSON for scripts")
@@ -128,24 +129,30 @@ def _raw():
     return argparse.RawDescriptionHelpFormatter
 
 
-def _sdb(args):
-    from obsw.pus import sdb as sdb_module
-
-    from obsw_host.sample import SDB_PATH
-
-    return sdb_module.load(args.sdb or SDB_PATH)
+def _port(args, ids, apid):
+    """``--port``, else the mission's UDP port of process ``apid``."""
+    if args.port is not None:
+        return args.port
+    return ids.ports.pus if apid == ids.apid("pus") else ids.ports.app(apid)
 
 
 def _client(args):
     from obsw_host.pus.ground import Ground
     from obsw_host.pus.obcp_ground import ObcpGround
-    from obsw_host.pus.onboard import port_for
 
-    sdb = _sdb(args)
-    apid = args.apid if args.apid is not None else sdb.apid("pus")
-    target = (args.host, args.port if args.port is not None else port_for(apid))
+    ids = mission_ids.from_args(args)
+    apid = args.apid if args.apid is not None else ids.pus_apid
+    target = (args.host, _port(args, ids, apid))
     log = (lambda s: print(s, file=sys.stderr)) if args.verbose else None
-    ground = Ground(sdb, apid=apid, target=target, timeout=args.timeout, log=log)
+    ground = Ground(
+        ids.sdb,
+        apid=apid,
+        target=target,
+        timeout=args.timeout,
+        log=log,
+        source_id=ids.source_id,
+        config=ids.pus_config,
+    )
     return ground, ObcpGround(ground)
 
 
@@ -310,9 +317,15 @@ def _listen(args):
 def _serve(args):
     from obsw_host.pus.obcp_onboard import onboard_with_obcp
 
-    sdb = _sdb(args)
+    ids = mission_ids.from_args(args)
+    apid = args.apid if args.apid is not None else ids.pus_apid
     onboard, engine = onboard_with_obcp(
-        sdb, files=args.files, apid=args.apid, host=args.host, port=args.port, period=args.period
+        ids.sdb,
+        files=args.files,
+        apid=apid,
+        host=args.host,
+        port=_port(args, ids, apid),
+        period=args.period,
     )
     onboard.start()  # bound (or OSError) before "serving" is printed
     print(

@@ -1,12 +1,13 @@
 """The frame processor process: two serial links to the COM module, UDP to the applications.
 
-Telecommand packets go to UDP port ``port_base + APID`` (5000 + APID by default), sent from
-the ``tm_port`` socket, so an application answering the sender reaches the TM input; telemetry
-packets sent to ``tm_port`` (4999) leave as TM frames on both links, on the VC of their APID
-(the real-time VC unless mapped). Each entry of ``vc_ports`` (VC ID -> UDP port) is one more
-input whose packets all go on that VC, unchanged: by default the playback VC of the plan on
-``tm_port + 1`` (5000 would collide with APID 0), where the PUS application process sends
-what service 15 retrieves from its packet stores.
+Telecommand packets go to UDP port ``port_base + APID`` (default: the base of
+``obsw_host.ports``), sent from the ``tm_port`` socket, so an application answering the sender
+reaches the TM input; telemetry packets sent to ``tm_port`` (default: the ports module's ``tm``,
+base - 1) leave as TM frames on both links, on the VC of their APID (the real-time VC unless
+mapped). Each entry of ``vc_ports`` (VC ID -> UDP port) is one more input whose packets all go
+on that VC, unchanged: by default the playback VC of the plan on ``tm_port + 1`` (the ports
+module's ``playback``), where the PUS application process sends what service 15 retrieves
+from its packet stores.
 
 TC security: with ``security`` (an ``obsw.frames.sdls.TcSecurity``, see
 ``obsw_host.frames.keys``) every TC frame is authenticated before FARM-1. A rejected frame is
@@ -29,8 +30,7 @@ from obsw.pus.services.s05_events import EventReporting
 
 from obsw_host.frames.links import SerialLink
 from obsw_host.net import DEFAULT_HOST
-
-DEFAULT_TM_PORT = 4999
+from obsw_host.ports import Ports
 
 
 def sdb_events(sdb):
@@ -64,8 +64,8 @@ class FrameProcessorHost:
         link_b,
         scid,
         host=DEFAULT_HOST,
-        port_base=5000,
-        tm_port=DEFAULT_TM_PORT,
+        port_base=None,
+        tm_port=None,
         essential_port=None,
         vc_ports=None,
         clock=time.monotonic,
@@ -80,7 +80,9 @@ class FrameProcessorHost:
             SerialLink(link) if isinstance(link, str) else link for link in (link_a, link_b)
         ]
         self.host = host
-        self.port_base = port_base
+        ports = Ports()
+        self.port_base = ports.base if port_base is None else port_base
+        tm_port = ports.tm if tm_port is None else tm_port
         self.essential_port = essential_port
         self.clock = clock
         self.essential = []

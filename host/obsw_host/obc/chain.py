@@ -22,8 +22,8 @@ import threading
 import time
 
 from obsw_host.frames.links import FdLink
+from obsw_host.ids import MissionIds
 
-SCID = 0x42
 SWITCH = """\
 // Switch CPDU lines through the nominal controller and confirm the new state.
 procedure
@@ -109,8 +109,12 @@ class Chain:
             "can": ["spacecan"],
             "frames": ["frames"],
         }
-        doc["pus"]["port"] = self.pus_port
-        doc["cfdp"]["port"] = self.cfdp_port
+        doc["ports"] = {  # free ports: several chains may run at once
+            "pus": self.pus_port,
+            "cfdp": self.cfdp_port,
+            "tm": self.tm_port,
+            "playback": self.playback_port,
+        }
         doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])
         doc["spacecan"].update(
             interface="hub",
@@ -123,8 +127,6 @@ class Chain:
         doc["frames"].update(
             uart_a=uart_a,
             uart_b=uart_b,
-            scid=SCID,
-            tm_port=self.tm_port,
             clcw_period=0.2,
             keys=self.sim.key_file,  # the mission's TC keys: the OBC's and the module's
         )
@@ -150,7 +152,7 @@ class Chain:
         from obsw_host.reconfig.sim import ReconfigSim
 
         os.makedirs(self.state, exist_ok=True)
-        self.pus_port, self.cfdp_port, self.tm_port = _free_ports(3)
+        self.pus_port, self.cfdp_port, self.tm_port, self.playback_port = _free_ports(4)
         ends = [self._pty(), self._pty()]
         self.uart_paths = [path for _, path in ends]
         self.links = [FdLink(ends[0][0], "A"), FdLink(ends[1][0], "B")]
@@ -158,8 +160,15 @@ class Chain:
         os.makedirs(sim_dir, exist_ok=True)
         self.sim = ReconfigSim(sim_dir, obc_command=self._obc_command, out=self.out)
         security, state = keys.load(self.sim.key_file, os.path.join(self.work, "station.state"))
+        self.ids = MissionIds.sample()  # the sample's, as write_config gives the OBC
         self.station = _station_class()(
-            self.links, SCID, tm_frame_length=256, security=security, state=state
+            self.links,
+            self.ids.scid,
+            vcid=self.ids.tc_vc,
+            map_id=self.ids.maps["packets"],
+            tm_frame_length=256,
+            security=security,
+            state=state,
         )
         self._thread = threading.Thread(target=self.station.run, args=(self._stop,), daemon=True)
         self._thread.start()

@@ -11,7 +11,7 @@ PUS = {
     "follow_period": 0.25,  # seconds between looks for components that (re)appeared
     "time_code": "cuc",  # ST[09] time reports: "cuc" (TM[9,2]) or "cds" (TM[9,3])
 }
-CFDP = {"port": 5100, "peers": {}}
+CFDP = {"peers": {}}  # ports and ids: obsw_host.ports and obsw_host.ids (the mission's)
 OBCP = {"timeout": 2.0, "activity_timeout": 30.0, "level": 2, "step_period": 0.01}
 SPACECAN = {
     "interface": "virtual",
@@ -24,9 +24,6 @@ SPACECAN = {
 FRAMES = {
     "uart_a": "pty",
     "uart_b": "pty",
-    "scid": 0x42,
-    "tm_port": 4999,
-    "playback_vc": 1,
     "tm_frame_length": 256,
     "clcw_period": 0.5,
     "uart_queue": 64,  # frames waiting for a UART; beyond, the oldest is dropped (counted)

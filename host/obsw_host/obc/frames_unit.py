@@ -71,10 +71,8 @@ class FramesUnit:
                 path = config.resolve(dev) if dev.startswith(".") else dev
                 links.append(SerialLink(path, queue=queue))
                 self.paths[side] = dev
-        apid = topology.pus_apid()
-        port = topology.pus_port()
-        tm_port = int(opts["tm_port"])
-        plan = sdb.tm_vcs
+        ids = topology.ids
+        ports = ids.ports
         security = {}
         if opts.get("keys"):  # TC frames authenticated (SDLS) with this key file
             state = os.path.join(config.state, "frames.keys.state")
@@ -82,12 +80,15 @@ class FramesUnit:
         self.fp = FrameProcessorHost(
             links[0],
             links[1],
-            int(opts["scid"]),
+            ids.scid,
             host=config.host,
-            port_base=port - apid,
-            tm_port=tm_port,
-            vc_ports={int(opts["playback_vc"]): tm_port + 1},
-            tm_plan=plan,
+            port_base=ports.pus - ids.pus_apid,
+            tm_port=ports.tm,
+            vc_ports={ids.playback_vc: ports.playback},
+            tm_plan=ids.tm_vcs,
+            tm_channels=ids.tm_channels(),
+            tm_vc_of_apid=ids.tm_vc_of_apid(),
+            tc_vcids=(ids.tc_vc,),
             tm_frame_length=int(opts["tm_frame_length"]),
             clcw_period=float(opts["clcw_period"]),
             **security,

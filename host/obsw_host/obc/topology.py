@@ -16,6 +16,7 @@ import os
 
 from obsw.il.interface import DATA, Attribute, Interface, Operation
 
+from obsw_host.ids import MissionIds
 from obsw_host.obc import defaults, plugins
 from obsw_host.obc.config import ConfigError
 from obsw_host.obc.registry import WITH_PUS
@@ -83,6 +84,7 @@ class Topology:
     def __init__(self, config, sdb=None):
         self.config = config
         self._sdb = sdb
+        self._ids = None
         self._equipments = None
         self.components = plugins.components(config)
         self.processes = [
@@ -135,15 +137,18 @@ class Topology:
             self._sdb = load_sdb(self.config.sdb_path)
         return self._sdb
 
+    @property
+    def ids(self):
+        """Every id and port of the mission (``obsw_host.ids.MissionIds``), read once."""
+        if self._ids is None:
+            self._ids = MissionIds(self.sdb, self.config.sdb_path, self.config)
+        return self._ids
+
     def pus_apid(self):
-        apid = self.config.section("pus").get("apid")
-        return int(apid) if apid is not None else self.sdb.apid("pus")
+        return self.ids.pus_apid
 
     def pus_port(self):
-        from obsw_host.pus.onboard import port_for
-
-        port = self.config.section("pus").get("port")
-        return int(port) if port is not None else port_for(self.pus_apid())
+        return self.ids.ports.pus
 
     def equipments(self):
         """The SpaceCAN equipment: the mission's ``spacecan.nodes`` if it lists any, else the

@@ -98,13 +98,12 @@ class PusUnit:
         opts = topology.section("pus")
         self.components = [c.build() for c in process.components]
         self.interfaces = topology.interfaces()
+        self.ids = ids = topology.ids
         playback_to = None
         tm_to = None
         if topology.runs("frames"):
-            f = topology.section("frames")
-            tm_port = int(f["tm_port"])
-            tm_to = (config.host, tm_port)
-            playback_to = {int(f["playback_vc"]): (config.host, tm_port + 1)}
+            tm_to = (config.host, ids.ports.tm)
+            playback_to = {ids.playback_vc: (config.host, ids.ports.playback)}
         if opts.get("tm_to"):  # a fixed ground address besides the last TC's sender
             host, port = str(opts["tm_to"]).rsplit(":", 1)
             tm_to = (host, int(port))
@@ -123,9 +122,10 @@ class PusUnit:
         self.onboard = Onboard(
             sdb,
             node=self.node,
-            apid=topology.pus_apid(),
+            apid=ids.pus_apid,
             host=config.host,
-            port=topology.pus_port(),
+            port=ids.ports.pus,
+            config=ids.pus_config,
             period=float(opts["period"]),
             store=Store(os.path.join(config.state, "context")),
             tm_to=tm_to,
@@ -148,15 +148,22 @@ class PusUnit:
 
         from obsw_host.cfdp.link import UdpEntity, make_entity
 
-        sdb = self.sdb
-        local = sdb.filestore_entity(sdb.local_filestore)
+        ids = self.ids
+        local, ground = ids.cfdp_entities
         peers = {}
         for eid, address in opts["peers"].items():
             host, port = address.rsplit(":", 1)
             peers[int(eid)] = (host, int(port))
+        if not peers:  # the ground entity of the filestores, on its port of the mission
+            peers[ground] = (self.config.host, ids.ports.cfdp_ground)
         entity = make_entity(local, list(peers), self.files)
-        self.cfdp = UdpEntity(entity, (self.config.host, int(opts["port"])), peers)
-        self.cfdp.packet_type = TYPE_TM
+        self.cfdp = UdpEntity(
+            entity,
+            (self.config.host, ids.ports.cfdp),
+            peers,
+            apid=ids.apid("cfdp"),
+            packet_type=TYPE_TM,
+        )
         self.copy = RemoteCopy(entity)
         self.node.provide(REMOTE_COPY, self.copy)
         self.cfdp.on_indication = self.copy.indication

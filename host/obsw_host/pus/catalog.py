@@ -28,9 +28,29 @@ def parameters(sdb):
                 "type": _type(p.type_spec),
                 "unit": p.unit or "",
                 "writable": "yes" if p.writable else "no",
+                "range": _bounds(p.values.range if p.values else None),
+                "values": _conversion(p.values),
             }
         )
     return out
+
+
+def _bounds(pair):
+    if pair is None:
+        return ""
+    return "[%s, %s]" % tuple("" if x is None else x for x in pair)
+
+
+def _conversion(values):
+    """How raw values become engineering ones: calibrated, labels, or nothing."""
+    if values is None:
+        return ""
+    if values.labels:
+        return ", ".join("%d=%s" % kv for kv in sorted(values.labels.items()))
+    cal = values.calibration
+    if cal is None:
+        return ""
+    return "polynomial" if hasattr(cal, "coefficients") else "point pairs"
 
 
 def function_rows(sdb):

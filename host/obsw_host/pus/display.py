@@ -141,13 +141,24 @@ class Picture:
                 self.update(name, value, when)
 
     def update(self, name, value, when=""):
+        """The value of parameter ``name`` as reported (raw); kept in engineering units, the
+        limit state from the engineering value (the database's limits are in them)."""
         p = parameter_of(self.sdb, name)
-        self.values[str(name)] = {
-            "value": text.plain(value),
+        eng = value
+        if p is not None:
+            try:
+                eng = text.engineering(self.sdb, name, value)
+            except (ValueError, TypeError):
+                eng = value
+        row = {
+            "value": text.plain(eng),
             "unit": (p.unit or "") if p is not None else "",
-            "limit": limit_state(p, value),
+            "limit": limit_state(p, eng),
             "time": when,
         }
+        if eng != value:
+            row["raw"] = text.plain(value)
+        self.values[str(name)] = row
 
     def _event(self, ev, when):
         data = ev.get("data")
@@ -227,13 +238,13 @@ def _request_detail(tc, sdb):
     return tc.data.hex()
 
 
-def _limit_text(sdb, pid, value):
-    p = parameter_of(sdb, pid)
-    unit = (" " + p.unit) if p is not None and p.unit else ""
-    return "%s%s" % (number(value), unit)
+def _limit_text(sdb, pid, value, raw=False):
+    """A raw value of parameter ``pid`` in engineering units (``raw``: as it is), with its
+    unit."""
+    return text.value_text(sdb, pid, value, raw).split(" (raw")[0]
 
 
-def named_row(row, sdb=None):
+def named_row(row, sdb=None, raw=False):
     """One row of a report (monitoring definitions, out-of-limits, event-actions, ..) with its
     ids, codes and times by name: parameters, events, check types and states, UTC times,
     decoded TCs, values with units."""
@@ -259,7 +270,7 @@ def named_row(row, sdb=None):
         elif key in ("value", "limit", "low", "high", "expected") and isinstance(
             value, (int, float)
         ):
-            value = _limit_text(sdb, pid, value)
+            value = _limit_text(sdb, pid, value, raw)
         elif key == "type" and isinstance(value, list) and len(value) == 2:
             continue  # the type of the embedded request: its text says it
         elif isinstance(value, bool):
@@ -290,15 +301,17 @@ def _rows(items):
     return isinstance(items, list) and items and all(isinstance(x, dict) for x in items)
 
 
-def readable(value, sdb=None):
+def readable(value, sdb=None, raw=False):
     """A reply as an operator reads it: lists of items as tables of rows by name (see
     ``named_row``), statistics per parameter, a directory listing as a table, found paths one a
-    line, times in UTC; else ``text.readable``."""
+    line, times in UTC (``raw``: raw values, not engineering); else ``text.readable``."""
     v = text.plain(value)
     if not isinstance(v, dict):
-        return text.readable(value, sdb)
+        return text.readable(value, sdb, raw)
     if "repository" in v and ("files" in v or "objects" in v):
         return _files(v)
+    if set(v) in ({"functional"}, {"definitions"}):  # service 12's own tables (text)
+        return text.readable(value, sdb, raw)
     if isinstance(v.get("paths"), list):
         return "\n".join(v["paths"]) or "(nothing found)"
     if isinstance(v.get("statistics"), dict):
@@ -309,7 +322,7 @@ def readable(value, sdb=None):
                 if _is_time(k):
                     row[k + " (UTC)"] = utc(x) or "-"
                 else:
-                    row[k] = number(x) if k == "samples" else _limit_text(sdb, name, x)
+                    row[k] = number(x) if k == "samples" else _limit_text(sdb, name, x, raw)
             rows.append(row)
         head = "from %s to %s" % (utc(v.get("start")) or "-", utc(v.get("end")) or "-")
         return head + "\n" + (table(rows) if rows else "(no statistics)")
@@ -320,7 +333,7 @@ def readable(value, sdb=None):
             if k not in lists and not isinstance(x, (list, dict)):
                 parts.append("%s: %s" % (k, utc(x) if _is_time(k) else x))
         for k in lists:
-            parts.append(table([_timed(named_row(x, sdb)) for x in v[k]]))
+            parts.append(table([_timed(named_row(x, sdb, raw)) for x in v[k]]))
         return "\n".join(parts)
     if isinstance(v.get("obcps"), list):
         return "(no OBCPs)"
@@ -328,7 +341,7 @@ def readable(value, sdb=None):
         return "\n".join(
             "%s: %s" % (k, (utc(x) or "-") if _is_time(k) else _cell(x)) for k, x in v.items()
         )
-    return text.readable(value, sdb)
+    return text.readable(value, sdb, raw)
 
 
 def _timed(row):

@@ -1,7 +1,7 @@
 """The ground application process on the host: service users over UDP, and a scripting API.
 
     from obsw_host.pus.ground import Ground
-    with Ground(sdb) as ground:               # talks to 127.0.0.1:5000 + the sdb's 'pus' APID
+    with Ground(sdb) as ground:               # talks to 127.0.0.1:base + the sdb's 'pus' APID
         tx = ground.ping()                    # a Transaction: tx.ok, tx.reply, tx.verification()
         hk = ground.housekeeping(1)           # {'sid': 1, 'values': {'SolarPanel.angle': 0.0, ..}}
         ground.set_parameter("SolarPanel.speed", 7.5)
@@ -25,12 +25,14 @@ import select
 import socket
 
 from obsw.il.clock import REAL_CLOCK
+from obsw.pus.config import DEFAULT, from_sdb
 from obsw.pus.services.s03_housekeeping import HousekeepingUser
 from obsw.pus.services.s05_events import EventUser
 from obsw.pus.services.s08_functions import FunctionUser, functions
 from obsw.pus.services.s09_time import TimeUser
 from obsw.pus.services.s11_scheduling import TimeSchedulingUser
-from obsw.pus.services.s12_user import OnBoardMonitoringUser, limit_check
+from obsw.pus.services.s12_functional_user import FunctionalMonitoringUser, functional_check
+from obsw.pus.services.s12_user import limit_check
 from obsw.pus.services.s17_test import ServiceTestUser
 from obsw.pus.services.s19_event_action import EventActionUser
 from obsw.pus.services.s20_parameters import ParameterUser
@@ -38,9 +40,11 @@ from obsw.pus.services.s21_sequencing import RequestSequencingUser
 from obsw.pus.services.s22_position_scheduling import PositionSchedulingUser
 from obsw.pus.user import UserProcess
 
+from obsw_host.ids import MissionIds
 from obsw_host.net import DEFAULT_HOST
+from obsw_host.ports import app_port
 from obsw_host.pus import text
-from obsw_host.pus.onboard import port_for, tai_now
+from obsw_host.pus.onboard import tai_now
 from obsw_host.pus.tm_fanout import SUBSCRIBE, UNSUBSCRIBE
 
 
@@ -69,18 +73,26 @@ class Ground:
         source_id=None,
         log=None,
         session=None,
+        config=None,
     ):
         self.sdb = sdb
         self.session = session  # a SessionLog, or None
-        self.apid = apid if apid is not None else (sdb.apid("pus") if sdb else 10)
-        self.target = target or (host, port_for(self.apid))
+        if apid is None and sdb is None:
+            raise ValueError("Ground: give a spacecraft database or the on-board APID")
+        self.apid = apid if apid is not None else sdb.apid("pus")
+        self.target = target or (host, app_port(self.apid))
         self.timeout = timeout
         self.log = log  # callable(str) shown every packet, or None
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind((self.target[0], 0))
-        if source_id is None:
-            source_id = sdb.apids.get("ground", 0) if sdb else 0
-        self.proc = UserProcess(self._send, REAL_CLOCK, source_id=source_id)
+        if source_id is None:  # the database's (pus.source_id or apids.ground), else 0; the
+            # ground tools pass MissionIds.source_id, which refuses a database without one
+            ids = MissionIds(sdb, None) if sdb is not None else None
+            source_id = ids.source_id if ids is not None and ids.has_source_id() else 0
+        if config is None:  # the database's packet layout
+            config = from_sdb(sdb) if sdb is not None else DEFAULT
+        self.config = config
+        self.proc = UserProcess(self._send, REAL_CLOCK, source_id=source_id, config=config)
         self.proc.listeners.append(self._show)
         self.received = []  # (tm, decoded) of TM no request asked for (events, periodic HK)
         self.keep_unsolicited = 1000
@@ -97,9 +109,9 @@ class Ground:
             ids = lambda key: sdb.parameter(key).id  # noqa: E731
             self.hk = reg(HousekeepingUser(types, names, sdb.housekeeping))
             self.events = reg(EventUser(sdb.event))
-            self.params = reg(ParameterUser(types, names, ids))
+            self.params = reg(ParameterUser(types, names, ids, sdb.parameter))
             self.functions = reg(FunctionUser(functions(sdb)))
-            self.monitoring = reg(OnBoardMonitoringUser(types, ids))
+            self.monitoring = reg(FunctionalMonitoringUser(types, ids))
         else:
             self.hk = self.events = self.params = self.functions = self.monitoring = None
 
@@ -110,7 +122,7 @@ class Ground:
         if self.session is not None:
             from obsw.pus.tc import PusTc
 
-            self.session.write("TC", raw, line=text.tc_line(PusTc.unpack(raw)))
+            self.session.write("TC", raw, line=text.tc_line(PusTc.unpack(raw, self.config)))
 
     def subscribe(self):
         """Ask the on-board process for its TM without sending a TC (repeat within its
@@ -218,12 +230,14 @@ class Ground:
         """TC[20,1]; ``tx.reply['values']`` maps names to values."""
         return self._issue(self.params.report(self._apid(apid), keys), timeout)
 
-    def set_parameter(self, key, value, apid=None, timeout=None):
+    def set_parameter(self, key, value, apid=None, timeout=None, raw=False):
         """TC[20,3] for one parameter (name or ID)."""
-        return self.set_parameters({key: value}, apid, timeout)
+        return self.set_parameters({key: value}, apid, timeout, raw)
 
-    def set_parameters(self, values, apid=None, timeout=None):
-        return self._issue(self.params.set(self._apid(apid), values), timeout)
+    def set_parameters(self, values, apid=None, timeout=None, raw=False):
+        """TC[20,3]: engineering values (labels, calibrated numbers; ``raw``: raw values),
+        refused here (``RangeError``) when outside a parameter's range."""
+        return self._issue(self.params.set(self._apid(apid), values, raw), timeout)
 
     def _event_ids(self, keys):
         return [self.sdb.event(k).id for k in keys]
@@ -255,7 +269,7 @@ class Ground:
 
     def parameter_request(self, values, apid=None):
         """A TC[20,3] for on-board use (see ``request``)."""
-        items = [{"id": self.sdb.parameter(k).id, "value": v} for k, v in values.items()]
+        items = self.params.raw_items(values)
         return self.request(20, 3, self.params.layout.pack({"items": items}), apid)
 
     def perform(self, key, apid=None, timeout=None, **arguments):
@@ -317,18 +331,17 @@ class Ground:
         high_event=0,
         apid=None,
         timeout=None,
+        raw=False,
         **options,
     ):
-        """TC[12,5] for one limit check (events by name or ID; 0: none), then TC[12,1]."""
-        d = limit_check(
-            pmon,
-            parameter,
-            low,
-            high,
-            self._event_id(low_event),
-            self._event_id(high_event),
-            **options,
-        )
+        """TC[12,5] for one limit check (events by name or ID; 0: none), then TC[12,1].
+        ``low`` and ``high`` are engineering values (``raw``: raw ones), sent as raw limits
+        (``obsw.pus.calibration.Values.raw_limits``)."""
+        low_event, high_event = self._event_id(low_event), self._event_id(high_event)
+        low, high, swapped = self.sdb.parameter(parameter).raw_limits(low, high, raw)
+        if swapped:  # a falling calibration: the low raw limit is the high engineering one
+            low_event, high_event = high_event, low_event
+        d = limit_check(pmon, parameter, low, high, low_event, high_event, **options)
         tx = self._issue(self.monitoring.add(self._apid(apid), [d]), timeout)
         if not tx.ok:
             return tx
@@ -354,6 +367,46 @@ class Ground:
     def out_of_limits(self, apid=None, timeout=None):
         """TC[12,10]; ``tx.reply['items']`` are the parameters now out of limits."""
         return self._issue(self.monitoring.report_out_of_limits(self._apid(apid)), timeout)
+
+    # -------------------------------------------------------------------------- functional
+
+    def add_functional_monitor(self, fmon, pmons, failing=1, event=0, apid=None, timeout=None):
+        """TC[12,23]: FMON ``fmon`` fails when ``failing`` of ``pmons`` are out of limits and
+        raises ``event`` (name or ID); new FMONs are disabled."""
+        d = functional_check(fmon, pmons, failing, self._event_id(event))
+        return self._issue(self.monitoring.add_functional(self._apid(apid), [d]), timeout)
+
+    def functional_monitors(self, apid=None, timeout=None, ids=()):
+        """TC[12,25]; ``tx.reply['functional']`` are the FMON definitions (all if no ids)."""
+        return self._issue(self.monitoring.report_functional(self._apid(apid), ids), timeout)
+
+    def functional_status(self, apid=None, timeout=None):
+        """TC[12,27]; ``tx.reply['functional']`` gives each FMON's statuses."""
+        return self._issue(self.monitoring.report_functional_status(self._apid(apid)), timeout)
+
+    def functional_request(self, action, ids=(), apid=None, timeout=None):
+        """TC[12,17]-[12,24] by name: enable-function, disable-function (no IDs), enable,
+        disable, protect, unprotect, delete (FMON IDs)."""
+        user = self.monitoring
+        a = self._apid(apid)
+        if action in ("enable-function", "disable-function"):
+            fn = getattr(user, action.replace("-function", "") + "_functional_function")
+            return self._issue(fn(a), timeout)
+        fn = getattr(user, action + "_functional", None)
+        if fn is None or action in ("add", "report"):
+            raise ValueError("functional monitoring action %r unknown" % action)
+        return self._issue(fn(a, list(ids)), timeout)
+
+    def parameter_definitions(self, keys=(), apid=None, timeout=None):
+        """TC[20,6]; ``tx.reply['definitions']`` says where each parameter lives."""
+        return self._issue(self.params.report_definitions(self._apid(apid), keys), timeout)
+
+    def define_parameters(self, items, object_memory=False, apid=None, timeout=None):
+        """TC[20,4]: ``items`` are (parameter, memory ID, absolute address); or TC[20,5]
+        (``object_memory``): (parameter, memory ID, object ID, offset in the object)."""
+        user = self.params
+        fn = user.change_object_definitions if object_memory else user.change_raw_definitions
+        return self._issue(fn(self._apid(apid), items), timeout)
 
     def _event_id(self, key):
         return key if isinstance(key, int) else self.sdb.event(key).id

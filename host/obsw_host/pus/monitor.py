@@ -27,9 +27,10 @@ def utc_now():
 class Display:
     """One line per packet for an operator (see the module text)."""
 
-    def __init__(self, sdb=None, colour=False):
+    def __init__(self, sdb=None, colour=False, raw=False):
         self.sdb = sdb
         self.colour = colour
+        self.raw = raw  # raw parameter values instead of engineering ones
         self.sent = {}  # (apid, seq) -> TC this ground sent, to name verification reports
 
     def _paint(self, line, kind):
@@ -99,19 +100,13 @@ class Display:
             body += ": data " + bytes(data).hex()
         return body, ev["severity"]
 
-    def unit(self, name):
-        if self.sdb is None:
-            return ""
-        try:
-            unit = self.sdb.parameter(name).unit
-        except (KeyError, ValueError, TypeError):
-            return ""
-        return (" " + unit) if unit else ""
-
     def values(self, decoded):
         """``name=value unit, ..`` for reports of parameter values, else the text summary."""
         if isinstance(decoded, dict) and isinstance(decoded.get("values"), dict):
-            parts = ["%s=%s%s" % (k, _num(v), self.unit(k)) for k, v in decoded["values"].items()]
+            parts = [
+                "%s=%s" % (k, text.value_text(self.sdb, k, v, self.raw))
+                for k, v in decoded["values"].items()
+            ]
             if "sid" in decoded:
                 parts.insert(0, "structure %s" % decoded["sid"])
             return ", ".join(parts)

@@ -1,4 +1,4 @@
-"""The on-board PUS process on the host: the core application process on UDP 5000 + APID.
+"""The on-board PUS process on the host: the core application process on UDP base + APID.
 
 ``Onboard(sdb)`` builds the application process with the services of ``SERVICES`` (the one
 service table of the PUS process) whose needs are met: 1, 3, 5, 8, 9, 11, 12, 17, 19, 20, 21,
@@ -16,13 +16,13 @@ calling thread until stopped (``obsw obc serve``).
 """
 
 import asyncio
-import os
 import threading
 import time
 
 from obsw.il.clock import REAL_CLOCK
 from obsw.il.node import Node
-from obsw.pus.app import EVENT_CYCLE_OVERRUN, ApplicationProcess
+from obsw.pus.app import ApplicationProcess
+from obsw.pus.config import from_sdb
 from obsw.pus.events import EventManager
 from obsw.pus.parameters import ParameterPool
 from obsw.pus.services.s02_device_access import DeviceAccess
@@ -33,7 +33,7 @@ from obsw.pus.services.s06_memory import MemoryManagement, areas_from_sdb
 from obsw.pus.services.s08_functions import FunctionManagement, functions
 from obsw.pus.services.s09_time import TimeManagement
 from obsw.pus.services.s11_scheduling import TimeScheduling
-from obsw.pus.services.s12_monitoring import OnBoardMonitoring
+from obsw.pus.services.s12_functional import FunctionalOnBoardMonitoring
 from obsw.pus.services.s13_large_packets import LargePacketTransfer
 from obsw.pus.services.s14_forwarding import ForwardingControl
 from obsw.pus.services.s15_storage import Storage
@@ -45,22 +45,24 @@ from obsw.pus.services.s21_sequencing import RequestSequencing
 from obsw.pus.services.s22_position_scheduling import PositionScheduling
 from obsw.pus.services.s23_files import FileManagement
 
+from obsw_host.ids import EVENT_COPY_COMPLETED, EVENT_COPY_FAILED, EVENT_OVERRUN, event_id
 from obsw_host.net import DEFAULT_HOST
+from obsw_host.ports import app_port
 from obsw_host.pus.tm_fanout import TmFanout
 from obsw_host.pus.tm_log import TmLog
 
-PORT_BASE = int(os.environ.get("OBSW_PORT_BASE", "5000"))  # another base for a second system
 TAI_MINUS_UNIX = 378691200 + 37  # seconds from 1958-01-01 TAI to 1970-01-01 UTC, now
-
-
-def port_for(apid):
-    """The UDP port of an application process: 5000 + APID."""
-    return PORT_BASE + apid
 
 
 def tai_now():
     """On-board time: TAI seconds since 1958-01-01 from the host clock."""
     return time.time() + TAI_MINUS_UNIX
+
+
+def copy_events(sdb):
+    """Service 23's copy events by name in the database (None: it declares them not)."""
+    ids = (event_id(sdb, EVENT_COPY_COMPLETED), event_id(sdb, EVENT_COPY_FAILED))
+    return None if None in ids else ids
 
 
 class ServiceContext:
@@ -96,7 +98,7 @@ SERVICES = (
     (20, (), lambda c: ParameterManagement(c.pool)),
     (8, (), lambda c: FunctionManagement(functions(c.sdb), c.node)),
     (11, (), lambda c: TimeScheduling()),
-    (12, (), lambda c: OnBoardMonitoring(c.pool, c.sdb.events)),
+    (12, (), lambda c: FunctionalOnBoardMonitoring(c.pool, c.sdb.events)),  # types 1-28
     (19, (), lambda c: EventAction(known=c.sdb.events)),
     (21, (), lambda c: RequestSequencing()),
     (22, ("position",), lambda c: PositionScheduling(c.pool, c.position.qualified)),
@@ -125,7 +127,12 @@ SERVICES = (
         23,
         ("files",),
         lambda c: FileManagement(
-            c.files, c.sdb.filestores, c.sdb.local_filestore, c.node, poll_every=4
+            c.files,
+            c.sdb.filestores,
+            c.sdb.local_filestore,
+            c.node,
+            poll_every=4,
+            events=copy_events(c.sdb),
         ),
     ),  # fmt: skip
 )
@@ -165,11 +172,12 @@ class Onboard:
         time_exponent=None,
         time_code="cuc",
         context=None,
+        config=None,
     ):
         self.sdb = sdb
         self.apid = apid if apid is not None else sdb.apid("pus")
         self.host = host
-        self.port = port_for(self.apid) if port is None else port
+        self.port = app_port(self.apid) if port is None else port
         self.period = period
         self.tm_to = tm_to
         self.playback_to = dict(playback_to or {})
@@ -184,11 +192,7 @@ class Onboard:
         self._stopping = None
         self._ready = threading.Event()
         self._error = None
-        overrun = EVENT_CYCLE_OVERRUN
-        try:
-            overrun = sdb.event("pus.cycle_overrun").id
-        except KeyError:
-            pass
+        overrun = event_id(sdb, EVENT_OVERRUN)  # None: the database declares none
         self.app = ApplicationProcess(
             self.apid,
             self._send,
@@ -199,6 +203,7 @@ class Onboard:
             max_tasks=max_tasks,
             task_timeout=10.0,
             overrun_event=overrun,
+            config=config if config is not None else from_sdb(sdb),
         )
         self.tasks = []  # more coroutine functions to run on the process's loop
         self.providers = [self.node.provide(itf, impl) for itf, impl in components]
@@ -225,6 +230,9 @@ class Onboard:
                 continue
             if all(getattr(context, n, None) is not None for n in needs):
                 self.app.register(build(context))
+        memory, parameters = self.app.services.get(6), self.app.services.get(20)
+        if memory is not None and parameters is not None:
+            parameters.use_memories(memory.areas)  # service 20 places parameters in them
 
     def _own_parameters(self):
         counters = self.app.counters

@@ -17,7 +17,7 @@ entity, until the completion report, a failure report or the timeout.
 
 import time
 
-from obsw.frames.tm_plan import PLAYBACK_VCID
+from obsw.frames.tm_plan import tm_plan
 from obsw.pus.services.s02_device_access import DeviceUser
 from obsw.pus.services.s04_statistics import StatisticsUser
 from obsw.pus.services.s06_memory import MemoryUser
@@ -84,9 +84,13 @@ class StorageGround:
 
     # -------------------------------------------------------------------------- ST[15]
 
-    def create_store(self, store, size, kind=0, vc=PLAYBACK_VCID):
+    def create_store(self, store, size, kind=0, vc=None):
         """TC[15,20]: a circular (``kind`` 0) or bounded (1) store of ``size`` bytes whose
-        retrievals go down on virtual channel ``vc`` (the playback VC unless told)."""
+        retrievals go down on virtual channel ``vc`` (the mission's playback VC unless told:
+        the database's ``frames.tm_vcs.playback``)."""
+        if vc is None:
+            sdb = self.ground.sdb
+            vc = tm_plan(sdb.tm_vcs if sdb is not None else None)["playback"]
         return self.issue(
             self.storage.create(
                 self.apid, [{"store": store, "size": size, "kind": kind, "vc": vc}]

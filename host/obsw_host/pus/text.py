@@ -1,5 +1,11 @@
-"""One readable line per PUS packet, and JSON-able forms of decoded values."""
+"""One readable line per PUS packet, and JSON-able forms of decoded values.
 
+Parameter values travel raw (the database's ``type``); what operators read is the engineering
+value in its ``unit`` (calibrated, or the enumeration's label), with the raw value beside it
+when the two differ: ``Coil.temp = 20 degC (raw 1400)``. ``raw=True`` shows raw values only.
+"""
+
+from obsw.pus.calibration import CalibrationError
 from obsw.pus.packets import RequestId
 from obsw.pus.services.s01_verification import describe
 
@@ -57,6 +63,10 @@ NAMES = {
     (20, 1): "report parameter values",
     (20, 2): "parameter value report",
     (20, 3): "set parameter values",
+    (20, 4): "change raw memory parameter definitions",
+    (20, 5): "change object memory parameter definitions",
+    (20, 6): "report parameter definitions",
+    (20, 7): "parameter definition report",
     (8, 1): "perform function",
     (11, 1): "enable time-based schedule",
     (11, 2): "disable time-based schedule",
@@ -101,6 +111,18 @@ NAMES = {
     (12, 14): "monitoring status report",
     (12, 15): "enable parameter monitoring function",
     (12, 16): "disable parameter monitoring function",
+    (12, 17): "enable functional monitoring function",
+    (12, 18): "disable functional monitoring function",
+    (12, 19): "enable functional monitoring",
+    (12, 20): "disable functional monitoring",
+    (12, 21): "protect functional monitoring",
+    (12, 22): "unprotect functional monitoring",
+    (12, 23): "add functional monitoring",
+    (12, 24): "delete functional monitoring",
+    (12, 25): "report functional monitoring",
+    (12, 26): "functional monitoring report",
+    (12, 27): "report functional monitoring status",
+    (12, 28): "functional monitoring status report",
     (19, 1): "add event-actions",
     (19, 2): "delete event-actions",
     (19, 3): "delete all event-actions",
@@ -276,8 +298,82 @@ def _event_name(sdb, eid):
         return str(eid)
 
 
-def readable(value, sdb=None):
-    """A reply as an operator reads it: names, units, UTC times, tables for lists."""
+def _number(x):
+    return "%.6g" % x if isinstance(x, float) else str(x)
+
+
+def _parameter(sdb, key):
+    if sdb is None:
+        return None
+    try:
+        return sdb.parameter(key)
+    except (KeyError, ValueError):
+        return None
+
+
+def value_text(sdb, key, raw_value, raw=False):
+    """A parameter's value as an operator reads it: engineering value and unit, the raw value
+    in parentheses when it differs (``raw``: the raw value and its raw unit only)."""
+    p = _parameter(sdb, key)
+    if p is None:
+        return _number(raw_value)
+    if raw:
+        return _number(raw_value) + (" " + p.raw_unit if p.raw_unit else "")
+    try:
+        eng = p.engineering(raw_value)
+    except (CalibrationError, TypeError):
+        return "%s (raw, outside the calibration)" % _number(raw_value)
+    unit = p.unit if p.unit and not isinstance(eng, str) else ""
+    text = _number(eng) + (" " + unit if unit else "")
+    if eng != raw_value or isinstance(eng, str):
+        text += " (raw %s)" % _number(raw_value)
+    return text
+
+
+def engineering(sdb, key, raw_value):
+    """The engineering value of ``raw_value`` of parameter ``key`` (raw if it has none)."""
+    p = _parameter(sdb, key)
+    if p is None:
+        return raw_value
+    try:
+        return p.engineering(raw_value)
+    except (CalibrationError, TypeError):
+        return raw_value
+
+
+_LIMIT_KEYS = ("low", "high", "value", "limit")
+
+
+_EVENT_KEYS = ("event", "low_event", "high_event")
+_PARAMETER_KEYS = ("parameter", "validity")
+
+
+def _engineering_row(row, sdb, raw):
+    """A service 12 row as operators read it: event and parameter names instead of IDs, a
+    limit check's limits and values in engineering units (``raw``: left as they are)."""
+    if raw or sdb is None:
+        return row
+    out = dict(row)
+    if row.get("check") == 1 and "parameter" in row:
+        for k in _LIMIT_KEYS:
+            x = out.get(k)
+            if isinstance(x, (int, float)) and not isinstance(x, bool):
+                out[k] = value_text(sdb, row["parameter"], x).split(" (raw")[0]
+    for k in _EVENT_KEYS:
+        if out.get(k):
+            out[k] = _event_name(sdb, out[k])
+    for k in _PARAMETER_KEYS:
+        if k == "validity" and not row.get("validity_mask"):
+            continue
+        p = _parameter(sdb, out.get(k)) if isinstance(out.get(k), int) else None
+        if p is not None:
+            out[k] = p.qualified
+    return out
+
+
+def readable(value, sdb=None, raw=False):
+    """A reply as an operator reads it: names, engineering values with units (``raw``: raw
+    values), UTC times, tables for lists."""
     from obsw_host.pus.catalog import table
 
     v = plain(value)
@@ -288,23 +384,19 @@ def readable(value, sdb=None):
     if isinstance(v.get("values"), dict):
         lines = ["structure %s" % v["sid"]] if "sid" in v else []
         for k, x in v["values"].items():
-            unit = ""
-            if sdb is not None:
-                try:
-                    unit = sdb.parameter(k).unit or ""
-                except (KeyError, ValueError):
-                    pass
-            lines.append(
-                "%s = %s%s"
-                % (k, "%.6g" % x if isinstance(x, float) else x, (" " + unit) if unit else "")
-            )
+            lines.append("%s = %s" % (k, value_text(sdb, k, x, raw)))
         return "\n".join(lines)
+    for key in ("functional", "definitions"):
+        if set(v) == {key} and isinstance(v[key], list):
+            rows = [_engineering_row(r, sdb, raw) for r in v[key]]
+            return table([{k: _cell(x) for k, x in r.items()} for r in rows])
     if isinstance(v.get("activities"), list):
         return table([_activity(a) for a in v["activities"]])
     if set(v) == {"ids"} and isinstance(v["ids"], list):
         return "disabled events: " + (", ".join(_event_name(sdb, i) for i in v["ids"]) or "none")
     if set(v) <= {"items", "delay"} and isinstance(v.get("items"), list):
         rows = [x if isinstance(x, dict) else {"item": x} for x in v["items"]]
+        rows = [_engineering_row(r, sdb, raw) for r in rows]
         return table([{k: _cell(x) for k, x in r.items()} for r in rows])
     return json_text(v)
 
@@ -335,4 +427,8 @@ def failure_detail(tx, sdb=None):
 
         fn = functions(sdb).get(fid)
         return "function %s" % (fn.name if fn else fid)
+    if tx.tc.service == 20 and data and len(data) == 2:
+        pid = int.from_bytes(bytes(data), "big")
+        p = _parameter(sdb, pid)
+        return "parameter %s" % (p.qualified if p is not None else pid)
     return ""

@@ -28,9 +28,13 @@ def main(argv=None):
     p.add_argument("hub_a", type=int)
     p.add_argument("hub_b", type=int)
     p.add_argument("--call", action="append", default=[], help="NODE:FUNCTION:VALUE")
-    p.add_argument("--nodes", default="10,11")
+    p.add_argument("--nodes", help="NOMINAL,REDUNDANT node ids (default: the sample mission's)")
     args = p.parse_args(argv)
     ctrl = Controller(heartbeat_period=0.2, timeout=0.5, retries=3)
+    if args.nodes is None:
+        from obsw_host.ids import MissionIds
+
+        args.nodes = "%d,%d" % MissionIds.sample().reconfig_nodes
     for n in args.nodes.split(","):
         ctrl.add_node(int(n), definition(int(n)))
     adapter = CanAdapter(ctrl, buses=[HubBus(args.hub_a), HubBus(args.hub_b)])

@@ -22,13 +22,15 @@ from obsw.frames import cltu, tc
 from obsw.frames.asm import CaduDecoder
 from obsw.frames.errors import FrameError
 from obsw.frames.tm_demux import TmDemultiplexer
-from obsw.reconfig.essential import ESSENTIAL_MAP, Report
+from obsw.reconfig.essential import Report
 from obsw.reconfig.hal import RESET_NAMES, RESET_POWER, RESET_STUCK, RESET_WATCHDOG
 from obsw.reconfig.models import Tps3813Model
 
 import obsw_host
 from obsw_host.frames import keys
 from obsw_host.frames.links import open_pty_pair
+from obsw_host.ids import MissionIds
+from obsw_host.reconfig import board_file
 from obsw_host.reconfig import simhal as W
 from obsw_host.reconfig.canhub import CanHub
 
@@ -140,7 +142,7 @@ class ReconfigSim:
         self,
         directory=None,
         obc_calls=(),
-        scid=0x42,
+        scid=None,
         obc_line=0,
         initial_lines=0x001,
         bit_error_gap=0,
@@ -152,10 +154,17 @@ class ReconfigSim:
         out=None,
         key_file=None,
         obc_command=None,
+        ids=None,
     ):
         self.own_dir = directory is None
         self.dir = directory or tempfile.mkdtemp(prefix="obsw-reconfig-")
         os.makedirs(self.dir, exist_ok=True)
+        # the mission's ids (default: the sample's), on the controllers' "flash" as on a board
+        self.ids = ids = ids or MissionIds.sample()
+        board_file(ids, self.dir)
+        self.nodes = ids.reconfig_nodes
+        self.essential_map = ids.maps["essential"]
+        scid = ids.scid if scid is None else scid
         self.obc_calls = list(obc_calls)
         self.obc_command = obc_command  # callable(sim) -> argv of the OBC, or the sample OBC
         self.scid = scid
@@ -304,6 +313,7 @@ class ReconfigSim:
         else:
             cmd = [sys.executable, "-m", "obsw_host.reconfig.obc"]
             cmd += [str(self.hub.ports[0]), str(self.hub.ports[1])]
+            cmd += ["--nodes", "%d,%d" % self.nodes]
             if self.obc_boots == 0:
                 for c in self.obc_calls:
                     cmd += ["--call", c]
@@ -397,7 +407,7 @@ class ReconfigSim:
 
     def send_hpc(self, hpc):
         """Send an HPC as a signed BD frame on the essential MAP to both controllers' COM UARTs."""
-        seg = tc.Segment(ESSENTIAL_MAP, hpc.packet(seq_count=self._seq)).pack()
+        seg = tc.Segment(self.essential_map, hpc.packet(seq_count=self._seq)).pack()
         seg = self.security.apply(self.scid, 0, seg, True)  # signed with the essential MAP's SA
         frame = tc.TcFrame(self.scid, 0, seg, self._seq & 0xFF, bypass=True).pack()
         self._seq += 1

@@ -240,7 +240,10 @@ def main(argv):
         security = security_from_file(argv[9])
         if security is None:
             raise OSError("no SDLS key file %s" % argv[9])
-    app = ReconfigApp(hal, essential_security=security)
+    from obsw.reconfig import mission
+
+    ids = mission.load(argv[6] + "/" + mission.FILE) or {}  # as on a board's flash
+    app = ReconfigApp(hal, essential_security=security, **ids)
     tag = "NR"[role]
 
     def log(text):

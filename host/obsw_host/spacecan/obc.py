@@ -30,6 +30,7 @@ from obsw.spacecan.master import MASTER, SpaceCanMaster
 from obsw.spacecan.nodedef import NodeDefinition
 from obsw.spacecan.responder import Responder
 
+from obsw_host import ids as mission_ids
 from obsw_host.spacecan.adapter import CanAdapter
 
 # The reconfiguration module's CPDU as seen on SpaceCAN: the one definition the firmware also
@@ -42,9 +43,6 @@ def cpdu_node():
     with open(CPDU_NODE_PATH) as f:
         return json.load(f)
 
-
-CPDU_NAME = "CpduN"
-CPDU_NODE_ID = 10
 
 _IDLE_WAIT = 0.2  # longest a wait blocks with nothing due (stop() is seen this soon)
 
@@ -301,6 +299,16 @@ def simulated_responder(node_id, definition, **kw):
     return resp
 
 
+def mission_equipment(ids):
+    """The equipment components of the mission database's ``nodes``."""
+    nodes = list(ids.sdb.nodes.values())
+    if not nodes:
+        raise ids.error("nodes", "none; expected the SpaceCAN equipment nodes (or --equipment)")
+    return [
+        Equipment(n.name, n.node_id, NodeDefinition.load(n.definition, n.node_id)) for n in nodes
+    ]
+
+
 def parse_equipment(spec):
     """``NAME:NODE_ID[:DEFINITION.json]`` -> ``Equipment`` (no file: the sample CPDU)."""
     parts = spec.split(":", 2)
@@ -322,9 +330,9 @@ def add_arguments(p):
         "--equipment",
         action="append",
         metavar="NAME:NODE_ID[:DEF.json]",
-        help="an equipment component (repeatable; default %s:%d, the sample CPDU)"
-        % (CPDU_NAME, CPDU_NODE_ID),
+        help="an equipment component (repeatable; default: the mission database's nodes)",
     )
+    mission_ids.add_arguments(p)
     p.add_argument("--dir", help="IL name directory (default $OBSW_IL_DIR or a temp dir)")
     p.add_argument("--heartbeat-period", type=float, default=0.5)
     p.add_argument("--timeout", type=float, default=0.5, help="request timeout per attempt, s")
@@ -336,8 +344,10 @@ def add_arguments(p):
 
 def run(args):
     """Serve the master and the equipment until SIGTERM/SIGINT or ``--duration``."""
-    specs = args.equipment or ["%s:%d" % (CPDU_NAME, CPDU_NODE_ID)]
-    equipment = [parse_equipment(s) for s in specs]
+    if args.equipment:
+        equipment = [parse_equipment(s) for s in args.equipment]
+    else:
+        equipment = mission_equipment(mission_ids.from_args(args))
     obc = ObcSpaceCan(
         equipment,
         interface=args.interface,

@@ -17,6 +17,8 @@ each attribute or parameter:
 
 from obsw.pus import sdb as sdb_module
 
+from obsw_host.ids import MissionIds
+
 
 class Param:
     """One PUS parameter: id, space system path parts, type pair and optional extras."""
@@ -31,6 +33,7 @@ class Param:
         self.range = extra.get("range")
         self.limits = extra.get("limits")
         self.calibration = extra.get("calibration")
+        self.labels = extra.get("labels")  # {raw value: label} of an enumeration, or None
         self.description = extra.get("description")
 
 
@@ -68,8 +71,11 @@ class Structure:
 class Spacecraft:
     """What the Yamcs instance needs to know of the spacecraft database."""
 
-    def __init__(self, mission, apids, params, events, functions, structures, filestores):
+    def __init__(
+        self, mission, apids, params, events, functions, structures, filestores, ids=None
+    ):
         self.mission = mission or "spacecraft"
+        self.ids = ids  # the mission's ids (obsw_host.ids.MissionIds): SCID, VCs, source id
         self.apids = apids
         self.params = params  # id -> Param
         self.events = events  # id -> Event
@@ -80,6 +86,12 @@ class Spacecraft:
     def apid(self, name, default=None):
         return self.apids.get(name, default)
 
+    def required_apid(self, name):
+        """The APID named ``name``; a MissionError naming the file and key when missing."""
+        if self.ids is None:
+            raise KeyError("no APID named %r in the spacecraft database" % (name,))
+        return self.ids.apid(name)
+
 
 def _pair(type_spec):
     if isinstance(type_spec, str):
@@ -87,15 +99,26 @@ def _pair(type_spec):
     return tuple(type_spec)
 
 
-def loads(text):
+def loads(text, path=None):
     """The Spacecraft of a database given as JSON text (SdbError when it is malformed)."""
     db = sdb_module.loads(text)
+    return from_sdb(db, MissionIds(db, path))
+
+
+def from_ids(ids):
+    """The Spacecraft of a mission's ids (``obsw_host.ids.MissionIds``)."""
+    return from_sdb(ids.sdb, ids)
+
+
+def from_sdb(db, ids):
+    """The Spacecraft of a parsed database ``db`` whose ids are ``ids``."""
     params = {}
     for pid, p in db.parameters.items():
         extra = {
             "range": p.range,
             "limits": p.limits,
             "calibration": p.calibration,
+            "labels": p.labels,
             "description": p.description,
         }
         params[pid] = Param(pid, p.qualified, _pair(p.type_spec), p.unit, p.writable, extra)
@@ -112,7 +135,14 @@ def loads(text):
         for h in db.housekeeping
     ]
     return Spacecraft(
-        db.mission, dict(db.apids), params, events, functions, structures, dict(db.filestores)
+        db.mission,
+        dict(db.apids),
+        params,
+        events,
+        functions,
+        structures,
+        dict(db.filestores),
+        ids,
     )
 
 
@@ -123,4 +153,4 @@ def load(path=None):
 
         path = SDB_PATH
     with open(path) as f:
-        return loads(f.read())
+        return loads(f.read(), path)

@@ -16,6 +16,8 @@ import threading
 
 from obsw.frames.processor import split_packets
 
+from obsw_host.ports import Ports
+
 
 class PacketGateway:
     """TCP servers for Yamcs (one per stream) and one UDP socket for the OBC (see the module)."""
@@ -25,12 +27,14 @@ class PacketGateway:
         host="127.0.0.1",
         tcp_ports=None,
         apids=None,
-        tm_port=4999,
-        port_base=5000,
+        tm_port=None,
+        port_base=None,
         routes=None,
     ):
         self.host = host
-        self.port_base = port_base
+        ports = Ports()  # the defaults of this run (obsw_host.ports)
+        self.port_base = ports.base if port_base is None else port_base
+        tm_port = ports.tm if tm_port is None else tm_port
         self.routes = dict(routes or {})
         self.apids = {a: name for name, group in (apids or {}).items() for a in group}
         self.counters = {"tc": 0, "tm": 0, "tm_dropped": 0, "tc_invalid": 0}

@@ -12,21 +12,25 @@ Two link modes, every socket on loopback:
 - ``frames``: Yamcs sends TC transfer frames in CLTUs by UDP to the frame processor (its FOP-1
   runs COP-1 against our FARM-1 on VC 0; no segment header, since Yamcs 5.12.8 fails on MAP
   IDs for the commands of its own services, CFDP's among them) and receives TM transfer
-  frames by UDP (virtual channels 0 real time, 1 playback, 2 CFDP, 6 essential; idle frames
-  and the CLCW in the OCF).
+  frames by UDP (the mission's virtual channels: real time, playback, CFDP and essential, from
+  the spacecraft database's ``frames`` plan; idle frames and the CLCW in the OCF).
+
+The spacecraft id, the virtual channels, the CFDP entities (the database's onboard filestore
+and the first other one, whatever their prefixes) and the CFDP APID come from the mission
+(``obsw_host.ids.MissionIds``); a missing one is an error naming the file and key.
 """
 
 import json
 import os
 
+from obsw_host.ports import Ports
 from obsw_host.yamcs.xtce import event_templates, generate
 
-INSTANCE = "obsw"
-HTTP_PORT = 8090
+INSTANCE = "obsw"  # the instance of library callers that name none (the CLI names the mission)
+_DEFAULT = Ports()  # the ports of this run without a mission file (obsw_host.ports)
+HTTP_PORT = _DEFAULT.yamcs_http
 # the default ports of the ground side of the links (all on 127.0.0.1)
-PORTS = {"pus": 10015, "cfdp": 10016, "cltu": 10017, "tm_frames": 10018}
-SCID = 0x2A
-CFDP_VC = 2
+PORTS = _DEFAULT.yamcs()
 
 
 def _yaml(value, indent=0):
@@ -80,9 +84,15 @@ PUS_TC_ARGS = {"errorDetection": {"type": "CRC-16-CCIIT"}}
 CFDP_TM_ARGS = {"timestampOffset": -1, "seqCountOffset": -1, "useLocalGenerationTime": True}
 
 
-def links(mode, ports, scid=SCID):
-    """The dataLinks section for ``mode`` ('packets' or 'frames')."""
-    tm_args = pus_tm_args()
+def instance_name(name):
+    """A Yamcs instance name for mission ``name`` (letters, digits, '_', '-', '.')."""
+    out = "".join(c if c.isalnum() or c in "_-." else "_" for c in str(name))
+    return out if out and (out[0].isalnum() or out[0] == "_") else "m" + out
+
+
+def links(mode, ports, ids):
+    """The dataLinks section for ``mode`` ('packets' or 'frames') of the mission ``ids``."""
+    tm_args = pus_tm_args(ids.pus_config)
     if mode == "packets":
         return [
             {
@@ -123,6 +133,8 @@ def links(mode, ports, scid=SCID):
 
     pus_pp = "org.yamcs.pus.PusPacketPreprocessor"
     generic = "org.yamcs.tctm.GenericPacketPreprocessor"
+    scid = ids.scid
+    plan = ids.tm_vcs
     return [
         {
             "name": "tc_frames",
@@ -136,7 +148,7 @@ def links(mode, ports, scid=SCID):
             "errorDetection": "CRC16",
             "virtualChannels": [
                 {
-                    "vcId": 0,
+                    "vcId": ids.tc_vc,
                     "service": "PACKET",
                     "stream": "tc_realtime",
                     "commandPostprocessorClassName": "org.yamcs.pus.PusCommandPostprocessor",
@@ -159,16 +171,18 @@ def links(mode, ports, scid=SCID):
             "goodFrameStream": "good_frames",
             "badFrameStream": "bad_frames",
             "virtualChannels": [
-                vc(0, "tm_realtime", pus_pp, tm_args),
-                vc(1, "tm_dump", pus_pp, tm_args),
-                vc(CFDP_VC, "cfdp_tm", generic, CFDP_TM_ARGS),
-                vc(6, "tm_essential", generic, CFDP_TM_ARGS),
+                vc(plan["realtime"], "tm_realtime", pus_pp, tm_args),
+                vc(plan["playback"], "tm_dump", pus_pp, tm_args),
+                vc(ids.cfdp_vc, "cfdp_tm", generic, CFDP_TM_ARGS),
+                vc(plan["essential"], "tm_essential", generic, CFDP_TM_ARGS),
             ],
         },
     ]
 
 
-def instance_config(spacecraft, mode, ports, mdb_file, ground_entity, sat_entity):
+def instance_config(spacecraft, mode, ports, mdb_file, ids):
+    ground_prefix, sat_prefix = ids.ground_prefix, ids.local_prefix
+    sat_entity, ground_entity = ids.cfdp_entities
     return {
         "services": [
             {"class": "org.yamcs.archive.XtceTmRecorder"},
@@ -204,12 +218,14 @@ def instance_config(spacecraft, mode, ports, mdb_file, ground_entity, sat_entity
                     "nakTimeout": 2000,
                     "inactivityTimeout": 10000,
                     "pendingAfterCompletion": 1000,
-                    "localEntities": [{"name": "GROUND", "id": ground_entity, "bucket": "cfdpUp"}],
-                    "remoteEntities": [{"name": "SAT", "id": sat_entity}],
+                    "localEntities": [
+                        {"name": ground_prefix, "id": ground_entity, "bucket": "cfdpUp"}
+                    ],
+                    "remoteEntities": [{"name": sat_prefix, "id": sat_entity}],
                 },
             },
         ],
-        "dataLinks": links(mode, ports),
+        "dataLinks": links(mode, ports, ids),
         "mdb": [{"type": "xtce", "spec": mdb_file}],
         "streamConfig": {
             "tm": [
@@ -286,12 +302,22 @@ def cfdp_sql(apid):
 
 
 def write_instance(
-    folder, spacecraft, mode="packets", ports=None, http_port=HTTP_PORT, instances=None
+    folder,
+    spacecraft,
+    mode="packets",
+    ports=None,
+    http_port=HTTP_PORT,
+    instances=None,
+    ids=None,
+    name=INSTANCE,
 ):
-    """Write a Yamcs server for ``spacecraft`` into ``folder``: one instance named ``obsw`` with
+    """Write a Yamcs server for ``spacecraft`` into ``folder``: one instance named ``name`` with
     ``mode`` links on ``ports``, or the ``instances`` given as {name: (mode, ports)} (one
-    server, several instances). Returns the MDB path."""
-    instances = instances or {INSTANCE: (mode, ports)}
+    server, several instances). ``ids``: the mission's ids (default: the database's alone).
+    Returns the MDB path."""
+    ids = ids or spacecraft.ids
+    instances = instances or {name: (mode, ports)}
+    defaults = ids.ports.yamcs()
     etc = os.path.join(folder, "etc")
     mdb = os.path.join(folder, "mdb")
     os.makedirs(etc, exist_ok=True)
@@ -301,8 +327,6 @@ def write_instance(
         f.write(generate(spacecraft))
     with open(os.path.join(etc, "events.json"), "w") as f:
         json.dump(event_templates(spacecraft), f, indent=1)
-    ground = spacecraft.filestores.get("GROUND", 1)
-    sat = spacecraft.filestores.get("SAT", 2)
     buckets = []
     files = {}
     for name, (mode_, ports_) in instances.items():
@@ -311,7 +335,7 @@ def write_instance(
             os.makedirs(os.path.join(folder, path), exist_ok=True)
             buckets.append({"name": "%s_%s" % (name, way), "path": path})
         config = instance_config(
-            spacecraft, mode_, dict(PORTS, **(ports_ or {})), "mdb/" + mdb_name, ground, sat
+            spacecraft, mode_, dict(defaults, **(ports_ or {})), "mdb/" + mdb_name, ids
         )
         cfdp = config["services"][-1]["args"]
         cfdp["incomingBucket"] = name + "_down"
@@ -331,7 +355,7 @@ def write_instance(
     }
     files["yamcs.yaml"] = _yaml(server)
     files["processor.yaml"] = _yaml(PROCESSOR)
-    files["extra_streams.sql"] = cfdp_sql(spacecraft.apid("cfdp", 100))
+    files["extra_streams.sql"] = cfdp_sql(ids.apid("cfdp"))
     for name, text in files.items():
         with open(os.path.join(etc, name), "w") as f:
             f.write(text + "\n")

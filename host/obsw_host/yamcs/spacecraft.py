@@ -22,15 +22,14 @@ import time
 from obsw.cfdp.entity import CfdpEntity
 from obsw.cfdp.mib import Mib, RemoteEntity
 from obsw.crc import CHECKSUM_MODULAR
-from obsw.pus import sdb as sdb_module
 from obsw.spp import TYPE_TM
 
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity
+from obsw_host.ids import MissionIds
 from obsw_host.pus.onboard import Onboard
 from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 from obsw_host.yamcs.gateway import PacketGateway
-from obsw_host.yamcs.instance import CFDP_VC, SCID
 
 LOOPBACK = "127.0.0.1"
 ASM = b"\x1a\xcf\xfc\x1d"
@@ -93,11 +92,17 @@ class SampleSpacecraft:
         sat_entity=None,
         ground_entity=None,
         ports=None,
+        ids=None,
     ):
         ports = ports or {}
         self.mode = mode
-        self.sdb = sdb_module.load(sdb_path)
+        self.ids = ids = ids or MissionIds.locate(sdb=sdb_path)
+        self.sdb = ids.sdb
         self.panel = SolarPanel()
+        # the sample's panel when the database has it; another mission's own components run
+        # in its OBC (`obsw yamcs run --obc`)
+        has_panel = SOLAR_PANEL.name in self.sdb.components
+        components = [(SOLAR_PANEL, self.panel)] if has_panel else []
         self.root = root
         os.makedirs(root, exist_ok=True)
         self._stop = threading.Event()
@@ -107,9 +112,9 @@ class SampleSpacecraft:
         self.gateway = None
         self.processor = None
         self.cfdp = None
-        sat = sat_entity or self.sdb.filestores.get("SAT", 2)
-        ground = ground_entity or self.sdb.filestores.get("GROUND", 1)
-        cfdp_apid = self.sdb.apids.get("cfdp", 100)
+        sat = sat_entity or ids.cfdp_entities[0]
+        ground = ground_entity or ids.cfdp_entities[1]
+        cfdp_apid = ids.apid("cfdp")
         self.ground_entity = ground
         try:
             if mode == "packets":
@@ -121,12 +126,13 @@ class SampleSpacecraft:
                 tm_input = self.gateway.tm_address
             elif mode == "frames":
                 from obsw.frames.tm_mux import TmVirtualChannel
-                from obsw.frames.tm_plan import plan_channels, tm_plan
+                from obsw.frames.tm_plan import plan_channels
 
                 from obsw_host.frames.processor import FrameProcessorHost
 
-                plan = tm_plan()
-                channels = plan_channels(plan) + [TmVirtualChannel(CFDP_VC, 0, 1 << 20, "cfdp")]
+                plan = ids.tm_vcs
+                cfdp_vc = ids.cfdp_vc
+                channels = plan_channels(plan) + [TmVirtualChannel(cfdp_vc, 0, 1 << 20, "cfdp")]
                 peer = (LOOPBACK, tm_frames_port) if tm_frames_port else None
                 self.link_a = UdpFrameLink(peer, ports.get("cltu", 0), drop=drop)
                 self.link_b = UdpFrameLink(None)
@@ -134,12 +140,13 @@ class SampleSpacecraft:
                 self.processor = FrameProcessorHost(
                     self.link_a,
                     self.link_b,
-                    SCID,
+                    ids.scid,
                     tm_port=0,
                     vc_ports={},
                     tm_channels=channels,
-                    tm_plan={},
-                    tm_vc_of_apid={cfdp_apid: CFDP_VC},
+                    tm_plan=plan,
+                    tm_vc_of_apid={cfdp_apid: cfdp_vc},
+                    tc_vcids=(ids.tc_vc,),
                     tm_randomize=False,
                     segment_header=False,
                     clcw_period=0.2,
@@ -152,7 +159,9 @@ class SampleSpacecraft:
                 port=0,
                 period=period,
                 tm_to=tm_input,
-                components=[(SOLAR_PANEL, self.panel)],
+                components=components,
+                apid=ids.pus_apid,
+                config=ids.pus_config,
             )
             remote = RemoteEntity(
                 ground,
@@ -186,7 +195,7 @@ class SampleSpacecraft:
     def start(self):
         """Run every process in daemon threads; returns self."""
         self.onboard.start()
-        routes = {self.sdb.apids["pus"]: self.onboard.address[:2]}
+        routes = {self.onboard.apid: self.onboard.address[:2]}
         routes[self.cfdp_apid] = self.cfdp.address[:2]
         if self.gateway is not None:
             self.gateway.routes.update(routes)

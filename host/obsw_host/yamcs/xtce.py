@@ -17,12 +17,15 @@
 import xml.etree.ElementTree as ET
 
 from obsw.pus import messages as M
+from obsw.pus.calibration import CalibrationError, Values
 from obsw.pus.config import PusConfig
+from obsw.pus.fields import field
 from obsw.pus.packets import ACK_ALL
 from obsw.pus.services.s01_verification import FAILURE_NAMES
-from obsw.pus.services.s12_layouts import STATUS_NAMES
+from obsw.pus.services.s12_layouts import FMON_STATUS_NAMES, STATUS_NAMES
+from obsw.pus.services.s20_parameters import DEFINITION_NAMES
 
-from obsw_host.yamcs.xtce_types import argument_type, parameter_type
+from obsw_host.yamcs.xtce_types import argument_type, linear, parameter_type
 
 XTCE_NS = "http://www.omg.org/spec/XTCE/20180204"
 U8, U16, U32, E8, E16 = (3, 4), (3, 12), (3, 14), (2, 8), (2, 16)
@@ -119,10 +122,12 @@ class Generator:
 
     def __init__(self, sc, config=None):
         self.sc = sc
-        self.cfg = config or PusConfig()
+        ids = sc.ids  # the mission's: layout, source id, APIDs
+        self.cfg = config or (ids.pus_config if ids is not None else PusConfig())
         self.root = SpaceSystem(_label(sc.mission), "/" + _label(sc.mission))
         self.refs = {}  # parameter id -> absolute reference
-        self.apid = sc.apid("pus", 10)
+        self.apid = sc.required_apid("pus")
+        self.source_id = ids.source_id if ids is not None else 0
 
     # ------------------------------------------------------------------ helpers
     def system_of(self, parts):
@@ -233,7 +238,9 @@ class Generator:
         for pid in sorted(self.sc.params):
             p = self.sc.params[pid]
             s = self.system_of(p.path[:-1])
-            ptype = parameter_type("", p.pair, p.unit, limits=p.limits, calibration=p.calibration)
+            ptype = parameter_type(
+                "", p.pair, p.unit, limits=p.limits, calibration=p.calibration, labels=p.labels
+            )
             self.refs[pid] = s.parameter(_label(p.path[-1]), ptype, p.description)
 
     def housekeeping(self):
@@ -330,7 +337,8 @@ class Generator:
     def tc_base(self):
         r = self.root
         cfg = self.cfg
-        for name, bits in (("apid_t", 11), ("ack_t", 4), ("u8_t", 8), ("source_t", 16)):
+        source_bits = 8 * cfg.source_id_size or 16
+        for name, bits in (("apid_t", 11), ("ack_t", 4), ("u8_t", 8), ("source_t", source_bits)):
             r.atypes.append(argument_type(name, (0, bits)))
         cmd = _sub(ET.Element("root"), "MetaCommand", name="pus_tc", abstract="true")
         cmd.set("shortDescription", "PUS-C telecommand: header, then the service's data")
@@ -340,7 +348,13 @@ class Generator:
         _sub(args, "Argument", name="service", argumentTypeRef="u8_t")
         _sub(args, "Argument", name="subtype", argumentTypeRef="u8_t")
         if cfg.source_id_size:
-            _sub(args, "Argument", name="source", argumentTypeRef="source_t", initialValue=0)
+            _sub(
+                args,
+                "Argument",
+                name="source",
+                argumentTypeRef="source_t",
+                initialValue=self.source_id,
+            )
         cc = _sub(cmd, "CommandContainer", name="pus_tc")
         entries = _sub(cc, "EntryList")
         _fixed(entries, "ccsds_version_type_flag", 0b00011, 5)
@@ -662,7 +676,6 @@ class Generator:
             if not p.writable:
                 continue
             s = self.system_of(p.path[:-1])
-            valid = tuple(p.range) if p.range else None
             self.command(
                 s,
                 "set_" + _label(p.path[-1]),
@@ -670,7 +683,7 @@ class Generator:
                 [
                     ("fixed", "n", 1, 8),
                     ("fixed", "parameter", pid, 16),
-                    ("arg", "value", argument_type("", p.pair, p.unit, valid=valid)),
+                    ("arg", "value", _value_argument(p)),
                 ],
                 "TC[20,3] set %s" % p.qualified,
             )
@@ -717,11 +730,7 @@ class Generator:
                 "low_event": "none",
                 "high_event": "none",
             }
-            if p.calibration or p.pair[0] != 5:  # on-board limits are raw integer values
-                for key in ("low", "high"):
-                    v = defaults[key]
-                    ok = v is not None and not p.calibration and float(v).is_integer()
-                    defaults[key] = int(v) if ok else None
+            defaults["low"], defaults["high"] = _raw_limits(p, low, high)
             for a in cmd.find("ArgumentList"):
                 if defaults.get(a.get("name")) is not None:
                     a.set("initialValue", str(defaults[a.get("name")]))
@@ -738,6 +747,123 @@ class Generator:
                 s, _label(f.path[-1]), M.TC_FUNCTION_PERFORM, fields, "TC[8,1] %s" % f.qualified
             )
 
+    # ------------------------------------------------------------------ ST[12] 17-28, ST[20] 4-7
+    def functional_monitoring(self):
+        """TM[12,26] and TM[12,28] (their first FMON), TC[12,17] to TC[12,27]."""
+        fmon_states = {k: _label(v) for k, v in FMON_STATUS_NAMES.items()}
+        yes_no = {0: "no", 1: "yes"}
+        count = self.header_param("fmon_count", 16)
+        fmon = self.header_param("fmon_id", 16)
+        protected = self.header_param("fmon_protected", 8, labels=yes_no)
+        enabled = self.header_param("fmon_enabled", 8, labels=yes_no)
+        checking = self.root.parameter(
+            "fmon_checking_status",
+            parameter_type("", E8, labels=fmon_states, alarms={"failed": "critical"}),
+        )
+        self.report(
+            "functional_status_report",
+            M.TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT,
+            [count, fmon, protected, enabled, checking],
+            archive=True,
+        )
+        validity = [
+            self.header_param("fmon_validity_parameter", 16),
+            self.header_param("fmon_validity_mask", 32),
+            self.header_param("fmon_validity_value", 32),
+        ]
+        ev_labels = {e.id: _label(e.qualified) for e in self.sc.events.values()}
+        ev_labels[0] = "none"
+        event = self.root.parameter("fmon_event", parameter_type("", E16, labels=ev_labels))
+        tail = [event, self.header_param("fmon_failing", 16), self.header_param("fmon_pmons", 16)]
+        self.report(
+            "functional_definition_report",
+            M.TM_MON_FUNCTIONAL_MONITORING_REPORT,
+            [count, fmon] + validity + [protected, enabled] + tail,
+        )
+        pus = self.root.child("PUS")
+        one = ("fixed", "n", 1, 16)
+
+        def fmon_arg():
+            return ("arg", "fmon", argument_type("", U16))
+
+        for name, mt in (
+            ("fmon_function_enable", M.TC_MON_ENABLE_FUNCTIONAL_MONITORING_FUNCTION),
+            ("fmon_function_disable", M.TC_MON_DISABLE_FUNCTIONAL_MONITORING_FUNCTION),
+            ("fmon_status_report", M.TC_MON_REPORT_FUNCTIONAL_MONITORING_STATUS),
+        ):
+            self.command(pus, name, mt)
+        for name, mt in (
+            ("fmon_enable", M.TC_MON_ENABLE_FUNCTIONAL_MONITORING),
+            ("fmon_disable", M.TC_MON_DISABLE_FUNCTIONAL_MONITORING),
+            ("fmon_protect", M.TC_MON_PROTECT_FUNCTIONAL_MONITORING),
+            ("fmon_unprotect", M.TC_MON_UNPROTECT_FUNCTIONAL_MONITORING),
+            ("fmon_delete", M.TC_MON_DELETE_FUNCTIONAL_MONITORING),
+            ("fmon_report", M.TC_MON_REPORT_FUNCTIONAL_MONITORING),
+        ):
+            self.command(pus, name, mt, [one, fmon_arg()])
+        for n in (1, 2, 3, 4):  # one command per number of PMONs
+            fields = [one, fmon_arg()]
+            fields += [
+                ("fixed", "validity", 0, 16),
+                ("fixed", "validity_mask", 0, 32),
+                ("fixed", "validity_value", 0, 32),
+                ("arg", "event", argument_type("", E16, labels=ev_labels)),
+                ("arg", "failing", argument_type("", U16, valid=(1, n))),
+                ("fixed", "n2", n, 16),
+            ]
+            fields += [("arg", "pmon%d" % i, argument_type("", U16)) for i in range(1, n + 1)]
+            self.command(
+                pus,
+                "fmon_add_%d" % n,
+                M.TC_MON_ADD_FUNCTIONAL_MONITORING,
+                fields,
+                "TC[12,23] an FMON over %d PMON%s" % (n, "s" if n > 1 else ""),
+            )
+
+    def parameter_definitions(self):
+        """TM[20,7] (its first parameter), TC[20,4] to TC[20,6]."""
+        param_labels = {pid: _label(p.qualified) for pid, p in self.sc.params.items()}
+        kinds = {k: _label(v) for k, v in DEFINITION_NAMES.items()}
+        entries = [
+            self.header_param("definition_count", 8),
+            self.root.parameter("defined_parameter", parameter_type("", U16, labels=param_labels)),
+            self.header_param("definition_kind", 8, labels=kinds),
+            self.header_param("definition_memory", 16),
+            self.header_param("definition_object", 16),
+            self.header_param("definition_address", 32),
+        ]
+        self.report("parameter_definition_report", M.TM_PARAM_DEFINITION_REPORT, entries)
+        pus = self.root.child("PUS")
+        one = ("fixed", "n", 1, 8)
+
+        def param():
+            return ("arg", "parameter", argument_type("", U16, labels=param_labels))
+
+        self.command(
+            pus,
+            "parameter_definitions_report",
+            M.TC_PARAM_REPORT_DEFINITIONS,
+            [one, param()],
+            "TC[20,6] report where a parameter lives",
+        )
+        for name, mt, where in (
+            ("parameter_define_raw", M.TC_PARAM_CHANGE_RAW_MEMORY_DEFINITIONS, "address"),
+            ("parameter_define_object", M.TC_PARAM_CHANGE_OBJECT_MEMORY_DEFINITIONS, "offset"),
+        ):
+            self.command(
+                pus,
+                name,
+                mt,
+                [
+                    one,
+                    param(),
+                    ("arg", "memory", argument_type("", U16)),
+                ]
+                + ([("arg", "object", argument_type("", U16))] if where == "offset" else [])
+                + [("arg", where, argument_type("", U32))],
+                "TC[%d,%d] place a parameter in memory (%s)" % (mt[0], mt[1], where),
+            )
+
     def build(self):
         self.headers()
         self.verification()
@@ -752,6 +878,8 @@ class Generator:
         self.parameter_commands()
         self.monitor_commands()
         self.function_commands()
+        self.functional_monitoring()
+        self.parameter_definitions()
         self.services_2_3_9_14()
         return self.root.element()
 
@@ -865,6 +993,31 @@ class Generator:
                 [one8, arg("apid", U16, (0, 2047)), ("fixed", "n2", 1, 8), arg("sid", U16)],
             )
         self.command(pus, "forward_diag_report", M.TC_FWD_REPORT_DIAG_STRUCTURES)
+
+
+def _value_argument(p):
+    """The value argument of a set command: a label of an enumeration; an engineering value
+    (range checked by Yamcs) when the calibration is linear; else the raw value."""
+    if p.labels:
+        return argument_type("", p.pair, p.unit, labels=p.labels)
+    valid = tuple(p.range) if p.range else None
+    if p.calibration:
+        if linear(p.calibration):
+            return argument_type("", p.pair, p.unit, valid=valid, calibration=p.calibration)
+        return argument_type("", p.pair)  # raw: the range is in engineering units
+    return argument_type("", p.pair, p.unit, valid=valid)
+
+
+def _raw_limits(p, low, high):
+    """Default raw limits of a limit check from engineering ones (None: not expressible)."""
+    if low is None or high is None:
+        return None, None
+    try:
+        values = Values(field(*p.pair), {"calibration": p.calibration})
+        raw_low, raw_high, _ = values.raw_limits(low, high)
+    except CalibrationError:
+        return None, None
+    return raw_low, raw_high
 
 
 def _drop_condition(container, ref):

@@ -6,6 +6,8 @@ it in a ParameterTypeSet or ArgumentTypeSet. Element order follows the XTCE 1.2 
 
 import xml.etree.ElementTree as ET
 
+from obsw.pus.calibration import CalibrationError, Polynomial
+from obsw.pus.calibration import calibration as parse_calibration
 from obsw.pus.fields import field
 
 
@@ -43,17 +45,35 @@ def _encoding(parent, pair, calibration=None):
     return enc
 
 
-def _calibrator(parent, calibration):
-    if "polynomial" in calibration:
+def _calibrator(parent, spec):
+    """A PolynomialCalibrator or SplineCalibrator for any shape ``obsw.pus.calibration``
+    reads (coefficient lists or XTCE terms, point pairs or XTCE points, order, extrapolate)."""
+    try:
+        cal = parse_calibration(spec)
+    except CalibrationError as e:
+        raise XtceTypeError(str(e)) from None
+    if isinstance(cal, Polynomial):
         poly = _sub(parent, "PolynomialCalibrator")
-        for exponent, coefficient in enumerate(calibration["polynomial"]):
+        for exponent, coefficient in enumerate(cal.coefficients):
             _sub(poly, "Term", coefficient=repr(float(coefficient)), exponent=exponent)
-    elif "spline" in calibration:
-        spline = _sub(parent, "SplineCalibrator")
-        for raw, eng in calibration["spline"]:
-            _sub(spline, "SplinePoint", raw=repr(float(raw)), calibrated=repr(float(eng)))
-    else:
-        raise XtceTypeError("calibration %r: expected 'polynomial' or 'spline'" % (calibration,))
+        return
+    spline = _sub(parent, "SplineCalibrator")
+    if cal.order != 1:
+        spline.set("order", str(cal.order))
+    if cal.extrapolate:
+        spline.set("extrapolate", "true")
+    for raw, eng in cal.points:
+        _sub(spline, "SplinePoint", raw=repr(float(raw)), calibrated=repr(float(eng)))
+
+
+def linear(spec):
+    """True if calibration ``spec`` is a polynomial of degree 1 (Yamcs can reverse it for a
+    command argument)."""
+    try:
+        cal = parse_calibration(spec)
+    except CalibrationError:
+        return False
+    return isinstance(cal, Polynomial) and cal.degree == 1
 
 
 def _units(parent, unit):
@@ -128,9 +148,17 @@ def parameter_type(name, pair, unit=None, limits=None, calibration=None, labels=
     return t
 
 
-def argument_type(name, pair, unit=None, valid=None, labels=None):
-    """An argument type; ``valid`` (low, high) bounds the values a user may give."""
+def argument_type(name, pair, unit=None, valid=None, labels=None, calibration=None):
+    """An argument type; ``valid`` (low, high) bounds the values a user may give; a linear
+    ``calibration`` makes it an engineering value that Yamcs turns into the raw one."""
     ptc, pfc = pair
+    if calibration is not None and ptc in (2, 3, 4, 5):
+        t = ET.Element("FloatArgumentType", name=name, sizeInBits="64")
+        _units(t, unit)
+        _encoding(t, pair, calibration)
+        if valid is not None:
+            _sub(_sub(t, "ValidRangeSet"), "ValidRange", **_range(valid))
+        return t
     if labels is not None:
         t = ET.Element("EnumeratedArgumentType", name=name)
         _units(t, unit)

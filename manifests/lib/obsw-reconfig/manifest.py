@@ -18,6 +18,7 @@ package(
         "eeprom.py",
         "essential.py",
         "hal.py",
+        "mission.py",
         "node.py",
         "safeguard.py",
         "watchdog.py",

@@ -188,6 +188,13 @@ class IlSystem(System):
         self.reads += 1
         if isinstance(v, dict) and "value" in v and "unit" in v:
             return Quantity(v["value"], v["unit"])
+        p = self.catalog.calibrated.get(target)
+        if p is not None:  # the engineering value of a raw one, with its unit
+            try:
+                v = p.engineering(v)
+            except ValueError as e:
+                raise ParameterError(path, e) from None
+            return Quantity(v, p.unit) if p.unit and not isinstance(v, str) else v
         return v
 
     def arguments(self, path, args):

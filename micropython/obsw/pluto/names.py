@@ -74,6 +74,7 @@ class Catalog:
     def __init__(self, sdb=None, interfaces=()):
         self.entries = {}
         self.interfaces = {}  # names of interfaces added
+        self.calibrated = {}  # "Component.attribute" -> sdb Parameter whose raw value differs
         self._paths = {}  # path -> entry or None, filled as paths are looked up
         if sdb is not None:
             self.add_sdb(sdb)
@@ -115,7 +116,11 @@ class Catalog:
             sdb = Sdb(sdb)
         for p in sdb.parameters.values():
             if p.component:
-                self.add("parameter", p.component, p.name, type_code(p.type_spec), p.unit)
+                code = type_code(p.type_spec)
+                if p.calibration or p.labels:  # PLUTO sees the engineering value
+                    self.calibrated[p.component + "." + p.name] = p
+                    code = "r" if p.calibration else "s"
+                self.add("parameter", p.component, p.name, code, p.unit)
         for op in sdb.operations.values():
             sig = None
             if op.signature is not None:

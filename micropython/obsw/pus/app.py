@@ -62,8 +62,8 @@ from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm
 from obsw.spp import SequenceCounter
 
-# The event this process raises when periodic work overruns its cycle; the spacecraft
-# database may assign another ID (``overrun_event``).
+# The event this process raises when periodic work overruns its cycle; the host gives the id
+# the spacecraft database names ``pus.cycle_overrun`` (``overrun_event``; None: no event).
 EVENT_CYCLE_OVERRUN = const(0xFF01)
 
 _DECODE_ERRORS = (ValueError, KeyError, IndexError, TypeError)
@@ -456,7 +456,8 @@ class ApplicationProcess:
 
     def _overrun(self, service):
         self.count("overruns")
-        self.event(self.overrun_event, MEDIUM, bytes((service,)))
+        if self.overrun_event is not None:  # None: the mission declares no such event
+            self.event(self.overrun_event, MEDIUM, bytes((service,)))
 
     async def run(self, period=None, cycles=None):
         """The activity loop: ``tick`` every ``period`` seconds (``cycles`` times, or forever)."""

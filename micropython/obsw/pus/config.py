@@ -140,3 +140,74 @@ def _key(c):
 
 # the PUS-C default layout, shared
 DEFAULT = PusConfig()
+
+
+# ---------------------------------------------------------------------------- from the database
+
+LAYOUT_KEYS = (
+    "source_id",
+    "source_id_size",
+    "destination_id_size",
+    "message_counter_size",
+    "time",
+    "pec",
+    "tc_spare",
+    "tm_spare",
+)
+
+
+class PusLayoutError(ValueError):
+    """The spacecraft database's ``pus`` section names a layout PUS-C does not allow."""
+
+    def __init__(self, key, message):
+        super().__init__("pus.%s: %s" % (key, message))
+        self.key = key
+
+
+def from_sdb(sdb):
+    """The packet layout the database's ``pus`` section declares (``Sdb.pus``), for example
+    ``{"source_id_size": 1, "time": {"coarse": 4, "fine": 3}, "pec": true}``; absent keys keep
+    the PUS-C defaults, ``"time": null`` leaves the TM time out. ``DEFAULT`` when the section
+    says nothing about the layout."""
+    doc = sdb.pus if sdb is not None else None
+    if not doc:
+        return DEFAULT
+    if not isinstance(doc, dict):
+        raise PusLayoutError("", "expected an object, got %r" % (doc,))
+    for key in doc:
+        if key not in LAYOUT_KEYS:
+            raise PusLayoutError(key, "unknown key (one of %s)" % ", ".join(LAYOUT_KEYS))
+    kw = {}
+    for key in ("source_id_size", "destination_id_size", "message_counter_size"):
+        if key in doc:
+            kw[key] = doc[key]
+    for key in ("tc_spare", "tm_spare"):
+        if key in doc:
+            kw[key] = doc[key]
+    if "pec" in doc:
+        if not isinstance(doc["pec"], bool):
+            raise PusLayoutError("pec", "expected true or false, got %r" % (doc["pec"],))
+        kw["pec"] = doc["pec"]
+    if "time" in doc:
+        kw["time"] = _time(doc["time"])
+    if not kw:
+        return DEFAULT
+    try:
+        return PusConfig(**kw)
+    except ValueError as e:
+        raise PusLayoutError("", str(e)) from None
+
+
+def _time(spec):
+    if spec is None:
+        return None
+    if not isinstance(spec, dict):
+        raise PusLayoutError("time", "expected {'coarse': 1-4, 'fine': 0-3} or null")
+    coarse = spec.get("coarse", 4)
+    fine = spec.get("fine", 2)
+    for key in spec:
+        if key not in ("coarse", "fine"):
+            raise PusLayoutError("time.%s" % key, "unknown key (coarse, fine)")
+    if coarse not in (1, 2, 3, 4) or fine not in (0, 1, 2, 3):
+        raise PusLayoutError("time", "CUC octets coarse 1-4, fine 0-3, got %r" % (spec,))
+    return Cuc(coarse, fine)

@@ -411,3 +411,6 @@ FAILURE_OBCP_REJECTED = const(24)  # ST[18] procedure text that does not load (l
 FAILURE_ABORTED = const(32)  # the request was aborted by another one (TC[6,12])
 FAILURE_WRITE_PROTECTED = const(33)  # a load into a memory whose write protection is on
 FAILURE_READBACK = const(34)  # data read back after a load differ from the data loaded
+
+# project-defined failure codes of raw and engineering values (ST[20])
+FAILURE_OUT_OF_RANGE = const(30)  # a value outside the parameter's declared range

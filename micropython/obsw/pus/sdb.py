@@ -19,8 +19,10 @@
 Also parsed here, so nothing else reads the JSON: ``functions`` (service 8: id, name, the
 operation's typed arguments), components' ``operations`` (name and arguments with units, for
 PLUTO's checker), ``position_scheduling`` (service 22's position parameter), ``frames``
-(``tm_vcs``: the TM virtual channel plan, role -> VC ID, and ``scid``), and ``nodes`` (SpaceCAN
-equipment: name, node id, node definition file relative to the database file).
+(``tm_vcs``: the TM virtual channel plan, role -> VC ID, and ``scid``; ``tc_vc``, ``maps`` and
+``cfdp_vc`` are kept in ``frames`` for the mission's ids), ``pus`` (the packet layout and the
+ground's source id, read by ``obsw.pus.config.from_sdb``) and ``nodes`` (SpaceCAN equipment:
+name, node id, node definition file relative to the database file).
 
 ``filestores`` maps the path prefixes of file management (``SAT:/data/x``) to CFDP entity
 ids (the onboard one is the first, unless one says ``"local": true``); ``memories`` declares
@@ -82,10 +84,13 @@ def field_type(spec, where="type"):
 
 
 class Parameter:
-    """An attribute of a component as a PUS parameter. ``extras`` are the optional entries for
-    mission control, kept as given: ``range`` ([low, high] a set may use), ``limits``
-    (``{"warning": [low, high], "critical": [low, high]}``), ``calibration``
-    (``{"polynomial": [c0, c1, ..]}`` or ``{"spline": [[raw, eng], ..]}``), ``description``."""
+    """An attribute of a component as a PUS parameter. ``type`` is the raw value (what packets
+    carry); ``unit`` the engineering unit, ``raw_unit`` the raw one. ``extras`` are the optional
+    entries, kept as given and checked by ``obsw.pus.calibration``: ``range`` ([low, high] a set
+    may use, engineering units), ``limits`` (``{"warning": [low, high], "critical": [low,
+    high]}``, engineering units), ``calibration`` (``{"polynomial": [c0, c1, ..]}`` or
+    ``{"spline": [[raw, eng], ..]}``), ``enumeration`` (labels of raw values),
+    ``description``. ``values`` converts raw <-> engineering."""
 
     def __init__(
         self, id, component, name, type_spec, unit=None, writable=False, default=None, extras=None
@@ -102,7 +107,38 @@ class Parameter:
         self.range = extras.get("range")
         self.limits = extras.get("limits")
         self.calibration = extras.get("calibration")
+        self.raw_unit = extras.get("raw_unit")
         self.description = extras.get("description")
+        self.values = None  # obsw.pus.calibration.Values, for an entry that has any of them
+        for key in _VALUE_ENTRIES:
+            if extras.get(key) is not None:
+                self.values = _values(self.type, extras, "parameter " + self.qualified)
+                break
+
+    @property
+    def labels(self):
+        """{raw value: label} of an enumeration, or None."""
+        return None if self.values is None else self.values.labels
+
+    def engineering(self, raw):
+        """The engineering value of raw value ``raw`` (a label for an enumeration)."""
+        return raw if self.values is None else self.values.engineering(raw)
+
+    def to_raw(self, eng):
+        """The raw value of an engineering value or label (CalibrationError if none)."""
+        return eng if self.values is None else self.values.to_raw(eng)
+
+    def out_of_range(self, raw):
+        """None if raw value ``raw`` is within the parameter's range, else why not."""
+        return None if self.values is None else self.values.out_of_range(raw)
+
+    def raw_limits(self, low, high, raw=False):
+        """(raw low, raw high, swapped) of a limit check from engineering limits (``raw``:
+        raw limits, checked against the type); see ``obsw.pus.calibration.Values``."""
+        values = self.values if self.values is not None else _values(self.type, {}, "")
+        if raw:
+            return values.raw_limits_of(low, high) + (False,)
+        return values.raw_limits(low, high)
 
     @property
     def qualified(self):
@@ -110,6 +146,20 @@ class Parameter:
 
     def __repr__(self):
         return "Parameter(%d, %s, %s)" % (self.id, self.qualified, self.type.name)
+
+
+_VALUE_ENTRIES = ("calibration", "enumeration", "range", "limits")
+
+
+def _values(ftype, extras, what):
+    # imported here, not at the top: a database with no calibration, label, range or limits
+    # (a small board's) does not pay the module's heap
+    from obsw.pus.calibration import CalibrationError, Values
+
+    try:
+        return Values(ftype, extras, what)
+    except CalibrationError as e:
+        raise SdbError(str(e)) from None
 
 
 class EventDef:
@@ -221,14 +271,16 @@ def _operation(cname, op):
 
 
 class NodeDef:
-    """A SpaceCAN equipment node: its component name, node id and definition file."""
+    """A SpaceCAN equipment node: its component name, node id and definition file; ``role``
+    is ``nominal`` or ``redundant`` for the reconfiguration module's two controllers."""
 
-    __slots__ = ("name", "node_id", "definition")
+    __slots__ = ("name", "node_id", "definition", "role")
 
-    def __init__(self, name, node_id, definition):
+    def __init__(self, name, node_id, definition, role=None):
         self.name = name
         self.node_id = node_id
         self.definition = definition
+        self.role = role
 
     def __repr__(self):
         return "NodeDef(%s, %d)" % (self.name, self.node_id)
@@ -254,6 +306,8 @@ class Sdb:
         self.position_parameter = None  # service 22's position parameter (a Parameter)
         self.tm_vcs = None  # TM virtual channel plan (role -> VC ID), None: the default
         self.scid = None  # spacecraft id, when the database gives it
+        self.frames = {}  # the frames plan as given (scid, tc_vc, maps, tm_vcs, cfdp_vc)
+        self.pus = {}  # the PUS section as given: packet layout and source id (obsw.pus.config)
         self.nodes = {}  # SpaceCAN equipment name -> NodeDef
         self.base = base  # the folder relative paths start from
         self._params_by_name = {}
@@ -369,6 +423,8 @@ class Sdb:
             self.tm_vcs = {str(k): _int(v, "TM VC of %s" % k) for k, v in frames["tm_vcs"].items()}
         if "scid" in frames:
             self.scid = _int(frames["scid"], "spacecraft id")
+        self.frames = frames
+        self.pus = doc.get("pus") or {}
         ids = set()
         for n in doc.get("nodes", []):
             nid = _int(n["node_id"], "node id of %s" % n["name"])
@@ -378,7 +434,12 @@ class Sdb:
             path = n.get("definition")
             if path and self.base and not path.startswith("/"):
                 path = self.base + "/" + path
-            self.nodes[n["name"]] = NodeDef(n["name"], nid, path)
+            role = n.get("role")
+            if role not in (None, "nominal", "redundant"):
+                raise SdbError(
+                    "node %s: role %r, expected nominal or redundant" % (n["name"], role)
+                )
+            self.nodes[n["name"]] = NodeDef(n["name"], nid, path, role)
 
     def function(self, key):
         """The FunctionDef with this id or name ('SolarPanel.set_angle')."""
@@ -508,6 +569,7 @@ _KNOWN = (
     "position_scheduling",
     "frames",
     "nodes",
+    "pus",
 )
 
 

@@ -1,7 +1,8 @@
 """The reconfiguration module's main loop: SpaceCAN node, essential TC/TM, CPDU, safeguard
 memory, time reference and watchdog, on whatever hardware layer it is given.
 
-`ReconfigApp(hal).run()` on a board; tests and the host simulation call `step()` themselves.
+`ReconfigApp(hal, **mission.load()).run()` on a board (the mission's SCID, node ids, MAP and VC
+from ``obsw.reconfig.mission``); tests and the host simulation call `step()` themselves.
 Nothing in a step may raise into the loop: an error is counted, makes the application unhealthy
 for a while, and an unhealthy application stops kicking the watchdog.
 """
@@ -13,9 +14,11 @@ from obsw.reconfig.cpdu import Cpdu
 from obsw.reconfig.ds3231 import DS3231, TimeSync
 from obsw.reconfig.eeprom import M24512
 from obsw.reconfig.essential import (
+    ESSENTIAL_MAP,
     HPC_POWER_CYCLE,
     HPC_PRIORITY,
     HPC_SELECT_OBC,
+    HPTM_VCID,
     TARGET_BOTH,
     Essential,
     Hpc,
@@ -55,6 +58,9 @@ class ReconfigApp:
         hal,
         scid=0x42,
         node_id=None,
+        node_ids=(NODE_NOMINAL, NODE_REDUNDANT),
+        essential_map=ESSENTIAL_MAP,
+        hptm_vc=HPTM_VCID,
         heartbeat_period=0.5,
         watchdog_open_ms=100,
         watchdog_timeout_ms=1000,
@@ -77,8 +83,8 @@ class ReconfigApp:
         self.rtc = DS3231(hal.i2c, hal.rtc_address)
         self.sync = TimeSync(self.rtc)
         self.watchdog = Watchdog(hal, watchdog_open_ms, watchdog_timeout_ms)
-        if node_id is None:
-            node_id = NODE_NOMINAL if self.role == NOMINAL else NODE_REDUNDANT
+        if node_id is None:  # the mission's node of this controller (obsw.reconfig.mission)
+            node_id = node_ids[0] if self.role == NOMINAL else node_ids[1]
         self.node = CpduNode(self, node_id, heartbeat_period)
         # the events _can acts on; the others (SYNC above all, a frame kind a loaded bus may
         # carry thousands of times a second) are not built
@@ -87,6 +93,8 @@ class ReconfigApp:
             scid,
             self.role,
             self.in_charge,
+            essential_map=essential_map,
+            hptm_vcid=hptm_vc,
             obc_lines=obc_lines,
             tm_frame_length=tm_frame_length,
             security=essential_security,

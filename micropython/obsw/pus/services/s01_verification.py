@@ -16,6 +16,7 @@ from obsw.pus.messages import (
     FAILURE_ILLEGAL_APP_DATA,
     FAILURE_OBCP_REJECTED,
     FAILURE_OUT_OF_BOUNDS,
+    FAILURE_OUT_OF_RANGE,
     FAILURE_PATH,
     FAILURE_READBACK,
     FAILURE_REFUSED,
@@ -59,6 +60,7 @@ FAILURE_NAMES = {
     FAILURE_ABORTED: "aborted",
     FAILURE_WRITE_PROTECTED: "write-protected",
     FAILURE_READBACK: "read-back mismatch",
+    FAILURE_OUT_OF_RANGE: "out of range",
 }
 
 # stages of a request, in order

@@ -7,6 +7,11 @@ type) and the check type's own fields: an expected-value check has a mask, an ex
 value and an event; a limit check a low limit and its event and a high limit and its event
 (limits of the parameter's own type); a delta check low and high thresholds on the mean of
 a number of consecutive deltas (float64) with their events. Event ID 0 raises no event.
+A check transition of an expected-value check carries the check's mask before the value.
+
+A functional monitoring definition (FMON) is an ID, a validity condition (parameter, mask,
+expected value), the event it raises when it fails, the minimum number of failing PMONs that
+fails it, and its PMON IDs; reports add its protection and enabled statuses.
 """
 
 from obsw.bits import Decoder, Encoder
@@ -64,6 +69,56 @@ DELAY_LAYOUT = Structure([("delay", DELAY)])
 STATUS_REPORT = Structure(
     [("items", Repeated(PMON_COUNT, [("pmon", PMON_ID), ("enabled", STATUS)]))]
 )
+
+
+# functional monitoring (FMON): field sizes, statuses, messages
+FMON_ID = U16
+FMON_COUNT = U16
+FAILING_NUMBER = U16  # minimum number of failing PMONs that fails the FMON
+PROTECTION = E8  # 1 protected, 0 unprotected
+FMON_CHECKING_STATUS = E8
+FMON_UNCHECKED = const(0)
+FMON_RUNNING = const(1)
+FMON_INVALID = const(2)
+FMON_FAILED = const(3)
+FMON_STATUS_NAMES = {
+    FMON_UNCHECKED: "unchecked",
+    FMON_RUNNING: "running",
+    FMON_INVALID: "invalid",
+    FMON_FAILED: "failed",
+}
+
+
+class FmonLayouts:
+    """The functional monitoring messages: ``ids`` (TC[12,19]-[12,22], [12,24], [12,25]),
+    ``add`` (TC[12,23]), ``report`` (TM[12,26]), ``status`` (TM[12,28]). Built on first use
+    by ``fmon_layouts()``: a board that defines no FMON keeps their heap."""
+
+    def __init__(self):
+        validity = [
+            ("validity", PARAMETER_ID),
+            ("validity_mask", MASK),
+            ("validity_value", MASK),
+        ]
+        pmons = ("pmons", Repeated(FMON_COUNT, PMON_ID))
+        self.ids = Structure([("ids", Repeated(FMON_COUNT, FMON_ID))])
+        tail = [("event", EVENT_ID), ("failing", FAILING_NUMBER), pmons]
+        head = [("fmon", FMON_ID)] + validity
+        self.add = Structure([("items", Repeated(FMON_COUNT, head + tail))])
+        flags = [("protected", PROTECTION), ("enabled", STATUS)]
+        self.report = Structure([("items", Repeated(FMON_COUNT, head + flags + tail))])
+        status = [("fmon", FMON_ID)] + flags + [("checking", FMON_CHECKING_STATUS)]
+        self.status = Structure([("items", Repeated(FMON_COUNT, status))])
+
+
+_fmon_layouts = []
+
+
+def fmon_layouts():
+    """The one ``FmonLayouts``, built on the first call."""
+    if not _fmon_layouts:
+        _fmon_layouts.append(FmonLayouts())
+    return _fmon_layouts[0]
 
 
 class Items:
@@ -144,7 +199,9 @@ class Layouts:
             ("time", TRANSITION_TIME),
         ]
         entries = {
-            CHECK_EXPECTED_VALUE: Structure([("value", value), ("limit", MASK)] + tail),
+            CHECK_EXPECTED_VALUE: Structure(
+                [("mask", MASK), ("value", value), ("limit", MASK)] + tail
+            ),
             CHECK_LIMIT: Structure([("value", value), ("limit", value)] + tail),
             CHECK_DELTA: Structure([("value", DELTA), ("limit", DELTA)] + tail),
         }

@@ -10,8 +10,14 @@ transition reporting delay (in cycles); a transition out of limits raises the ch
 through the application process (service 5 reports it, service 19 may act on it), with the
 PMON ID and the parameter ID as auxiliary data. New definitions are disabled; disabling
 one makes it unchecked. An enabled definition cannot be deleted, nor every definition
-while the monitoring function is enabled. Definitions persist in the context store.
-Functional monitoring (TC[12,17] and after) is not provided.
+while the monitoring function is enabled, nor a PMON that a functional monitoring
+definition uses. Definitions persist in the context store. Functional monitoring
+(TC[12,17] to TM[12,28]) is ``obsw.pus.services.s12_functional``, a subclass of this provider
+(a board that needs parameter monitoring only keeps its heap).
+
+Limits are raw values of the parameter's own type, as the standard's messages carry them:
+the ground converts engineering limits to raw ones (``obsw.pus.calibration``), so no
+calibration runs on board for a check.
 """
 
 from obsw.pus.messages import (
@@ -215,6 +221,9 @@ class OnBoardMonitoring(Service):
         for i in ids:
             if self.pmons[i].enabled:
                 raise _pmon_failure(FAILURE_REFUSED, "PMON %d is enabled" % i, i)
+            fmon = self.user_of(i)
+            if fmon is not None:
+                raise _pmon_failure(FAILURE_REFUSED, "FMON %d uses PMON %d" % (fmon, i), i)
         req.start()
         for i in ids:
             del self.pmons[i]
@@ -224,6 +233,8 @@ class OnBoardMonitoring(Service):
         req.decode(EMPTY)
         if self.function:
             raise PusFailure(FAILURE_REFUSED, "the monitoring function is enabled")
+        if self.user_of(None) is not None:
+            raise PusFailure(FAILURE_REFUSED, "functional monitoring definitions use the PMONs")
         req.start()
         self.pmons = {}
         self.persist()
@@ -276,6 +287,8 @@ class OnBoardMonitoring(Service):
             for m in self.pmons.values():
                 m.reset()
         self.function = enabled
+        if not enabled:
+            self.functional_stop()
         self.persist()
 
     def enable_function(self, req):
@@ -311,6 +324,19 @@ class OnBoardMonitoring(Service):
             {"pmon": i, "enabled": 1 if m.enabled else 0} for i, m in sorted(self.pmons.items())
         ]
         req.report(TM_MON_PARAMETER_MONITORING_STATUS_REPORT, STATUS_REPORT.pack({"items": items}))
+
+    # -------------------------------------------------------------------------- hooks
+
+    def user_of(self, pmon):
+        """The ID of a functional monitoring definition that uses PMON ``pmon`` (any PMON:
+        None), or None; none here (``obsw.pus.services.s12_functional`` has them)."""
+        return None
+
+    def functional_stop(self):
+        """The parameter monitoring function was disabled (functional monitoring stops)."""
+
+    def functional_cycle(self):
+        """Evaluate functional monitoring after the PMONs of a cycle."""
 
     # -------------------------------------------------------------------------- monitoring
 
@@ -370,6 +396,8 @@ class OnBoardMonitoring(Service):
             "current": status,
             "time": self.app.time(),
         }
+        if d["check"] == CHECK_EXPECTED_VALUE:
+            entry["mask"] = d["mask"]
         m.status = status
         m.transition = entry
         self.transitions += 1
@@ -410,6 +438,10 @@ class OnBoardMonitoring(Service):
                     self.sample(m)
                 except (KeyError, TypeError, ValueError):
                     self.app.count("monitoring_errors")
+        try:
+            self.functional_cycle()
+        except (KeyError, TypeError, ValueError):
+            self.app.count("monitoring_errors")
         self.flush()
 
     def flush(self, force=False):

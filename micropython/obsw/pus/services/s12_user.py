@@ -1,7 +1,8 @@
 """The ST[12] on-board monitoring user: definitions sent, reports decoded.
 
 ``limit_check``, ``expected_value_check`` and ``delta_check`` build definitions; checks and
-statuses are the numbers of ``obsw.pus.services.s12_layouts``.
+statuses are the numbers of ``obsw.pus.services.s12_layouts``. Functional monitoring is
+``obsw.pus.services.s12_functional_user``.
 """
 
 from obsw.pus.messages import (

@@ -72,23 +72,32 @@ def test_watch_refuses_times_that_are_not_positive(bad):
     assert r.returncode == 2 and "--seconds" in r.stderr and "Traceback" not in r.stderr
 
 
-def _read_until(fd, needle, seconds=BOUND):
-    """What the terminal shows until ``needle`` appears (AssertionError after ``seconds``)."""
-    got = b""
-    end = time.monotonic() + seconds
-    while needle.encode() not in got:
-        left = end - time.monotonic()
-        assert left > 0, "%r not seen in %r" % (needle, got[-600:])
-        r, _, _ = select.select([fd], [], [], left)
-        if r:
-            try:
-                chunk = os.read(fd, 4096)
-            except OSError:
-                break
-            if not chunk:
-                break
-            got += chunk
-    return got.decode(errors="replace")
+class Terminal:
+    """The master side of a pseudo-terminal: what it shows, read up to each needle in turn."""
+
+    def __init__(self, fd):
+        self.fd = fd
+        self.pending = b""
+
+    def until(self, needle, seconds=BOUND):
+        """What the terminal shows up to and including ``needle`` (AssertionError after
+        ``seconds``); what came after it stays for the next call."""
+        end = time.monotonic() + seconds
+        want = needle.encode()
+        while want not in self.pending:
+            left = end - time.monotonic()
+            assert left > 0, "%r not seen in %r" % (needle, self.pending[-600:])
+            r, _, _ = select.select([self.fd], [], [], left)
+            if r:
+                try:
+                    chunk = os.read(self.fd, 4096)
+                except OSError:
+                    chunk = b""
+                assert chunk, "%r not seen before the end: %r" % (needle, self.pending[-600:])
+                self.pending += chunk
+        cut = self.pending.index(want) + len(want)
+        shown, self.pending = self.pending[:cut], self.pending[cut:]
+        return shown.decode(errors="replace")
 
 
 def test_console_in_a_terminal_pings_reads_a_parameter_and_keeps_history(obc, tmp_path):  # noqa: F811 (the fixture)
@@ -106,17 +115,18 @@ def test_console_in_a_terminal_pings_reads_a_parameter_and_keeps_history(obc, tm
         start_new_session=True,
     )
     os.close(slave)
+    term = Terminal(master)
     try:
-        _read_until(master, "obsw-demo>")
+        term.until("obsw-demo>")
         os.write(master, b"ping\r")
-        assert "alive" in _read_until(master, "alive")
-        _read_until(master, "obsw-demo>")
+        assert "alive" in term.until("alive")
+        term.until("obsw-demo>")
         os.write(master, b"params get SolarPanel.sp\t")  # Tab completes the name
-        _read_until(master, "speed")
+        term.until("speed")
         os.write(master, b"\r")
-        shown = _read_until(master, "deg/s")
+        shown = term.until("deg/s")
         assert "SolarPanel.speed = " in shown
-        _read_until(master, "obsw-demo>")  # (typed ahead, Ctrl-D would be the tty's EOF)
+        term.until("obsw-demo>")  # (typed ahead, Ctrl-D would be the tty's EOF)
         os.write(master, b"\x04")  # Ctrl-D leaves
         assert proc.wait(BOUND) == 0
     finally:

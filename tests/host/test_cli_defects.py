@@ -176,3 +176,16 @@ def _alive(pid):
             return f.read().split(") ")[1][0] != "Z"
     except OSError:
         return False
+
+
+def test_no_answer_names_the_port_the_ground_used(tmp_path):
+    env = dict(ENV, OBSW_PORT_BASE="17000")
+    r = subprocess.run(
+        OBSW + ["ground", "--timeout", "0.3", "ping"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=BOUND,
+    )
+    assert r.returncode == 1
+    assert "no report from 127.0.0.1:17010 within 0.3s" in r.stdout + r.stderr

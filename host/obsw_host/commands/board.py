@@ -1,6 +1,7 @@
 """`obsw board`: build, deploy, flash, repl and test the reconfiguration module's Pyboard."""
 
 import signal
+import sys
 
 
 def add_parser(sub):
@@ -104,9 +105,22 @@ def _interrupt(signum, frame):
 def _deploy(args):
     from obsw_host import board
 
-    return _guard(
-        lambda: print("%d modules deployed" % len(board.deploy(args.port, march=args.march)))
-    )
+    def go():
+        names = board.deploy(args.port, march=args.march, progress=_progress)
+        print("%d modules deployed" % len(names))
+
+    return _guard(go)
+
+
+def _progress(text):
+    """One step of long work on stderr: rewritten in place on a terminal, a line otherwise."""
+    if sys.stderr.isatty():
+        sys.stderr.write("\r\x1b[K" + text)
+        if text.startswith("copying"):
+            sys.stderr.write("\n")
+    else:
+        sys.stderr.write(text + "\n")
+    sys.stderr.flush()
 
 
 def _flash(args):

@@ -189,3 +189,43 @@ def test_no_answer_names_the_port_the_ground_used(tmp_path):
     )
     assert r.returncode == 1
     assert "no report from 127.0.0.1:17010 within 0.3s" in r.stdout + r.stderr
+
+
+def tcp_port():
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def test_yamcs_run_leaves_nothing_in_the_temp_folder_when_terminated(tmp_path):
+    from obsw_host.yamcs import server
+
+    if server.missing():
+        pytest.skip(server.missing())
+    temp = tmp_path / "temp"
+    temp.mkdir()
+    env = dict(ENV, TMPDIR=str(temp), OBSW_PORT_BASE=str(udp_port() - 10))
+    ports = ["--http-port", tcp_port(), "--pus-port", tcp_port(), "--cfdp-port", udp_port()]
+    ports += ["--cltu-port", udp_port(), "--tm-frames-port", udp_port()]
+    run = subprocess.Popen(
+        OBSW + ["yamcs", "run"] + [str(p) for p in ports],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        out = Lines(run.stdout)
+        assert "starting Yamcs" in out.until(lambda line: "Yamcs" in line)  # said at once
+        out.until(lambda line: "(Ctrl-C stops)" in line)
+        assert os.listdir(temp)  # its instance lives there while it runs
+        run.send_signal(signal.SIGTERM)  # as a service manager stops it
+        assert run.wait(120) == 0  # a clean stop, as by Ctrl-C
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+            run.wait()
+    assert os.listdir(temp) == []

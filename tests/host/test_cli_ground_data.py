@@ -85,3 +85,14 @@ def test_tc_by_name_checked_against_types_and_ranges_before_sending(obc):  # noq
         assert r.returncode == 2 and says in r.stderr, (args, r.stderr)
         assert "TC ->" not in r.stderr  # nothing was sent
     assert ok(port, "params", "get", "SolarPanel.speed") == ["SolarPanel.speed = 7.5 deg/s"]
+
+
+def test_a_tc_sent_in_large_packet_parts_is_verified_as_itself(obc):  # noqa: F811
+    port, _ = obc
+    r = ground(port, "-v", "--json", "large", 17, 1, "--part-size", 4)
+    out = json.loads(r.stdout.splitlines()[-1])
+    assert r.returncode == 0 and out["request"] == "TC[17,1]", r.stdout
+    assert out["verification"][-1] == "completion success"
+    assert "TC[13,9]" in r.stderr and "TC[13,11]" in r.stderr  # it went in parts
+    out = json.loads(ground(port, "--json", "large", 3, 99).stdout)
+    assert out["request"] == "TC[3,99]" and out["failure"]["code"] == 4  # illegal subtype

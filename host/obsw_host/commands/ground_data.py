@@ -14,6 +14,8 @@ downlink (service 15) and files (service 23).
     obsw ground file copy SAT:/a.dat SAT:/b.dat [--move]        TC[23,14|15]
     obsw ground file attributes SAT:/a.dat | find SAT:/ "*.dat" | delete SAT:/b.dat
     obsw ground file create SAT:/log.txt [--max-size N] | mkdir SAT:/d | rmdir SAT:/d
+    obsw ground large 17 1                      a TC (here TC[17,1]) in parts, TC[13,9..11];
+    obsw ground large 6 2 --file patch.bin      its own verification reports at the end
 
 Times are UTC (YYYY-MM-DDTHH:MM:SS[.fff]Z); replies print by name, as tables.
 """
@@ -21,6 +23,7 @@ Times are UTC (YYYY-MM-DDTHH:MM:SS[.fff]Z); replies print by name, as tables.
 import argparse
 
 from obsw.pus.sdb import field_type
+from obsw.pus.services.schedule_user import embed
 from obsw.utc import parse_utc
 
 from obsw_host.commands import ground
@@ -45,6 +48,17 @@ def add_to_ground(s):
     st.add_parser("disable", help="TC[4,5]").set_defaults(func=_stats, what="disable")
 
     _add_store(_subparsers(s.choices["store"]))
+
+    x = s.add_parser(
+        "large",
+        help="service 13: send a TC in parts (TC[13,9..11]), e.g. one larger than the link takes",
+    )
+    x.add_argument("service", type=int)
+    x.add_argument("subtype", type=int)
+    x.add_argument("data", nargs="?", default="", help="application data, hex")
+    x.add_argument("--file", help="application data from this file instead")
+    x.add_argument("--part-size", type=int, default=256, help="octets per part (default 256)")
+    x.set_defaults(func=_large)
 
     fi = s.add_parser("file", help="service 23 file management").add_subparsers(dest="f23")
     fi.required = True
@@ -222,6 +236,35 @@ def _file(args):
         if args.what == "mkdir":
             return sg.issue(files.create_directory(apid, args.path))
         return sg.issue(files.delete_directory(apid, args.path))
+
+    return ground._run(args, go)
+
+
+def _large(args):
+    """The TC SERVICE SUBTYPE DATA, sent in parts of service 13; the inner TC's reports."""
+    if args.file:
+        with open(args.file, "rb") as f:
+            data = f.read()
+    else:
+        try:
+            data = bytes.fromhex(args.data)
+        except ValueError:
+            raise UserError("application data %r" % args.data, expected="hex octets") from None
+    for what, value in (("service", args.service), ("subtype", args.subtype)):
+        if not 0 <= value <= 255:
+            raise UserError("%s %d" % (what, value), expected="0 to 255")
+    if args.part_size < 1:
+        raise UserError("part size %d" % args.part_size, expected="at least 1 octet")
+
+    def go(g):
+        sg = StorageGround(g)
+        sg.large.part_size = args.part_size
+        raw, inner = embed(g.proc, g.apid, args.service, args.subtype, data)
+        for part in sg.large.uplink(g.apid, raw):
+            sg.issue(part)
+            if not part.ok:
+                return part  # the part's failure report says why
+        return g.wait(inner)
 
     return ground._run(args, go)
 

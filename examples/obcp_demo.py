@@ -33,9 +33,9 @@ def run(out=print, timeout=15.0):
     from obsw_host.pus.ground import Ground
     from obsw_host.pus.obcp_ground import ObcpGround, explain
     from obsw_host.pus.obcp_onboard import onboard_with_obcp
-    from obsw_host.sample import load_sdb
+    from obsw_host.sample import SDB_PATH, load_sdb
 
-    sdb = load_sdb()
+    sdb = load_sdb(SDB_PATH)
     files = tempfile.mkdtemp(prefix="obsw-obcp-files-")
     os.mkdir(os.path.join(files, "obcp"))
     with open(os.path.join(files, "obcp", "turn_panel.plt"), "w") as f:

@@ -9,7 +9,7 @@ an action (service 19), and a time-tagged TC (service 11) runs at its release ti
 import sys
 
 from obsw_host.ports import app_port
-from obsw_host.sample import SDB_PATH, load_sdb  # noqa: F401
+from obsw_host.sample import SDB_PATH, load_sdb
 
 
 def _start_onboard(sdb, out, components):
@@ -27,7 +27,7 @@ def run(out=print):
     from obsw_host.pus.ground import Ground
     from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 
-    sdb = load_sdb()
+    sdb = load_sdb(SDB_PATH)
     panel = SolarPanel()
     onboard = _start_onboard(sdb, out, [(SOLAR_PANEL, panel)])
     ok = True

@@ -52,9 +52,9 @@ class Segment:
         tm_frame_length=256,
     ):
         from obsw_host.pus.onboard import Onboard
-        from obsw_host.sample import load_sdb
+        from obsw_host.sample import SDB_PATH, load_sdb
 
-        self.sdb = sdb = sdb or load_sdb()
+        self.sdb = sdb = sdb or load_sdb(SDB_PATH)
         self.work = work
         self.log = log
         self.timeout = timeout

@@ -7,12 +7,13 @@ import os
 import sys
 
 from obsw_host.pus.coverage import coverage, markdown, obc_services
+from obsw_host.sample import MISSION_DIR
 
 PAGE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "pus-coverage.md")
 
 
 def main(argv):
-    text = markdown(coverage(obc_services()))
+    text = markdown(coverage(obc_services(MISSION_DIR)))
     if "--check" in argv:
         with open(PAGE) as f:
             current = f.read() == text

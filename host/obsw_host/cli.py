@@ -29,6 +29,7 @@ COMMANDS = {
     "board": "Pyboard firmware for the reconfiguration module",
     "yamcs": "mission control with Yamcs: XTCE, instance, server",
     "pus": "PUS-C: the standard's message types the OBC serves",
+    "mission": "check, create or upgrade a mission folder",
 }
 ANYWHERE = ("--json", "--debug")  # flags accepted at any position before "--"
 USAGE_ERROR = 2

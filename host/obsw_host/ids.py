@@ -20,11 +20,11 @@ from obsw.frames.tm_plan import TmPlanError, plan_channels, tm_plan
 from obsw.pus import sdb as sdb_module
 from obsw.pus.config import PusLayoutError, from_sdb
 
+from obsw_host import mission, sample
 from obsw_host.errors import UserError
 from obsw_host.obc import config as mission_config
 from obsw_host.ports import Ports
 
-MISSION_FILE = "mission.json"  # the mission file of a mission folder
 ESSENTIAL_MAP = 63  # the reconfiguration module's MAP unless the frames plan names one
 PACKETS_MAP = 1  # the MAP of ordinary TC packets unless the frames plan names one
 FRAMES_KEYS = ("scid", "tc_vc", "maps", "tm_vcs", "cfdp_vc")
@@ -55,22 +55,9 @@ class MissionError(UserError):
 
 
 def locate(path=None):
-    """The mission file of ``path``: a folder holding ``mission.json``, or a mission file;
-    None: ``./mission.json`` if there is one, else the sample spacecraft's."""
-    if path is None:
-        here = os.path.join(os.getcwd(), MISSION_FILE)
-        return here if os.path.isfile(here) else mission_config.SAMPLE
-    if os.path.isdir(path):
-        found = os.path.join(path, MISSION_FILE)
-        if not os.path.isfile(found):
-            raise UserError(
-                "%s: no %s in this folder" % (path, MISSION_FILE),
-                expected="a mission folder or a mission file",
-            )
-        return found
-    if not os.path.exists(path):
-        raise UserError("%s: no such file or directory" % path, expected="a mission folder")
-    return path
+    """The mission file of ``path`` (``obsw_host.mission.locate``: a folder or file,
+    $OBSW_MISSION, or the nearest ``mission.json``; never the sample silently)."""
+    return mission.locate(path)
 
 
 def load_config(path):
@@ -121,7 +108,7 @@ class MissionIds:
     @classmethod
     def sample(cls):
         """The ids of the sample spacecraft shipped with the product (demos, simulations)."""
-        return cls.locate(mission_config.SAMPLE)
+        return cls.locate(sample.MISSION_PATH)
 
     def _port_section(self):
         """The mission file's ``ports``, with the ports older mission files give in their

@@ -1,14 +1,22 @@
-"""The sample spacecraft shipped with the product: its database, loaded by name."""
+"""The sample spacecraft: the mission folder ``examples/sample`` of the source tree, by name.
+
+Nothing uses it by default: callers name it through these constants (tests, demos, examples).
+It is not part of an installed package; ``obsw mission new NAME`` writes a mission folder from
+the template the package ships (``obsw_host/mission/template``).
+"""
 
 import os
 
-DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
-SDB_PATH = os.path.join(DATA, "sdb.json")
-CPDU_NODE_PATH = os.path.join(DATA, "cpdu_node.json")
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+MISSION_DIR = os.path.join(ROOT, "examples", "sample")
+MISSION_PATH = os.path.join(MISSION_DIR, "mission.json")
+SDB_PATH = os.path.join(MISSION_DIR, "sdb.json")
+CPDU_NODE_PATH = os.path.join(MISSION_DIR, "nodes", "cpdu.json")
+PROCEDURES_DIR = os.path.join(MISSION_DIR, "procedures")
 
 
 def load_sdb(path=None):
-    """The spacecraft database at ``path`` (default: the sample); errors say which file."""
+    """The spacecraft database at ``path`` (default: the sample's); errors say which file."""
     from obsw.pus import sdb as sdb_module
 
     path = path or SDB_PATH

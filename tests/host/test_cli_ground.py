@@ -11,6 +11,7 @@ import sys
 import threading
 
 import pytest
+from obsw_host.sample import SDB_PATH
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 OBSW = [sys.executable, "-m", "obsw_host.cli"]
@@ -116,10 +117,12 @@ def obc(tmp_path):
     mission.write_text(
         json.dumps(
             {
+                "format": 2,
                 "name": "test-ground",
-                "sdb": os.path.join(ROOT, "host", "obsw_host", "data", "sdb.json"),
+                "sdb": SDB_PATH,
                 "state": "state",
-                "processes": {"obc": ["pus", "solar_panel"]},
+                "processes": {"obc": ["pus", "SolarPanel"]},
+                "components": {"SolarPanel": {"module": "obsw_host.solar_panel"}},
                 "pus": {"apid": 10, "period": 0.1},
             }
         )

@@ -139,9 +139,11 @@ def test_every_file_shown_exists():
 def test_the_obc_configurations_shown_are_accepted(tmp_path):
     configs = [(page, json.loads(b)) for page, b in _json_blocks() if '"processes"' in b]
     assert {str(page) for page, _ in configs} == {
-        "docs/obc.md",
+        "examples/sample/mission.json",
         "docs/topology.md",
         "boards/raspberry-pi/mission.json",
+        "docs/mission.md",
+        "docs/fly-your-own-spacecraft.md",
     }
     for page, doc in configs:
         config = MissionConfig(doc, str(tmp_path / "mission.json"))

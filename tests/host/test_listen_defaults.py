@@ -11,7 +11,7 @@ from obsw_host.frames.station import GroundStation
 from obsw_host.net import DEFAULT_HOST
 from obsw_host.pus.onboard import Onboard
 from obsw_host.reconfig.canhub import CanHub
-from obsw_host.sample import load_sdb
+from obsw_host.sample import MISSION_DIR, SDB_PATH, load_sdb
 from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 
 HOST_TREE = os.path.join(os.path.dirname(__file__), "..", "..", "host", "obsw_host")
@@ -48,7 +48,7 @@ def test_ground_station_binds_loopback():
 
 def test_pus_process_binds_loopback():
     panel = [(SOLAR_PANEL, SolarPanel())]  # hosted here: no wait for a remote component
-    onboard = Onboard(load_sdb(), port=0, period=0.05, components=panel).start()
+    onboard = Onboard(load_sdb(SDB_PATH), port=0, period=0.05, components=panel).start()
     try:
         assert onboard.address[0] == "127.0.0.1"
     finally:
@@ -79,7 +79,7 @@ def test_commands_default_to_loopback():
     parser = build_parser()
     from obsw_host.obc.config import load
 
-    assert load(None).host == DEFAULT_HOST  # what `obsw obc serve` binds without a CONFIG
+    assert load(MISSION_DIR).host == DEFAULT_HOST  # the sample binds loopback: it names none
     args = parser.parse_args(["frames", "processor", "--uart-a", "a", "--uart-b", "b"])
     assert args.host == DEFAULT_HOST
 

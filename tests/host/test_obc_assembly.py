@@ -15,6 +15,7 @@ from obsw.pus.tm import PusTm
 from obsw_host.obc import config as obc_config
 from obsw_host.obc.platform import PlatformManager
 from obsw_host.pus.ground import Ground
+from obsw_host.sample import MISSION_DIR, MISSION_PATH
 
 WAIT = 30.0
 
@@ -38,13 +39,13 @@ def free_port():
 
 
 def sample():
-    with open(obc_config.SAMPLE) as f:
+    with open(MISSION_PATH) as f:
         return json.load(f)
 
 
 def write_config(tmp_path, doc):
-    """The sample's relative paths point into the package: make them absolute here."""
-    base = os.path.dirname(obc_config.SAMPLE)
+    """The sample's relative paths point into its folder: make them absolute here."""
+    base = MISSION_DIR
     doc["sdb"] = os.path.join(base, doc["sdb"])
     if "obcp" in doc:
         doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])
@@ -55,10 +56,8 @@ def write_config(tmp_path, doc):
 
 
 def test_sample_loads_and_paths_are_relative_to_the_file():
-    c = obc_config.load()
-    assert c.sdb_path == os.path.normpath(
-        os.path.join(os.path.dirname(obc_config.SAMPLE), "..", "..", "data", "sdb.json")
-    )
+    c = obc_config.load(MISSION_DIR)
+    assert c.sdb_path == os.path.join(MISSION_DIR, "sdb.json")
     assert os.path.exists(c.sdb_path)
     assert c.host == "127.0.0.1"
     assert c.process_of("pus") == c.process_of("obcp") == c.process_of("cfdp")

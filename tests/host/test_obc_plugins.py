@@ -12,6 +12,7 @@ from obsw_host.il.transport import SocketTransport
 from obsw_host.obc import config as obc_config
 from obsw_host.obc.platform import PlatformManager
 from obsw_host.pus.ground import Ground
+from obsw_host.sample import MISSION_PATH
 from test_obc_assembly import free_port, sample, wait_for, write_config
 
 
@@ -91,7 +92,7 @@ def test_a_component_that_starts_after_the_obc(tmp_path):
 
 
 def test_the_sample_mission_names_its_solar_panel_as_a_plug_in():
-    with open(obc_config.SAMPLE) as f:
+    with open(MISSION_PATH) as f:
         doc = json.load(f)
     assert doc["components"] == {"SolarPanel": {"module": "obsw_host.solar_panel"}}
     assert "SolarPanel" in doc["processes"]["obc"]

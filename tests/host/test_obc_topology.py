@@ -10,6 +10,7 @@ from obsw_host.obc import registry
 from obsw_host.obc.plugins import Component, PluginError, component_for
 from obsw_host.obc.topology import Topology
 from obsw_host.pus.onboard import SERVICES
+from obsw_host.sample import MISSION_DIR, MISSION_PATH
 from test_obc_assembly import free_port
 
 PLUGIN = """
@@ -35,14 +36,14 @@ class Torquer:
 
 
 def sample():
-    with open(obc_config.SAMPLE) as f:
+    with open(MISSION_PATH) as f:
         return json.load(f)
 
 
 def mission(tmp_path, change=None, plugin=PLUGIN):
     """The sample with its paths made absolute, changed by ``change``, in ``tmp_path``."""
     doc = sample()
-    base = os.path.dirname(obc_config.SAMPLE)
+    base = os.path.dirname(MISSION_PATH)
     doc["sdb"] = os.path.join(base, doc["sdb"])
     doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])
     doc["state"] = str(tmp_path / "state")
@@ -64,7 +65,7 @@ def test_every_registered_unit_kind_imports_and_has_the_unit_methods():
 
 
 def test_the_sample_topology():
-    topology = Topology(obc_config.load()).check()
+    topology = Topology(obc_config.load(MISSION_DIR)).check()
     (obc,) = topology.processes
     assert [label for label, _ in obc.units()] == ["pus", "spacecan"]
     assert [c.name for c in obc.components] == ["SolarPanel"]
@@ -84,7 +85,7 @@ def test_the_database_is_read_once(monkeypatch):
     calls = []
     real = obsw_host.sample.load_sdb
     monkeypatch.setattr(obsw_host.sample, "load_sdb", lambda p: calls.append(p) or real(p))
-    topology = Topology(obc_config.load())
+    topology = Topology(obc_config.load(MISSION_DIR))
     topology.pus_apid()
     topology.equipments()
     topology.interfaces()
@@ -110,7 +111,7 @@ def test_a_legacy_solar_panel_kind_is_the_plug_in():
     doc = sample()
     doc["processes"] = {"obc": ["pus", "solar_panel"]}
     del doc["components"]
-    c = obc_config.MissionConfig(doc, obc_config.SAMPLE)
+    c = obc_config.MissionConfig(doc, MISSION_PATH)
     assert c.processes == {"obc": ["pus", "SolarPanel"]}
     assert Topology(c).components["SolarPanel"].module_ref == "obsw_host.solar_panel"
 

@@ -10,6 +10,7 @@ from obsw.pus import messages
 from obsw_host.cli import main
 from obsw_host.pus.coverage import coverage, markdown, obc_services
 from obsw_host.pus.standard import MESSAGE_TYPES
+from obsw_host.sample import MISSION_DIR
 
 ROOT = os.path.join(os.path.dirname(__file__), "..", "..")
 PAGE = os.path.join(ROOT, "docs", "pus-coverage.md")
@@ -21,7 +22,7 @@ ELSEWHERE = set()
 
 @pytest.fixture(scope="module")
 def report():
-    return coverage(obc_services())
+    return coverage(obc_services(MISSION_DIR))
 
 
 def test_the_table_has_the_standards_318_types_once_each():
@@ -68,11 +69,11 @@ def test_the_docs_page_is_generated_from_the_report(report):
 
 
 def test_the_command_prints_json_and_text(capsys):
-    assert main(["pus", "coverage", "--json"]) == 0
+    assert main(["pus", "coverage", MISSION_DIR, "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["total"] == 318
     assert [s["service"] for s in out["services"]][:3] == [1, 2, 3]
-    assert main(["pus", "coverage", "--missing"]) == 0
+    assert main(["pus", "coverage", MISSION_DIR, "--missing"]) == 0
     text = capsys.readouterr().out
     assert text.strip().endswith("of 318 message types served")
     assert "ST[17] test" in text

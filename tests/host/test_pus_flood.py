@@ -107,10 +107,11 @@ def free_port():
 def test_flood_into_the_obc_core_process(tmp_path):
     from obsw_host.obc import config as obc_config
     from obsw_host.obc.assembly import ObcProcess
+    from obsw_host.sample import MISSION_DIR, MISSION_PATH
 
-    with open(obc_config.SAMPLE) as f:
+    with open(MISSION_PATH) as f:
         doc = json.load(f)
-    base = os.path.dirname(obc_config.SAMPLE)
+    base = MISSION_DIR
     doc["sdb"] = os.path.join(base, doc["sdb"])
     if "obcp" in doc:
         doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])

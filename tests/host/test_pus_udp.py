@@ -11,13 +11,13 @@ from obsw_host.commands import ground as ground_command
 from obsw_host.ports import app_port
 from obsw_host.pus.ground import Ground, PusTimeout
 from obsw_host.pus.onboard import Onboard
-from obsw_host.sample import load_sdb
+from obsw_host.sample import SDB_PATH, load_sdb
 from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 
 
 @pytest.fixture
 def system(tmp_path):
-    sdb = load_sdb()
+    sdb = load_sdb(SDB_PATH)
     panel = SolarPanel()
     onboard = Onboard(
         sdb,
@@ -34,7 +34,7 @@ def system(tmp_path):
 
 
 def test_port_convention():
-    sdb = load_sdb()
+    sdb = load_sdb(SDB_PATH)
     assert app_port(sdb.apid("pus")) == 5000 + sdb.apid("pus")
     assert Onboard(sdb).port == 5000 + sdb.apid("pus")
 
@@ -125,7 +125,7 @@ def test_time_reports(system):
 
 
 def test_timeout_names_the_transaction():
-    sdb = load_sdb()
+    sdb = load_sdb(SDB_PATH)
     with Ground(sdb, target=("127.0.0.1", 9), timeout=0.05) as ground:
         with pytest.raises(PusTimeout) as e:
             ground.ping()

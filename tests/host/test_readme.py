@@ -154,6 +154,7 @@ def test_every_example_runs(page, tmp_path):
         OBSW_IL_DIR=str(tmp_path / "il"),
         TMPDIR=str(tmp_path),
         HOME=str(tmp_path / "home"),  # what the examples write under ~ stays here
+        OBSW_MISSION=str(work / "sample"),  # the reader's session names its mission once
         PYTHONPATH=os.pathsep.join([str(work), str(ROOT / "micropython"), str(ROOT / "host")]),
     )
     os.makedirs(env["OBSW_IL_DIR"])

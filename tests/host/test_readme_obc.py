@@ -14,6 +14,7 @@ import sys
 import time
 
 import pytest
+from obsw_host.sample import MISSION_DIR
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PAGES = ("docs/pus.md", "docs/obcp.md", "docs/obc.md")  # the pages whose examples need the OBC
@@ -64,8 +65,12 @@ def ports_free(ports=(5010, 5100)):
     return True
 
 
+# the reader's session names its mission once, as the docs say (`export OBSW_MISSION=...`)
+ENV = dict(os.environ, OBSW_MISSION=MISSION_DIR)
+
+
 def run(argv, cwd, timeout=COMMAND_TIMEOUT):
-    return subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=timeout, env=ENV)
 
 
 def test_every_obc_example_of_the_docs(tmp_path, capsys):
@@ -80,6 +85,7 @@ def test_every_obc_example_of_the_docs(tmp_path, capsys):
 
     for name in ("turn.plt",):
         (tmp_path / name).write_text(DEMO_PROCEDURE)
+    os.symlink(MISSION_DIR, tmp_path / "sample")  # the pages run from examples/: `sample` there
     state = tmp_path / "state"
     t0 = time.monotonic()
     end = t0 + 300.0
@@ -90,6 +96,7 @@ def test_every_obc_example_of_the_docs(tmp_path, capsys):
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         start_new_session=True,
+        env=ENV,
     )
     try:
         end = time.monotonic() + 60.0

@@ -8,8 +8,10 @@ import pytest
 from obsw.reconfig.essential import HPC_POWER_CYCLE, Hpc
 from obsw.reconfig.hal import NOMINAL, REDUNDANT
 from obsw.reconfig.node import definition_dict
+from obsw_host.mission.new import TEMPLATE_DIR
 from obsw_host.reconfig import simhal as W
 from obsw_host.reconfig.sim import ReconfigSim, micropython_binary
+from obsw_host.sample import CPDU_NODE_PATH
 
 pytestmark = pytest.mark.skipif(
     micropython_binary() is None or not hasattr(os, "openpty"),
@@ -20,9 +22,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def test_node_definition_shared_with_the_obc():
-    path = os.path.join(HERE, "..", "..", "host", "obsw_host", "data", "cpdu_node.json")
-    with open(path) as f:
-        assert json.load(f) == definition_dict()
+    for path in (CPDU_NODE_PATH, os.path.join(TEMPLATE_DIR, "nodes", "cpdu.json")):
+        with open(path) as f:
+            assert json.load(f) == definition_dict()
 
 
 def log_of(sim):

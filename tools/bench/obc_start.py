@@ -33,6 +33,7 @@ from obsw.pus.tm import PusTm  # noqa: E402
 from obsw_host.il.processes import python_path  # noqa: E402
 from obsw_host.obc.config import load as load_config  # noqa: E402
 from obsw_host.obc.topology import Topology  # noqa: E402
+from obsw_host.sample import MISSION_DIR  # noqa: E402
 
 GOAL = 1.0  # seconds: issue 23's goal for the cold start
 LIMIT = 60.0  # a run that has not answered by then has failed
@@ -89,11 +90,14 @@ def one_run(mission, address, apid, pycache):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("mission", nargs="?", help="mission file (default: the sample spacecraft)")
+    p.add_argument(
+        "mission", nargs="?", help="mission folder or file (default: the sample spacecraft)"
+    )
     p.add_argument("--runs", type=int, default=5, help="runs (default 5)")
     p.add_argument("--quick", action="store_true", help="3 runs")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     args = p.parse_args(argv)
+    args.mission = args.mission or MISSION_DIR  # named: the OBC uses no mission by default
     runs = 3 if args.quick else args.runs
     address, apid = pus_address(args.mission)
     pycache = tempfile.mkdtemp(prefix="obsw-start-pycache-")

@@ -31,9 +31,9 @@ REPORTS = 4  # datagrams that answer one TC
 
 def serve_obsw(port):
     from obsw_host.pus.onboard import Onboard
-    from obsw_host.sample import load_sdb
+    from obsw_host.sample import SDB_PATH, load_sdb
 
-    onboard = Onboard(load_sdb(), port=port, period=0.1, max_tasks=64).start()
+    onboard = Onboard(load_sdb(SDB_PATH), port=port, period=0.1, max_tasks=64).start()
     print("ready", flush=True)
     onboard._thread.join()
 

@@ -1,11 +1,14 @@
-"""`obsw obc serve [CONFIG]`: the onboard computer of a mission configuration file.
+"""`obsw obc serve [MISSION]`: the onboard computer of a mission folder (or its mission file).
 
-Without CONFIG it runs the sample spacecraft: every PUS service (1-23) on UDP 5010, the CFDP
-entity on 5100, the OBCP engine, the SpaceCAN master with the CPDU nodes (simulated on
-virtual buses), and the sample solar panel (a plug-in component), in processes started and
-watched by the platform manager. Its state lives in the mission's state folder (default
-`$XDG_STATE_HOME/obsw/<mission>`), locked while it runs: a second `obsw obc serve` of the
-same mission refuses. `obsw obc reset [CONFIG]` clears that folder; `obsw obc config [CONFIG]`
+MISSION is a mission folder or its file; without it, $OBSW_MISSION or a mission.json in the
+working folder or above (the sample spacecraft is `examples/sample`). The whole folder is
+checked first (`obsw mission check`): a mistake stops the start with one line per problem,
+exit status 2, before any process starts. Then the PUS services, the CFDP entity, the OBCP
+engine, the SpaceCAN master and the mission's components run in the processes the mission
+file names, started and watched by the platform manager. Its state lives in the mission's
+state folder (default `$XDG_STATE_HOME/obsw/<mission>`), locked while it runs: a second `obsw
+obc serve` of the same mission refuses. `obsw obc reset [MISSION]` clears that folder; `obsw obc
+config [MISSION]`
 prints the configuration and its topology as the OBC understands them. `--process NAME` runs
 one process of the configuration (what the platform manager starts).
 """
@@ -15,6 +18,8 @@ import json
 import os
 import sys
 
+from obsw_host.errors import UserError
+from obsw_host.mission import locate
 from obsw_host.obc.config import ConfigError
 from obsw_host.obc.config import load as load_config
 from obsw_host.obc.state import StateLock, StateLocked, default_state
@@ -22,6 +27,7 @@ from obsw_host.obc.state import reset as reset_state
 from obsw_host.obc.topology import Topology
 
 EXIT_REFUSED = 2
+MISSION_HELP = "mission folder or file (default: $OBSW_MISSION, or a mission.json here or above)"
 
 
 def add_parser(sub):
@@ -32,17 +38,17 @@ def add_parser(sub):
     add_serve_arguments(x)
     x.set_defaults(func=serve)
     c = s.add_parser("config", help="print the mission configuration and topology as understood")
-    c.add_argument("config", nargs="?", help="mission configuration JSON (default: the sample)")
+    c.add_argument("config", nargs="?", help=MISSION_HELP)
     c.add_argument("--state", help="the state folder (default: the mission's)")
     c.set_defaults(func=show)
     r = s.add_parser("reset", help="clear the mission's state folder (refused while it runs)")
-    r.add_argument("config", nargs="?", help="mission configuration JSON (default: the sample)")
+    r.add_argument("config", nargs="?", help=MISSION_HELP)
     r.add_argument("--state", help="the state folder (default: the mission's)")
     r.set_defaults(func=reset)
 
 
 def add_serve_arguments(x):
-    x.add_argument("config", nargs="?", help="mission configuration JSON (default: the sample)")
+    x.add_argument("config", nargs="?", help=MISSION_HELP)
     x.add_argument("--state", help="folder for context, files and packet stores (default: the "
                    "configuration's 'state', or $XDG_STATE_HOME/obsw/<mission>)")  # fmt: skip
     x.add_argument("--il-dir", help="interaction layer name directory (default STATE/il)")
@@ -65,6 +71,13 @@ def load(args):
     return config
 
 
+def check_mission(path):
+    """The problems of the whole mission folder at ``path`` (``obsw mission check``)."""
+    from obsw_host.mission.check import check  # jsonschema and the PLUTO checker: parent only
+
+    return check(locate(path))[1]
+
+
 def _refuse(text):
     print("obsw obc: %s" % text, file=sys.stderr, flush=True)
     return EXIT_REFUSED
@@ -76,12 +89,18 @@ def serve(args):
             print(text, file=sys.stderr, flush=True)
 
     try:
+        if not args.process:  # the platform manager checks the whole folder, once
+            problems = check_mission(args.config)
+            if problems:
+                for problem in problems:  # one line each: FILE: $.path: what; expected ...
+                    print(problem, file=sys.stderr, flush=True)
+                return EXIT_REFUSED
         config = load(args)
         topology = Topology(config)
         if args.process:
             return _serve_process(topology, args, out)
         topology.check()  # component modules import, before anything starts
-    except ConfigError as e:
+    except (ConfigError, UserError) as e:
         return _refuse(e)
     from obsw_host.obc.platform import PlatformManager
 

@@ -1,9 +1,10 @@
 """`obsw pus`: the PUS-C standard against what the OBC serves.
 
 `obsw pus coverage [CONFIG]` lists every message type of ECSS-E-ST-70-41C services 1-23, by
-service, and whether the OBC of the mission configuration CONFIG (default: the sample) serves
-it, from the service tables its PUS application process registers. `--missing` lists only the
-types not served; `--json` prints the whole report for scripts.
+service, and whether the OBC of mission CONFIG (a mission folder or its file; default:
+$OBSW_MISSION, or a mission.json here or above) serves it, from the service tables its PUS
+application process registers. `--missing` lists only the types not served; `--json` prints
+the whole report for scripts.
 """
 
 import json
@@ -17,7 +18,11 @@ def add_parser(sub):
     s = p.add_subparsers(dest="action", metavar="ACTION")
     s.required = True
     c = s.add_parser("coverage", help="every standard message type and whether the OBC serves it")
-    c.add_argument("config", nargs="?", help="mission configuration JSON (default: the sample)")
+    c.add_argument(
+        "config",
+        nargs="?",
+        help="mission folder or file (default: $OBSW_MISSION, or a mission.json here or above)",
+    )
     c.add_argument("--missing", action="store_true", help="list only the types not served")
     c.set_defaults(func=coverage_cmd)
 

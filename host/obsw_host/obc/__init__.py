@@ -5,6 +5,6 @@ the composition root everyone reads: the processes, the units each runs (kinds f
 ``registry`` table), the mission's plug-in components (``plugins``) and the interfaces that
 join them; ``units`` holds the units, ``assembly`` runs the units of one process with its
 heartbeat, ``platform`` starts and watches the processes; ``state`` is the state folder and
-its lock. ``obsw obc serve [CONFIG]`` runs it all; without a file, the sample spacecraft
-(``data/spacecraft.json``).
+its lock. ``obsw obc serve [MISSION]`` runs it all, once ``obsw_host.mission`` has checked the
+whole mission folder (the sample spacecraft is ``examples/sample``).
 """

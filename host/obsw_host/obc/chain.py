@@ -96,10 +96,10 @@ class Chain:
         return controller, os.ttyname(device)
 
     def write_config(self, hub_ports, uart_a, uart_b):
-        from obsw_host.obc.config import SAMPLE
+        from obsw_host.sample import MISSION_DIR, MISSION_PATH
 
-        base = os.path.dirname(SAMPLE)
-        with open(SAMPLE) as f:
+        base = MISSION_DIR
+        with open(MISSION_PATH) as f:
             doc = json.load(f)
         doc["name"] = "chain"
         doc["sdb"] = os.path.join(base, doc["sdb"])

@@ -2,7 +2,8 @@
 
 Every path in it is relative to the file. Top level:
 
-- ``name``: the spacecraft's name; ``sdb``: the spacecraft database; ``host``: the address
+- ``format``: 2 (``obsw mission upgrade`` converts older files); ``name``: the spacecraft's
+  name; ``sdb``: the spacecraft database (default ``sdb.json``); ``host``: the address
   every UDP service binds (default loopback, ``obsw_host.net.DEFAULT_HOST``); ``state``: the
   folder for the context store, the onboard filestore and the packet stores;
   ``il_directory``: the interaction layer's name directory (default: a folder under ``state``).
@@ -15,18 +16,20 @@ Every path in it is relative to the file. Top level:
   ``frames``), and ``platform`` for the platform manager (heartbeat period, restart deadline,
   failures allowed in a window before the OBC asks to be power-cycled).
 
-``load(path)`` returns a ``MissionConfig``; anything wrong raises ``ConfigError`` naming the
-key and what was expected.
+``load(path)`` returns a ``MissionConfig`` of the mission ``obsw_host.mission.locate`` finds
+(never the sample by default); anything wrong raises ``ConfigError`` naming the key and what
+was expected. ``obsw_host.mission.check`` checks the whole mission folder before a start; the
+JSON Schema of the file (``obsw_host/mission/schema``) states every key.
 """
 
 import json
 import os
 
+from obsw_host.mission import locate
 from obsw_host.net import DEFAULT_HOST
 from obsw_host.obc.defaults import PLATFORM as _PLATFORM
 from obsw_host.obc.registry import KINDS, WITH_PUS
 
-SAMPLE = os.path.join(os.path.dirname(__file__), "data", "spacecraft.json")
 # component kinds that became plug-ins: the kind -> (component name, its entry)
 _LEGACY_KINDS = {"solar_panel": ("SolarPanel", {"module": "obsw_host.solar_panel"})}
 
@@ -56,6 +59,7 @@ class MissionConfig:
         self.doc = doc
         self.path = os.path.abspath(path)
         self.dir = os.path.dirname(self.path)
+        self.format = doc.get("format", 1)
         self.name = str(doc.get("name", os.path.splitext(os.path.basename(path))[0]))
         self.host = str(doc.get("host", DEFAULT_HOST))
         self.sdb_path = self.resolve(self._str("sdb"))
@@ -68,7 +72,7 @@ class MissionConfig:
         self.platform = platform
 
     def _str(self, key):
-        v = self.doc.get(key)
+        v = self.doc.get(key, "sdb.json" if key == "sdb" else None)
         if not isinstance(v, str) or not v:
             raise ConfigError(key, "expected a path, got %r" % (v,))
         return v
@@ -136,8 +140,9 @@ class MissionConfig:
 
 
 def load(path=None):
-    """The configuration at ``path`` (default: the shipped sample spacecraft)."""
-    path = path or SAMPLE
+    """The configuration of mission ``path`` (a folder or its file), else of the one
+    ``obsw_host.mission.locate`` finds ($OBSW_MISSION, a mission.json here or above)."""
+    path = locate(path)
     try:
         with open(path) as f:
             text = f.read()

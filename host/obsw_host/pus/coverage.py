@@ -20,7 +20,8 @@ from obsw_host.pus.standard import MESSAGE_TYPES, SERVICE_NAMES
 
 def obc_services(config_path=None):
     """{service type: provider} of the PUS process of the mission at ``config_path``
-    (default: the sample), built in a throw-away state folder with no fixed port bound."""
+    (default: the one ``obsw_host.mission.locate`` finds), built in a throw-away state folder
+    with no fixed port bound."""
     config = obc_config.load(config_path)
     config.doc = copy.deepcopy(config.doc)
     if "cfdp" in config.doc:

@@ -16,7 +16,6 @@ within one process only, so that is how a test or demo gets a node to talk to).
 """
 
 import argparse
-import json
 import os
 import select
 import signal
@@ -24,6 +23,7 @@ import sys
 
 from obsw.il.interface import check_unique_ids
 from obsw.il.node import Node
+from obsw.reconfig.node import definition_dict
 from obsw.spacecan.controller import Controller
 from obsw.spacecan.equipment import Equipment
 from obsw.spacecan.master import MASTER, SpaceCanMaster
@@ -35,13 +35,11 @@ from obsw_host.spacecan.adapter import CanAdapter
 
 # The reconfiguration module's CPDU as seen on SpaceCAN: the one definition the firmware also
 # uses (``obsw.reconfig.node``; nominal controller node 10, redundant 11).
-CPDU_NODE_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "data", "cpdu_node.json")
 
 
 def cpdu_node():
-    """The CPDU node definition (a fresh dict from ``CPDU_NODE_PATH``)."""
-    with open(CPDU_NODE_PATH) as f:
-        return json.load(f)
+    """The CPDU node definition (a fresh dict, the firmware's own)."""
+    return definition_dict()
 
 
 _IDLE_WAIT = 0.2  # longest a wait blocks with nothing due (stop() is seen this soon)

@@ -557,6 +557,7 @@ class Sdb:
 
 
 _KNOWN = (
+    "$schema",  # the JSON Schema editors check the file with
     "mission",
     "apids",
     "components",

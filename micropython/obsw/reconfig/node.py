@@ -1,6 +1,6 @@
 """The CPDU node on SpaceCAN: state bits and module status as parameters, line commands as
 service 8 functions, a housekeeping report. The OBC loads the same definition
-(`host/obsw_host/data/cpdu_node.json`, kept equal to ``DEFINITION`` by a test)."""
+(the mission folders' `nodes/cpdu.json`, kept equal to ``DEFINITION`` by a test)."""
 
 from obsw.compat import const
 from obsw.spacecan.nodedef import NodeDefinition

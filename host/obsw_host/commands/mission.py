@@ -1,0 +1,81 @@
+"""`obsw mission check|new|upgrade`: the mission folder a team writes, checked before a start.
+
+`check [DIR]` checks the whole folder (the mission file and the database against their JSON
+Schemas, then names, ids and references between the files, node definitions, procedures and
+components) and prints one line per problem: `FILE: $.json.path: what is wrong; expected ...`
+(exit status 2). `new NAME [--dir D]` writes a mission folder that passes the check and runs
+under `obsw obc serve`. `upgrade FILE` converts an older mission file to the current format.
+"""
+
+import json
+import sys
+
+from obsw_host import mission
+from obsw_host.errors import UserError, read_json
+
+
+def add_parser(sub):
+    p = sub.add_parser("mission", help="check, create or upgrade a mission folder",
+                       description=__doc__)  # fmt: skip
+    s = p.add_subparsers(dest="action", metavar="ACTION")
+    s.required = True
+    c = s.add_parser("check", help="check the whole mission folder; one line per problem")
+    c.add_argument("dir", nargs="?", help="mission folder or file (default: $OBSW_MISSION, or "
+                   "a mission.json here or above)")  # fmt: skip
+    c.set_defaults(func=check_cmd)
+    n = s.add_parser("new", help="write a new mission folder from the shipped template")
+    n.add_argument("name", help="the spacecraft's name (letters, digits, '_', '.', '-')")
+    n.add_argument("--dir", help="the folder to write (default: ./NAME)")
+    n.set_defaults(func=new_cmd)
+    u = s.add_parser("upgrade", help="convert a format-1 mission file to format 2")
+    u.add_argument("file", help="the mission file (rewritten in place unless --output)")
+    u.add_argument("-o", "--output", help="write the upgraded file here instead")
+    u.set_defaults(func=upgrade_cmd)
+
+
+def check_cmd(args):
+    from obsw_host.mission.check import check
+
+    path = mission.locate(args.dir)
+    m, problems = check(path)
+    if args.json:
+        print(json.dumps({"mission": path, "ok": not problems,
+                          "problems": [str(p) for p in problems]}, indent=2))  # fmt: skip
+    else:
+        for p in problems:
+            print(p, file=sys.stderr)
+    if problems:
+        return 2
+    if not args.json:
+        sdb = m.sdb
+        print("%s: ok (%s; %d parameters, %d events, %d functions, components %s)" % (
+            path, m.name, len(sdb.parameters), len(sdb.events), len(sdb.functions),
+            ", ".join(sorted(m.interfaces)) or "none"))  # fmt: skip
+    return 0
+
+
+def new_cmd(args):
+    from obsw_host.mission.new import write
+
+    folder = write(args.name, args.dir or args.name)
+    print("%s: mission %s written; next: obsw mission check %s && obsw obc serve %s"
+          % (folder, args.name, folder, folder))  # fmt: skip
+    return 0
+
+
+def upgrade_cmd(args):
+    from obsw_host.mission.upgrade import upgrade
+
+    doc = read_json(args.file, "mission file")
+    if not isinstance(doc, dict):
+        raise UserError("%s is not a JSON object" % args.file, expected="a mission file")
+    new, changes = upgrade(doc)
+    if not changes:
+        print("%s: already format %d" % (args.file, new["format"]))
+        return 0
+    out = args.output or args.file
+    with open(out, "w", encoding="utf-8") as f:
+        json.dump(new, f, indent=2)
+        f.write("\n")
+    print("%s: %s" % (out, "; ".join(changes)))
+    return 0

@@ -20,8 +20,6 @@ from obsw_host.sample import load_sdb
 from prompt_toolkit.document import Document
 from test_cli_ground import BOUND, ENV, OBSW, obc, obsw, start, stop  # noqa: F401, F811
 
-WIDE = dict(ENV, COLUMNS="160")
-
 
 def test_watch_once_shows_values_units_and_limit_states(obc):  # noqa: F811 (the fixture)
     port, _ = obc
@@ -39,7 +37,7 @@ def test_watch_once_shows_values_units_and_limit_states(obc):  # noqa: F811 (the
     obsw("ground", "--port", port, "params", "set", "SolarPanel.speed=16")
     table = subprocess.run(
         OBSW + ["ground", "--port", str(port), "watch", "--once"],
-        env=WIDE,
+        env=dict(ENV, COLUMNS="160"),
         capture_output=True,
         text=True,
         timeout=BOUND,

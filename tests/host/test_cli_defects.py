@@ -11,7 +11,15 @@ import socket
 import subprocess
 
 import pytest
-from test_cli_ground import BOUND, ENV, OBSW, Lines, obc, obsw  # noqa: F401
+from test_cli_ground import BOUND, ENV, OBSW, ROOT, Lines, obc, obsw  # noqa: F401
+
+SAMPLE = dict(ENV, OBSW_MISSION=os.path.join(ROOT, "examples", "sample"))  # the sample mission
+
+
+def sample(*args):
+    return subprocess.run(
+        OBSW + [str(a) for a in args], env=SAMPLE, capture_output=True, text=True, timeout=BOUND
+    )
 
 
 def udp_port():
@@ -32,7 +40,7 @@ def test_ctrl_c_during_cfdp_put_cancels_and_the_receiver_keeps_nothing(tmp_path)
         OBSW
         + ["cfdp", "serve", "--port", str(port), "--root", str(onboard)]
         + ["--peer", "1=127.0.0.1:%d" % back],
-        env=ENV,
+        env=SAMPLE,
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -44,7 +52,7 @@ def test_ctrl_c_during_cfdp_put_cancels_and_the_receiver_keeps_nothing(tmp_path)
         put = subprocess.Popen(
             OBSW + ["cfdp", "put", "big.bin", "--root", str(ground), "--segment", "64"]
             + ["--port", str(back), "--peer", "2=127.0.0.1:%d" % port],
-            env=ENV,
+            env=SAMPLE,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
@@ -92,8 +100,8 @@ def test_durations_and_counts_must_be_positive(args):
 
 
 def test_missing_key_files_and_folders_in_one_line(tmp_path):
-    keygen = obsw("frames", "keygen", tmp_path / "no" / "such" / "keys.json")
-    sign = obsw("frames", "sign", "--keys", tmp_path / "absent.json", "00")
+    keygen = sample("frames", "keygen", tmp_path / "no" / "such" / "keys.json")
+    sign = sample("frames", "sign", "--keys", tmp_path / "absent.json", "00")
     for r in (keygen, sign):
         assert r.returncode == 2, r.stderr
         assert "no such file or directory" in r.stderr and "[Errno" not in r.stderr
@@ -101,7 +109,7 @@ def test_missing_key_files_and_folders_in_one_line(tmp_path):
 
 
 def test_spacecan_without_socketcan_in_one_line():
-    r = obsw(
+    r = sample(
         "spacecan", "monitor", "--interface", "socketcan", "--channel-a", "obswnone0",
         "--channel-b", "obswnone1", "--duration", "0.5",
     )  # fmt: skip
@@ -179,7 +187,7 @@ def _alive(pid):
 
 
 def test_no_answer_names_the_port_the_ground_used(tmp_path):
-    env = dict(ENV, OBSW_PORT_BASE="17000")
+    env = dict(SAMPLE, OBSW_PORT_BASE="17000")
     r = subprocess.run(
         OBSW + ["ground", "--timeout", "0.3", "ping"],
         env=env,
@@ -206,7 +214,7 @@ def test_yamcs_run_leaves_nothing_in_the_temp_folder_when_terminated(tmp_path):
         pytest.skip(server.missing())
     temp = tmp_path / "temp"
     temp.mkdir()
-    env = dict(ENV, TMPDIR=str(temp), OBSW_PORT_BASE=str(udp_port() - 10))
+    env = dict(SAMPLE, TMPDIR=str(temp), OBSW_PORT_BASE=str(udp_port() - 10))
     ports = ["--http-port", tcp_port(), "--pus-port", tcp_port(), "--cfdp-port", udp_port()]
     ports += ["--cltu-port", udp_port(), "--tm-frames-port", udp_port()]
     run = subprocess.Popen(

@@ -131,8 +131,12 @@ def obc(tmp_path):
     proc, out, err = start("obc", "serve", mission, env=env)
     both = Lines.merged(out, err)
     both.until(lambda line: " up: " in line)
-    yield base + 10, both
-    stop(proc)
+    ENV["OBSW_MISSION"] = str(mission)  # the ground commands of the test use this mission
+    try:
+        yield base + 10, both
+    finally:
+        ENV.pop("OBSW_MISSION", None)
+        stop(proc)
 
 
 def test_a_second_terminal_sees_the_tm_of_the_first(obc, tmp_path):
@@ -222,7 +226,7 @@ def test_onboard_log_one_line_per_tc(obc):
     ],
 )
 def test_discovery_from_the_database(kind, expected):
-    result = obsw("ground", "list", kind)
+    result = obsw("ground", "--mission", os.path.join(ROOT, "examples", "sample"), "list", kind)
     rows = [" ".join(line.split()) for line in result.stdout.splitlines()]
     assert result.returncode == 0 and " ".join(expected.split()) in rows, rows
 

@@ -132,7 +132,7 @@ def test_console_in_a_terminal_pings_reads_a_parameter_and_keeps_history(obc, tm
             proc.kill()
             proc.wait()
         os.close(master)
-    history = (state / "obsw-demo" / "ground-history").read_text()
+    history = (tmp_path / "state" / "ground-history").read_text()  # the mission's state
     assert "+ping" in history and "+params get SolarPanel.speed" in history
 
 

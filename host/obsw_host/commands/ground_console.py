@@ -9,10 +9,9 @@ console against a running `obsw obc serve`.
                                         completion of commands and of the database's parameter,
                                         function and event names, and a history per mission
 
-The console's history file is ``ground-history`` in the mission's state folder (``$OBSW_STATE``,
-else ``$XDG_STATE_HOME/obsw``, else ``~/.local/state/obsw``, then the mission's name), or
-``--history FILE``. With standard input not a terminal, the console reads one command a line
-(for scripts) and keeps no history.
+The console's history file is ``ground-history`` in the mission's state folder (the mission
+file's ``state``), or ``--history FILE``. With standard input not a terminal, the console reads
+one command a line (for scripts) and keeps no history.
 """
 
 import argparse
@@ -29,6 +28,7 @@ from rich.console import Console, Group
 from rich.live import Live
 from rich.table import Table
 
+from obsw_host import ids as mission_ids
 from obsw_host.commands import arguments, ground
 from obsw_host.errors import user_message
 from obsw_host.obc.state import default_state
@@ -151,12 +151,16 @@ def _frames(g, args, frames, show):
 # ------------------------------------------------------------------------------ console
 
 
-def history_path(args, sdb):
-    """The console's history file: ``--history``, else in the mission's state folder."""
+def history_path(args, ids):
+    """The console's history file: ``--history``, else ``ground-history`` in the mission's
+    state folder (its mission file's ``state``; without a mission file, the user state folder
+    of the database's mission name)."""
     if args.history:
         return args.history
-    mission = getattr(sdb, "mission", "") or "obsw"
-    return os.path.join(default_state(mission), HISTORY_FILE)
+    state = getattr(getattr(ids, "config", None), "state", None)
+    if not state:
+        state = default_state(getattr(ids.sdb, "mission", "") or "obsw")
+    return os.path.join(state, HISTORY_FILE)
 
 
 def _subcommands(parser):
@@ -271,7 +275,7 @@ def _console(args):
             if line.strip() and not line.lstrip().startswith("#"):
                 status = run_line(line, base, parser) or status
         return status
-    path = history_path(args, sdb)
+    path = history_path(args, mission_ids.from_args(args))
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     session = PromptSession(
         history=FileHistory(path),

@@ -316,7 +316,7 @@ def _monitor_live(args):
 
     seen = [0]
     with _ground(args) as g:
-        display = Display(g.sdb, _colour(args), getattr(args, "raw", False))
+        display = Display(g.sdb, _colour(args), getattr(args, "raw", False), g.proc.config)
 
         def show(tm, decoded, tx):
             seen[0] += 1
@@ -492,7 +492,7 @@ def _listen(args):
     service, subtype = args.listen
     n = 0
     with _ground(args) as g:
-        display = Display(g.sdb, raw=getattr(args, "raw", False))
+        display = Display(g.sdb, raw=getattr(args, "raw", False), config=g.proc.config)
         g.subscribe()
         print(
             "listening for TM[%s,%s] from %s:%d for %gs"

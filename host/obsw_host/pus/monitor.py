@@ -27,10 +27,11 @@ def utc_now():
 class Display:
     """One line per packet for an operator (see the module text)."""
 
-    def __init__(self, sdb=None, colour=False, raw=False):
+    def __init__(self, sdb=None, colour=False, raw=False, config=None):
         self.sdb = sdb
         self.colour = colour
         self.raw = raw  # raw parameter values instead of engineering ones
+        self.config = config  # the mission's PusConfig: its TM time code (default: PUS-C's)
         self.sent = {}  # (apid, seq) -> TC this ground sent, to name verification reports
 
     def _paint(self, line, kind):
@@ -52,7 +53,7 @@ class Display:
     def tm(self, tm, decoded, when=None, config=None):
         """One line for a TM: its on-board time in UTC, else ``when`` (a logged time), else
         now."""
-        tai = tm_seconds(tm, config)
+        tai = tm_seconds(tm, config or self.config)
         when = format_utc(tai) if tai else (when or utc_now())
         head = "%s  TM apid %4d seq %5d  TM[%d,%d] " % (
             when,

@@ -112,6 +112,8 @@ def write_mission(folder):
     doc["state"] = "state"
     doc["ports"] = {"base": BASE}
     doc["processes"] = {"obc": ["pus", "cfdp", "obcp", "SolarPanel"], "frames": ["frames"]}
+    # this mission's frame processor runs without keys, and says so (secure by default)
+    doc.setdefault("frames", {})["tc_security"] = "none"
     doc["pus"].pop("apid", None)  # the database's: said once
     doc["platform"]["power_cycle"]["component"] = "MtqN"
     with open(os.path.join(folder, "mission.json"), "w") as f:

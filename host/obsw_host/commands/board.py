@@ -46,6 +46,12 @@ def add_parser(sub):
                 "--march",
                 help="mpy-cross architecture (default: the board's own, else armv7emsp)",
             )
+            q.add_argument("--keys", help="the board's SDLS key file, installed as tc.keys")
+            q.add_argument(
+                "--insecure",
+                action="store_true",
+                help="no keys: let the board take essential TCs unauthenticated (logged)",
+            )
         if name == "test":
             q.add_argument(
                 "files", nargs="*", help="test files (default: the reconfiguration core tests)"
@@ -106,8 +112,23 @@ def _deploy(args):
     from obsw_host import board
 
     def go():
-        names = board.deploy(args.port, march=args.march, progress=_progress)
+        names = board.deploy(
+            args.port,
+            march=args.march,
+            keys=args.keys,
+            insecure=args.insecure,
+            progress=_progress,
+        )
         print("%d modules deployed" % len(names))
+        if args.keys:
+            print("SDLS keys installed on the board as tc.keys (from %s)" % args.keys)
+        elif args.insecure:
+            print("SDLS OFF on the board (tc.insecure): essential TCs accepted unauthenticated")
+        else:
+            print(
+                "SDLS keys NOT installed (no --keys): unless the board already has tc.keys, "
+                "it refuses every essential TC"
+            )
 
     return _guard(go)
 

@@ -165,21 +165,35 @@ class Report:
         return d
 
 
-def security_from_file(path):
-    """The TcSecurity of the SDLS key file at ``path``, or None when there is none. A key file
-    that cannot be read as one gives a TcSecurity with no SA: every TC frame is then rejected,
-    but the module keeps running (a boot that raised would reset it forever)."""
+def security_from_file(path, insecure=None, log=print):
+    """The TcSecurity of the SDLS key file at ``path``. Secure by default: without a key file,
+    or with one that cannot be read as one, a TcSecurity with no SA (every TC frame rejected,
+    while the module keeps running: a boot that raised would reset it forever). Only when the
+    file ``insecure`` exists (the mission's explicit choice, put there by ``obsw board
+    deploy``) and there is no key file: None, TC frames unauthenticated. ``log`` gets one line
+    at every boot that is not the normal, keyed one."""
+    from obsw.frames.sdls import SdlsError, TcSecurity
+
     try:
         f = open(path)
     except OSError:
-        return None
-    from obsw.frames.sdls import SdlsError, TcSecurity
+        if insecure is not None:
+            try:
+                open(insecure).close()
+            except OSError:
+                pass
+            else:
+                log("SDLS OFF (%s): essential TCs accepted without authentication" % insecure)
+                return None
+        log("SDLS: no key file %s: every essential TC is refused" % path)
+        return TcSecurity(())
     from obsw.frames.sdls_keys import load_security
 
     try:
         with f:
             return load_security(f.read())
     except (SdlsError, OSError, ValueError):
+        log("SDLS: %s is not a usable key file: every essential TC is refused" % path)
         return TcSecurity(())
 
 

@@ -101,12 +101,15 @@ def write_mission(folder):
     with open(os.path.join(folder, "sdb.json"), "w") as f:
         json.dump(tailored_sdb(), f, indent=1)
     shutil.copy(sample.CPDU_NODE_PATH, os.path.join(folder, "node.json"))
-    with open(obc_config.SAMPLE) as f:
+    with open(sample.MISSION_PATH) as f:
         doc = json.load(f)
-    shutil.copytree(
-        os.path.join(os.path.dirname(obc_config.SAMPLE), doc["obcp"]["files"]),
-        os.path.join(folder, "procedures"),
-    )
+    procedures = os.path.join(os.path.dirname(sample.MISSION_PATH), doc["obcp"]["files"])
+    os.makedirs(os.path.join(folder, "procedures"))
+    for name in os.listdir(procedures):  # the CPDU components are this mission's Mtq nodes
+        with open(os.path.join(procedures, name)) as f:
+            text = f.read().replace("CpduN", "MtqN").replace("CpduR", "MtqR")
+        with open(os.path.join(folder, "procedures", name), "w") as f:
+            f.write(text)
     doc["name"] = NAME
     doc["sdb"] = "sdb.json"
     doc["state"] = "state"

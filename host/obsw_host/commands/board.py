@@ -1,5 +1,8 @@
 """`obsw board`: build, deploy, flash, repl and test the reconfiguration module's Pyboard."""
 
+import signal
+import sys
+
 
 def add_parser(sub):
     p = sub.add_parser("board", help="Pyboard firmware for the reconfiguration module")
@@ -85,6 +88,10 @@ def _qemu(args):
 
     def go():
         q = board.qemu(args.qemu_args)
+        # SIGTERM (a service manager, `kill`) ends QEMU too, as Ctrl-C does, not only this
+        # process; SIGHUP (the terminal closed) likewise
+        for signum in (signal.SIGTERM, signal.SIGHUP):
+            signal.signal(signum, _interrupt)
         print("QEMU board on %s (obsw board deploy|test|repl --port %s); Ctrl-C ends it"
               % (q.pty, q.pty), flush=True)  # fmt: skip
         try:
@@ -97,11 +104,21 @@ def _qemu(args):
     return _guard(go)
 
 
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
 def _deploy(args):
     from obsw_host import board
 
     def go():
-        names = board.deploy(args.port, march=args.march, keys=args.keys, insecure=args.insecure)
+        names = board.deploy(
+            args.port,
+            march=args.march,
+            keys=args.keys,
+            insecure=args.insecure,
+            progress=_progress,
+        )
         print("%d modules deployed" % len(names))
         if args.keys:
             print("SDLS keys installed on the board as tc.keys (from %s)" % args.keys)
@@ -114,6 +131,17 @@ def _deploy(args):
             )
 
     return _guard(go)
+
+
+def _progress(text):
+    """One step of long work on stderr: rewritten in place on a terminal, a line otherwise."""
+    if sys.stderr.isatty():
+        sys.stderr.write("\r\x1b[K" + text)
+        if text.startswith("copying"):
+            sys.stderr.write("\n")
+    else:
+        sys.stderr.write(text + "\n")
+    sys.stderr.flush()
 
 
 def _flash(args):

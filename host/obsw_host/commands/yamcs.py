@@ -8,6 +8,8 @@ mission's PUS process and CFDP entity in-process, or with ``--obc HOST:PORT`` li
 
 import json
 import os
+import shutil
+import signal
 import sys
 import tempfile
 import threading
@@ -48,7 +50,7 @@ def add_parser(sub):
     )
     x.add_argument("--files", help="the on-board CFDP filestore (default: DIR/sat)")
     x.add_argument("--seconds", type=float, help="stop after this many seconds")
-    x.set_defaults(func=run)
+    x.set_defaults(func=run_in_temp)
 
 
 def _instance_options(x):
@@ -225,3 +227,21 @@ def run(args):
     finally:
         sat.close()
     return 0
+
+
+def run_in_temp(args):
+    """``run``; without ``--dir`` its instance (Yamcs' data, some MB) lives in a new temporary
+    folder that is removed when Yamcs stops, by Ctrl-C, SIGTERM, ``--seconds`` or an error."""
+    signal.signal(signal.SIGTERM, _interrupt)
+    print("starting Yamcs (Java; up to a minute) ...", file=sys.stderr, flush=True)
+    if args.dir:
+        return run(args)
+    args.dir = tempfile.mkdtemp(prefix="obsw-yamcs-")
+    try:
+        return run(args)
+    finally:
+        shutil.rmtree(args.dir, ignore_errors=True)
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt

@@ -119,7 +119,7 @@ def test_mission_new_passes_the_check_and_runs(tmp_path):
     env = dict(ENV, OBSW_PORT_BASE=str(base))
     obc = Obc(str(folder), tmp_path / "state", env)
     try:
-        wait_for_ping(["ground", "--port", base + 10], obc)
+        wait_for_ping(["ground", "--mission", folder, "--port", base + 10], obc)
         r = obsw("ground", "--sdb", folder / "sdb.json", "--port", base + 10, "params", "get",
                  "pus.tc_received")  # fmt: skip
         assert r.returncode == 0, r.stderr
@@ -133,7 +133,7 @@ def test_aurora_differs_from_the_sample_and_passes_the_check():
     a, s = load(AURORA), load(sample.MISSION_DIR)
     assert a.name != s.name and a.sdb.mission != s.sdb.mission
     assert set(a.sdb.apids.values()).isdisjoint(s.sdb.apids.values())
-    assert a.sdb.scid != s.config.doc["frames"]["scid"]
+    assert a.sdb.scid != s.sdb.scid
     assert a.sdb.tm_vcs != s.sdb.tm_vcs
     assert set(a.sdb.filestores).isdisjoint(s.sdb.filestores)
     assert set(a.sdb.filestores.values()).isdisjoint(s.sdb.filestores.values())

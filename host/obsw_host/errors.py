@@ -44,6 +44,16 @@ def _os_error(e):
         return "cannot bind that address: not an address of this machine"
     if e.errno == errno.ECONNREFUSED:
         return "connection refused: nothing is listening there"
+    if e.errno == errno.EAFNOSUPPORT:  # the one unusual family we open: PF_CAN (socketcan)
+        return (
+            "address family not supported by this machine (no socketcan here?); expected "
+            "Linux with the can and can_raw modules loaded, or --interface virtual or "
+            "udp_multicast"
+        )
+    if e.errno == errno.ENODEV:
+        return "no such device (%s); expected an interface that exists and is up" % (
+            e.strerror or e
+        )
     if e.filename is not None:
         return _file_error(e) or "%s: %s" % (e.filename, e.strerror)
     return None

@@ -181,3 +181,34 @@ def speedups():
 
 
 pus_accelerator = speedups  # the PUS codec's name for it
+
+
+def aes_ecb(key):
+    """AES encryption in ECB mode under ``key`` (16, 24 or 32 octets): a function that takes a
+    multiple of 16 octets and returns as many. MicroPython: ``cryptolib.aes``; CPython:
+    ``cryptography``; where neither is (an image built without cryptolib), AES in Python
+    (``obsw.frames.aes``), the same octets much slower."""
+    try:
+        if MICROPYTHON:
+            import cryptolib
+
+            return cryptolib.aes(bytes(key), 1).encrypt
+        from cryptography.hazmat.primitives.ciphers import Cipher, algorithms, modes
+
+        return Cipher(algorithms.AES(bytes(key)), modes.ECB()).encryptor().update
+    except ImportError:
+        from obsw.frames.aes import Aes
+
+        return Aes(key).encrypt
+
+
+def gcm_accelerator(key):
+    """``cryptography``'s AESGCM under ``key`` (the whole GCM in C) or None: on MicroPython,
+    under OBSW_PURE, or without the package. ``obsw.frames.gcm`` stays the definition."""
+    if pure():
+        return None
+    try:
+        from cryptography.hazmat.primitives.ciphers.aead import AESGCM
+    except ImportError:
+        return None
+    return AESGCM(bytes(key))

@@ -16,7 +16,9 @@ from obsw.cfdp.tlv import FilestoreRequest
 
 
 def _tmpdir():
-    base = "/tmp/obsw-cfdp-fs-%d" % (os.getpid() if hasattr(os, "getpid") else 0)
+    """A folder of this process in the temp folder ($TMPDIR, else /tmp); tearDown removes it."""
+    temp = (os.getenv("TMPDIR") if hasattr(os, "getenv") else None) or "/tmp"
+    base = temp.rstrip("/") + "/obsw-cfdp-fs-%d" % (os.getpid() if hasattr(os, "getpid") else 0)
     try:
         os.mkdir(base)
     except OSError:
@@ -119,12 +121,13 @@ class TestMemoryFilestore(Common, unittest.TestCase):
 
 class TestOsFilestore(Common, unittest.TestCase):
     def setUp(self):
-        self.root = _tmpdir() + "/root"
+        self.base = _tmpdir()
+        self.root = self.base + "/root"
         _rmtree(self.root)
         os.mkdir(self.root)
 
     def tearDown(self):
-        _rmtree(self.root)
+        _rmtree(self.base)  # the process's folder too: nothing is left in the temp folder
 
     def fs(self):
         return OsFilestore(self.root)

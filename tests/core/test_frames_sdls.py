@@ -441,18 +441,37 @@ class TestEssentialCommands(unittest.TestCase):
         self.assertEqual(self.unit.frames.counters["tc_rejected"], 2)
 
     def test_security_from_file(self):
-        self.assertIsNone(self.E.security_from_file("/nonexistent/tc.keys"))
         import os
 
+        said = []
+        # secure by default: no key file, no SA, every essential TC refused (one line said)
+        missing = self.E.security_from_file("/nonexistent/tc.keys", None, said.append)
+        self.assertEqual(missing.sas, {})
+        unit = self.E.Essential(SCID, security=missing)
+        unit.feed(self.hpc_frame(self.E.Hpc(self.E.HPC_REPORT, ())), 0.0)
+        unit.feed(self.hpc_frame(self.E.Hpc(self.E.HPC_REPORT, ()), sign=False), 0.0)
+        self.assertEqual(unit.counters["hpcs"], 0)
+        self.assertEqual(len(said), 1)
         try:  # a host's temporary folder, else (a board) the root of its filesystem
             os.stat("/tmp")
             path = "/tmp/obsw_test_frames_sdls_bad.keys"
         except OSError:
             path = "/obsw_test_frames_sdls_bad.keys"
+        # unauthenticated only when the mission put its marker file there, and then said so
+        with open(path + ".insecure", "w") as f:
+            f.write("")
+        try:
+            off = self.E.security_from_file(
+                "/nonexistent/tc.keys", path + ".insecure", said.append
+            )
+        finally:
+            os.remove(path + ".insecure")
+        self.assertIsNone(off)
+        self.assertIn("OFF", said[-1])
         with open(path, "w") as f:
             f.write("{not a key file")
         try:
-            broken = self.E.security_from_file(path)
+            broken = self.E.security_from_file(path, None, said.append)
         finally:
             os.remove(path)
         self.assertEqual(broken.sas, {})  # fail secure, keep running

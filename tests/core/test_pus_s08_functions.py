@@ -3,6 +3,7 @@
 import json
 import unittest
 
+from obsw import cbor
 from obsw.il.clock import SimClock
 from obsw.il.errors import ComponentError
 from obsw.il.interface import Interface, Operation
@@ -111,12 +112,15 @@ class TestFunctions(unittest.TestCase):
             ],
         )
         tx = loop.run_async(lambda: user.perform(APID, "Heater.cycle", {"times": 0}))
-        self.assertEqual(failure(tx), (4, FAILURE_COMPONENT, b"\x00\x02"))
+        said = cbor.dumps(["NOTHING", "zero cycles", None])
+        self.assertEqual(failure(tx), (4, FAILURE_COMPONENT, b"\x00\x02" + said))
 
     def test_component_errors_fail_the_completion(self):
         loop, fm, user, heater, _ = make()
         tx = loop.run_async(lambda: user.perform(APID, 1, {"watts": 500.0}))
-        self.assertEqual(failure(tx), (4, FAILURE_COMPONENT, b"\x00\x01"))
+        stage, code, data = failure(tx)
+        self.assertEqual((stage, code, data[:2]), (4, FAILURE_COMPONENT, b"\x00\x01"))
+        self.assertEqual(cbor.loads(data[2:]), ["TOO_HOT", "at most 100 W", 500.0])
         tx = loop.run_async(lambda: user.perform(APID, "Absent.op"))
         self.assertEqual(failure(tx), (4, FAILURE_UNAVAILABLE, b"\x00\x05"))
 

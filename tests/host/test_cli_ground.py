@@ -131,8 +131,12 @@ def obc(tmp_path):
     proc, out, err = start("obc", "serve", mission, env=env)
     both = Lines.merged(out, err)
     both.until(lambda line: " up: " in line)
-    yield base + 10, both
-    stop(proc)
+    ENV["OBSW_MISSION"] = str(mission)  # the ground commands of the test use this mission
+    try:
+        yield base + 10, both
+    finally:
+        ENV.pop("OBSW_MISSION", None)
+        stop(proc)
 
 
 def test_a_second_terminal_sees_the_tm_of_the_first(obc, tmp_path):
@@ -196,7 +200,7 @@ def test_readable_replies(obc):
     assert "2031-01-01T00:00:00.000Z" in listing and "TC[17,1] are-you-alive" in listing
     failed = obsw("ground", "--port", port, "function", "SolarPanel.set_angle", "angle=5")
     assert failed.returncode == 1
-    assert "completion failure: component error (code 13) (function SolarPanel.set_angle)" in (
+    assert "completion failure: component error (code 13) (function SolarPanel.set_angle: " in (
         failed.stdout
     )
     hk = obsw("ground", "--port", port, "hk", "report", "1").stdout
@@ -222,7 +226,7 @@ def test_onboard_log_one_line_per_tc(obc):
     ],
 )
 def test_discovery_from_the_database(kind, expected):
-    result = obsw("ground", "list", kind)
+    result = obsw("ground", "--mission", os.path.join(ROOT, "examples", "sample"), "list", kind)
     rows = [" ".join(line.split()) for line in result.stdout.splitlines()]
     assert result.returncode == 0 and " ".join(expected.split()) in rows, rows
 

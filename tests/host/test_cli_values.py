@@ -3,6 +3,8 @@ shown with their unit and raw beside them, `--raw`, ranges refused before sendin
 engineering units on an integer parameter, functional monitoring and parameter definitions."""
 
 import json
+import os
+import shutil
 
 import pytest
 from obsw_host.sample import SDB_PATH
@@ -21,14 +23,17 @@ def obc(tmp_path):
                 a["raw_unit"] = "half-deg/s"
     sdb = tmp_path / "sdb.json"
     sdb.write_text(json.dumps(doc))
+    shutil.copytree(os.path.join(os.path.dirname(SDB_PATH), "nodes"), tmp_path / "nodes")
     mission = tmp_path / "mission.json"
     mission.write_text(
         json.dumps(
             {
+                "format": 2,
                 "name": "test-values",
                 "sdb": str(sdb),
                 "state": "state",
-                "processes": {"obc": ["pus", "solar_panel"]},
+                "processes": {"obc": ["pus", "SolarPanel"]},
+                "components": {"SolarPanel": {"module": "obsw_host.solar_panel"}},
                 "pus": {"apid": 10, "period": 0.1},
             }
         )

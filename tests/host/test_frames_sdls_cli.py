@@ -56,8 +56,9 @@ def test_processor_with_keys(key_file, capsys):
             os.close(fd)
 
 
-def test_keygen_refuses_to_overwrite_or_write_into_a_repository(key_file):
-    with pytest.raises(SystemExit):
-        main(["frames", "keygen", key_file])
-    with pytest.raises(SystemExit):
-        main(["frames", "keygen", os.path.join(os.path.dirname(__file__), "tc.keys")])
+def test_keygen_refuses_to_overwrite_or_write_into_a_repository(key_file, capsys):
+    # a user mistake: one line, exit status 2 (as every command's), no traceback
+    assert main(["frames", "keygen", key_file]) == 2
+    assert "already exists" in capsys.readouterr().err
+    assert main(["frames", "keygen", os.path.join(os.path.dirname(__file__), "tc.keys")]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1

@@ -101,17 +101,22 @@ def write_mission(folder):
     with open(os.path.join(folder, "sdb.json"), "w") as f:
         json.dump(tailored_sdb(), f, indent=1)
     shutil.copy(sample.CPDU_NODE_PATH, os.path.join(folder, "node.json"))
-    with open(obc_config.SAMPLE) as f:
+    with open(sample.MISSION_PATH) as f:
         doc = json.load(f)
-    shutil.copytree(
-        os.path.join(os.path.dirname(obc_config.SAMPLE), doc["obcp"]["files"]),
-        os.path.join(folder, "procedures"),
-    )
+    procedures = os.path.join(os.path.dirname(sample.MISSION_PATH), doc["obcp"]["files"])
+    os.makedirs(os.path.join(folder, "procedures"))
+    for name in os.listdir(procedures):  # the CPDU components are this mission's Mtq nodes
+        with open(os.path.join(procedures, name)) as f:
+            text = f.read().replace("CpduN", "MtqN").replace("CpduR", "MtqR")
+        with open(os.path.join(folder, "procedures", name), "w") as f:
+            f.write(text)
     doc["name"] = NAME
     doc["sdb"] = "sdb.json"
     doc["state"] = "state"
     doc["ports"] = {"base": BASE}
     doc["processes"] = {"obc": ["pus", "cfdp", "obcp", "SolarPanel"], "frames": ["frames"]}
+    # this mission's frame processor runs without keys, and says so (secure by default)
+    doc.setdefault("frames", {})["tc_security"] = "none"
     doc["pus"].pop("apid", None)  # the database's: said once
     doc["platform"]["power_cycle"]["component"] = "MtqN"
     with open(os.path.join(folder, "mission.json"), "w") as f:

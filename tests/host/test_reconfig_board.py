@@ -83,6 +83,27 @@ def test_deploy_compiles_for_the_pyboard_and_copies(fakes, tmp_path, monkeypatch
     assert not [n for n in names if n.startswith(("obsw/cfdp", "obsw/pluto", "obsw/il"))]
 
 
+def test_deploy_installs_the_keys_or_says_it_did_not(fakes, tmp_path, capsys):
+    from obsw_host.frames import keys
+
+    tmp, calls = fakes
+    argv = ["board", "deploy", "--port", "/dev/ttyACM0", "--march", "armv7emsp"]
+    assert run(argv) == 0
+    assert "SDLS keys NOT installed" in capsys.readouterr().out
+    assert ":tc.keys" not in calls()[-1]
+    key_file = str(tmp_path / "board.keys")
+    keys.generate(key_file, algorithm="aes-gcm")
+    assert run(argv + ["--keys", key_file]) == 0
+    assert "installed on the board as tc.keys" in capsys.readouterr().out
+    assert "cp %s :tc.keys" % key_file in calls()[-1]
+    assert run(argv + ["--insecure"]) == 0
+    assert "SDLS OFF" in capsys.readouterr().out and "tc.insecure" in calls()[-1]
+    n = len(calls())
+    os.chmod(key_file, 0o644)  # others could read it: refused before anything is copied
+    assert run(argv + ["--keys", key_file]) == 2
+    assert "chmod 600" in capsys.readouterr().out and len(calls()) == n
+
+
 BOARD_SAYS = """#!/bin/sh
 echo "$(basename "$0") $*" >> "{log}"
 case "$*" in *_mpy*) echo {mpy} ;; esac

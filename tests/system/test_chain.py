@@ -1,6 +1,7 @@
 """The twelve-step chain end to end (``obsw_host.obc.chain``), then its faults: each OBC process
 killed in turn, bus A cut, UART A cut, the whole OBC killed and power-cycled by the
-reconfiguration module on an essential TC. Every wait has a deadline; the figures are printed,
+reconfiguration module on an essential TC, the whole OBC hung and power-cycled by the module
+alone. Every wait has a deadline; the figures are printed,
 nothing asserts on time."""
 
 import os
@@ -163,6 +164,25 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
         tries = led.ping_until_ok()
         figures.append(("2 failures: platform manager had the OBC power-cycled (%d pings)"
                         % tries, time.monotonic() - t))  # fmt: skip
+
+        # the whole OBC hung (every process stopped): the reconfiguration module misses its
+        # SpaceCAN heartbeat and power-cycles it by itself, without any ground TC
+        led.ping_until_ok()
+        time.sleep(2.0)  # the OBC in its stride: heartbeats flowing, no TC frame outstanding
+        boots = chain.sim.obc_boots
+        t = time.monotonic()
+        chain.sim.hang_obc()
+        assert chain.sim.wait_for(lambda: chain.sim.seen("recovery: power_cycle line 0"), WAIT)
+        assert chain.sim.wait_for(lambda: chain.sim.obc_boots == boots + 1, WAIT)
+        try:
+            tries = led.ping_until_ok()
+        except AssertionError:
+            fop = chain.station.ground.fop
+            raise AssertionError("FOP-1 state %r, vs %r" % (fop.state, fop.vs)) from None
+        figures.append(("OBC hung: power-cycled by the module alone, serving again (%d pings)"
+                        % tries, time.monotonic() - t))  # fmt: skip
+        tx, end = chain.switch(0x003, name="after_hang", timeout=20.0)
+        assert (tx.ok, end) == (True, "obcp.finished")
     with capsys.disabled():
         print("\n  12-step chain and faults, %.1f s in all:" % (time.monotonic() - t_start))
         for what, seconds in figures:

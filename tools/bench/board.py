@@ -76,6 +76,8 @@ CASES = (
     ("loop_idle", "main loop pass, idle", 8),
     ("loop_busy", "main loop pass, busy (status, report, save, four frames)", 4),
     ("essential_tc", "essential TC: CLTU to CPDU line change", 4),
+    ("essential_tc_hmac", "essential TC, SDLS HMAC-SHA-256 verified", 4),
+    ("essential_tc_gcm", "essential TC, SDLS AES-256-GCM verified (AES in Python)", 4),
     ("sgm_write", "safeguard record write (both EEPROMs, read back)", 4),
     ("sgm_read", "safeguard record read (both EEPROMs, ECC, compare)", 4),
     ("pus_tc_decode", "PUS TC decode (TC[17,1])", 8),

@@ -232,6 +232,41 @@ def _essential(rig):
     return op
 
 
+def _essential_secured(rig, algorithm):
+    # the same HPCs as essential_tc, each frame authenticated on the essential MAP's SA (SPI
+    # 63): HMAC-SHA-256, or AES-256-GCM (on a board without cryptolib, AES in Python)
+    from obsw.frames import cltu, sdls, tc
+    from obsw.frames.sdls_gcm import GcmSecurityAssociation
+    from obsw.reconfig.essential import HPC_LINES, TARGET_BOTH, Hpc
+
+    key = bytes(range(32))
+
+    def sa():
+        if algorithm == "gcm":
+            return GcmSecurityAssociation(63, 0, key, 63, reserve_block=1 << 20)
+        return sdls.SecurityAssociation(63, 0, key, 63)
+
+    app = rig.app
+    hal = rig.hal
+    app.essential.frames.security = sdls.TcSecurity([sa()])
+    sender = sdls.TcSecurity([sa()])
+    values = []
+    for i in range(12):  # every measured operation takes a fresh frame (anti-replay)
+        hpc = Hpc(HPC_LINES, (0x0F0, (0x0A0, 0x050)[i & 1]), TARGET_BOTH)
+        data = sender.apply(SCID, 0, tc.Segment(63, hpc.packet()).pack(), True)
+        values.append(cltu.encode(tc.TcFrame(SCID, 0, data, i, bypass=True).pack()))
+    state = [0]
+
+    def op():
+        k = state[0]
+        state[0] = k + 1
+        hal.uart_rx[0].extend(values[k])
+        app.step()
+        hal.uart_tx[0] = bytearray()
+
+    return op
+
+
 def _sgm_write(rig):
     from obsw.reconfig.app import RECORD_CONTEXT
 
@@ -336,6 +371,8 @@ OPS = {
     "loop_idle": _loop_idle,
     "loop_busy": _loop_busy,
     "essential_tc": _essential,
+    "essential_tc_hmac": lambda rig: _essential_secured(rig, "hmac"),
+    "essential_tc_gcm": lambda rig: _essential_secured(rig, "gcm"),
     "sgm_write": _sgm_write,
     "sgm_read": _sgm_read,
     "pus_tc_decode": _pus_tc_decode,

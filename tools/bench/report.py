@@ -39,12 +39,15 @@ RUNS = {
     "cfdp_udp": ("cfdp_udp.py", {}, "CFDP over UDP, two processes"),
     "spacecan": ("spacecan.py", {}, "SpaceCAN"),
     "frames": ("frames.py", {}, "Space data link: frames, CLTU, COP-1, SDLS"),
+    "sdls": ("sdls.py", {}, "SDLS AES-256-GCM per frame"),
     "pluto": ("pluto.py", {}, "PLUTO procedures"),
     "reconfig": ("reconfig.py", {}, "Reconfiguration module logic (host)"),
     "board": ("board.py", {}, "Reconfiguration module CPU budget (Cortex-M, QEMU)"),
     "chain": ("chain.py", {}, "The end-to-end chain"),
     "obc_start": ("obc_start.py", {}, "OBC cold start"),
+    "supervision": ("supervision.py", {}, "OBC recovery of a killed and a hung unit"),
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
+    "recovery": ("recovery.py", {}, "Autonomous recovery of a hung OBC"),
 }
 # benchmarks whose figures do not depend on the host's load (instructions counted under QEMU)
 EXACT = ("board",)

@@ -14,6 +14,7 @@ receiver has confirmed (its keep-alive and Finished PDUs), not the bytes sent.
 """
 
 import os
+import sys
 import time
 
 from obsw.cfdp import msgs
@@ -25,6 +26,7 @@ STATUS_NAMES = {0: "undefined", 1: "active", 2: "terminated", 3: "unrecognized"}
 FILE_STATUS = {0: "discarded", 1: "discarded by filestore", 2: "retained", 3: "unreported"}
 TIMEOUT = 60.0  # seconds for a whole transaction
 ANSWER_TIMEOUT = 5.0  # seconds to wait for the first PDU from the remote entity
+CANCEL_WAIT = 10.0  # seconds a cancelled transaction may take to tell the receiver (Ctrl-C)
 
 
 def state_dir():
@@ -219,6 +221,15 @@ class CfdpClient:
         }
         return result
 
+    def cancel(self, tid, finished, seconds=CANCEL_WAIT):
+        """Cancel transaction ``tid`` (CFDP cancel request): its EOF (cancel) goes to the
+        receiver, which discards the partial file; steps the entity until ``finished()`` (the
+        EOF acknowledged in class 2) or for at most ``seconds``."""
+        self.entity.cancel(tid, time.monotonic())
+        end = time.monotonic() + seconds
+        while not finished() and time.monotonic() < end:
+            self.udp.step()
+
     def _expects_answer(self):
         return any(r.mode == 0 for r in self.entity.mib.remotes.values()) or self._request
 
@@ -249,6 +260,10 @@ class CfdpClient:
         self._request = False
         try:
             self._run(lambda: bool(fin), result, remote, progress if on_progress else None)
+        except KeyboardInterrupt:  # Ctrl-C: cancel, so the receiver keeps no partial file
+            print("cancelling the transfer (Ctrl-C again leaves at once)", file=sys.stderr)
+            self.cancel(tid, lambda: bool(fin))
+            raise
         finally:
             self._handlers.remove(on)
         if fin:

@@ -1,5 +1,8 @@
 """`obsw board`: build, deploy, flash, repl and test the reconfiguration module's Pyboard."""
 
+import signal
+import sys
+
 
 def add_parser(sub):
     p = sub.add_parser("board", help="Pyboard firmware for the reconfiguration module")
@@ -43,6 +46,12 @@ def add_parser(sub):
                 "--march",
                 help="mpy-cross architecture (default: the board's own, else armv7emsp)",
             )
+            q.add_argument("--keys", help="the board's SDLS key file, installed as tc.keys")
+            q.add_argument(
+                "--insecure",
+                action="store_true",
+                help="no keys: let the board take essential TCs unauthenticated (logged)",
+            )
         if name == "test":
             q.add_argument(
                 "files", nargs="*", help="test files (default: the reconfiguration core tests)"
@@ -79,6 +88,10 @@ def _qemu(args):
 
     def go():
         q = board.qemu(args.qemu_args)
+        # SIGTERM (a service manager, `kill`) ends QEMU too, as Ctrl-C does, not only this
+        # process; SIGHUP (the terminal closed) likewise
+        for signum in (signal.SIGTERM, signal.SIGHUP):
+            signal.signal(signum, _interrupt)
         print("QEMU board on %s (obsw board deploy|test|repl --port %s); Ctrl-C ends it"
               % (q.pty, q.pty), flush=True)  # fmt: skip
         try:
@@ -91,12 +104,44 @@ def _qemu(args):
     return _guard(go)
 
 
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
 def _deploy(args):
     from obsw_host import board
 
-    return _guard(
-        lambda: print("%d modules deployed" % len(board.deploy(args.port, march=args.march)))
-    )
+    def go():
+        names = board.deploy(
+            args.port,
+            march=args.march,
+            keys=args.keys,
+            insecure=args.insecure,
+            progress=_progress,
+        )
+        print("%d modules deployed" % len(names))
+        if args.keys:
+            print("SDLS keys installed on the board as tc.keys (from %s)" % args.keys)
+        elif args.insecure:
+            print("SDLS OFF on the board (tc.insecure): essential TCs accepted unauthenticated")
+        else:
+            print(
+                "SDLS keys NOT installed (no --keys): unless the board already has tc.keys, "
+                "it refuses every essential TC"
+            )
+
+    return _guard(go)
+
+
+def _progress(text):
+    """One step of long work on stderr: rewritten in place on a terminal, a line otherwise."""
+    if sys.stderr.isatty():
+        sys.stderr.write("\r\x1b[K" + text)
+        if text.startswith("copying"):
+            sys.stderr.write("\n")
+    else:
+        sys.stderr.write(text + "\n")
+    sys.stderr.flush()
 
 
 def _flash(args):

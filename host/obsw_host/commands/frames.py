@@ -6,6 +6,7 @@ import binascii
 import json
 
 from obsw_host import ids as mission_ids
+from obsw_host.errors import UserError, user_message
 from obsw_host.net import DEFAULT_HOST
 
 
@@ -124,7 +125,7 @@ def processor(args):
         try:
             security = security_options(args.keys, ids.sdb, args.key_state)
         except (OSError, ValueError, KeyError) as e:
-            raise SystemExit("obsw frames processor: %s" % e) from None
+            raise _mistake("processor", e) from None
     try:
         host = FrameProcessorHost(
             args.uart_a,
@@ -143,7 +144,7 @@ def processor(args):
             **security,
         )
     except ValueError as e:
-        raise SystemExit("obsw frames processor: %s" % e) from None
+        raise _mistake("processor", e) from None
     for link in host.links:
         link.port.baudrate = args.baudrate
     print("frame processor: %s + %s, TC to UDP %s:%d+APID, TM on UDP %d (VC %d), playback "
@@ -178,7 +179,7 @@ def keygen(args):
             args.ahead,
         )
     except (OSError, ValueError) as e:
-        raise SystemExit("obsw frames keygen: %s" % e) from None
+        raise _mistake("keygen", e) from None
     for sa in sas:
         print("SA %d: VC %d MAP %s, HMAC-SHA-256 MAC %d octets, window %d" % (
             sa.spi, sa.vcid, "any" if sa.map_id is None else sa.map_id, sa.mac_length,
@@ -203,7 +204,7 @@ def sign_frame(args):
         )
         state.save()
     except (OSError, ValueError) as e:
-        raise SystemExit("obsw frames sign: %s" % e) from None
+        raise _mistake("sign", e) from None
     print(binascii.hexlify(encode(frame) if args.cltu else frame).decode())
     return 0
 
@@ -234,7 +235,7 @@ def cltu_decode(args):
         data, fixed = decode(_hex(args.hex), args.randomize)
         frame = TcFrame.unpack(data, trailing=True)
     except FrameError as e:
-        raise SystemExit("obsw frames cltu decode: %s" % e) from None
+        raise _mistake("cltu decode", e) from None
     out = _frame_json(frame)
     out["corrected_bits"] = fixed
     print(json.dumps(out))
@@ -256,7 +257,7 @@ def tm_decode(args):
     try:
         frame = TmFrame.unpack(raw)
     except FrameError as e:
-        raise SystemExit("obsw frames tm decode: %s" % e) from None
+        raise _mistake("tm decode", e) from None
     out = {
         "scid": frame.scid,
         "vcid": frame.vcid,
@@ -285,10 +286,16 @@ def verify_frame(args):
             raw, _ = decode(raw)
         frame = TcFrame.unpack(raw, trailing=True)
     except (OSError, FrameError) as e:
-        raise SystemExit("obsw frames verify: %s" % e) from None
+        raise _mistake("verify", e) from None
     outcome, sa, sn, clear = security.process(raw, len(frame))
     out = _frame_json(frame)
     out.update(outcome=OUTCOME_NAMES[outcome], spi=None if sa is None else sa.spi, sn=sn)
     out["data"] = None if clear is None else binascii.hexlify(clear).decode()
     print(json.dumps(out))
     return 0 if clear is not None else 1
+
+
+def _mistake(action, e):
+    """A bad key file, path or input of ``action`` as one line (exit status 2), the errno
+    spelled out as every command spells it (``obsw_host.errors.user_message``)."""
+    return UserError("%s: %s" % (action, user_message(e) or e))

@@ -54,6 +54,7 @@ import json
 import sys
 
 from obsw_host import ids as mission_ids
+from obsw_host.commands import arguments
 from obsw_host.errors import UserError
 from obsw_host.net import DEFAULT_HOST
 
@@ -82,10 +83,12 @@ def add_parser(sub):
 
     obcp.add_to_ground(s)
     cfdp.add_parser(s)  # obsw ground cfdp put|get|status|serve
-    from obsw_host.commands import ground_memory, ground_services
+    from obsw_host.commands import ground_console, ground_data, ground_memory, ground_services
 
     ground_services.add_to_ground(s)  # obsw ground device|diag|functional|forward (2, 3, 14)
     ground_memory.add_to_ground(s)  # obsw ground memory ..|store ..
+    ground_console.add_to_ground(s)  # obsw ground watch|console
+    ground_data.add_to_ground(s)  # obsw ground stats|store ..|file (services 4, 15, 23)
 
     _add_operator(s)
     s.add_parser("ping", help="TC[17,1] are-you-alive").set_defaults(func=_ping)
@@ -118,7 +121,7 @@ def add_parser(sub):
     x.add_argument("interval", type=int)
     x.set_defaults(func=_hk_interval)
     x = hk.add_parser("listen", help="print periodic reports")
-    x.add_argument("--seconds", type=float, default=3.0)
+    x.add_argument("--seconds", type=arguments.seconds, default=3.0)
     x.set_defaults(func=_listen, listen=(3, 25))
     ground_services.add_to_hk(hk)  # obsw ground hk append
 
@@ -140,7 +143,7 @@ def add_parser(sub):
         x.add_argument("names", nargs="+")
         x.set_defaults(func=_events_switch, ev_action=name)
     x = ev.add_parser("listen", help="print event reports")
-    x.add_argument("--seconds", type=float, default=3.0)
+    x.add_argument("--seconds", type=arguments.seconds, default=3.0)
     x.set_defaults(func=_listen, listen=(5, None))
 
     _add_automation(s)
@@ -151,7 +154,7 @@ def add_parser(sub):
     x.add_argument("exponent", type=int)
     x.set_defaults(func=_time_rate)
     x = ti.add_parser("listen", help="print time reports (CUC TM[9,2] or CDS TM[9,3])")
-    x.add_argument("--seconds", type=float, default=3.0)
+    x.add_argument("--seconds", type=arguments.seconds, default=3.0)
     x.set_defaults(func=_listen, listen=(9, None))
 
 
@@ -198,8 +201,8 @@ def _add_automation(s):
         description="Without ACTION: print every TM as it arrives until Ctrl-C (or --seconds, "
         "--count). With ACTION: service 12 on-board monitoring.",
     )
-    mo.add_argument("--seconds", type=float, help="stop after this many seconds")
-    mo.add_argument("--count", type=int, help="stop after this many TM packets")
+    mo.add_argument("--seconds", type=arguments.seconds, help="stop after this many seconds")
+    mo.add_argument("--count", type=arguments.count, help="stop after this many TM packets")
     mo.add_argument("--colour", choices=("auto", "always", "never"), default="auto")
     mo.add_argument("--log", metavar="FILE", default=argparse.SUPPRESS, help="session log")
     mo.set_defaults(func=_monitor_live)
@@ -313,7 +316,7 @@ def _monitor_live(args):
 
     seen = [0]
     with _ground(args) as g:
-        display = Display(g.sdb, _colour(args), getattr(args, "raw", False))
+        display = Display(g.sdb, _colour(args), getattr(args, "raw", False), g.proc.config)
 
         def show(tm, decoded, tx):
             seen[0] += 1
@@ -369,7 +372,7 @@ def _list(args):
 
 
 def _run(args, fn):
-    from obsw_host.pus import text
+    from obsw_host.pus import display, text
     from obsw_host.pus.ground import PusTimeout
 
     with _ground(args) as g:
@@ -380,7 +383,7 @@ def _run(args, fn):
         sdb = g.sdb
         target = g.target
     result = text.transaction(tx)
-    detail = text.failure_detail(tx, sdb)
+    detail = display.failure_detail(tx, sdb)  # the component's error by name
     if args.json:
         if detail:
             result["failure_detail"] = detail
@@ -391,7 +394,7 @@ def _run(args, fn):
             line = "%s (%s)" % (line.split(" data ")[0], detail)
         print("  " + line)
     for reply in tx.replies:
-        print(text.readable(reply, sdb, getattr(args, "raw", False)))
+        print(display.readable(reply, sdb, getattr(args, "raw", False)))  # names, tables
     if not tx.done:
         print(_no_answer(args, tx, target))
     return 0 if tx.ok else 1
@@ -489,7 +492,7 @@ def _listen(args):
     service, subtype = args.listen
     n = 0
     with _ground(args) as g:
-        display = Display(g.sdb, raw=getattr(args, "raw", False))
+        display = Display(g.sdb, raw=getattr(args, "raw", False), config=g.proc.config)
         g.subscribe()
         print(
             "listening for TM[%s,%s] from %s:%d for %gs"

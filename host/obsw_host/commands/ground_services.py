@@ -18,7 +18,7 @@ On SpaceCAN, an on/off address is node << 8 | on << 7 | line, a register address
 node << 16 | parameter id, a CPDU line node << 8 | output line (obsw.spacecan.device_access).
 """
 
-from obsw_host.commands import ground
+from obsw_host.commands import ground, ground_data
 from obsw_host.errors import UserError
 from obsw_host.pus import text
 from obsw_host.pus.storage_ground import StorageGround
@@ -173,10 +173,15 @@ def add_to_ground(s):
         func=_forward, what="report"
     )
 
-    x = s.add_parser("tc", help="any TC: service, subtype and application data in hex")
-    x.add_argument("service", type=int)
-    x.add_argument("subtype", type=int)
-    x.add_argument("data", nargs="?", default="", help="application data, hex (default none)")
+    x = s.add_parser(
+        "tc",
+        help="any TC: by name from the database, or by service, subtype and data in hex",
+        description="`tc FUNCTION [ARG=VALUE..]` (TC[8,1]) or `tc PARAMETER=VALUE..` "
+        "(TC[20,3]) by name from the database, every value checked against its type and the "
+        "database's range before anything is sent; or `tc SERVICE SUBTYPE [HEX]`.",
+    )
+    x.add_argument("what", metavar="NAME|SERVICE", help="a function, PARAMETER=VALUE, or a number")
+    x.add_argument("rest", nargs="*", metavar="ARG=VALUE|SUBTYPE [HEX]")
     x.set_defaults(func=_tc)
 
 
@@ -259,6 +264,14 @@ def _forward(args):
 
 
 def _tc(args):
+    if not args.what.isdigit():
+        return ground_data.tc_by_name(args)  # a function or parameters, typed and checked
+    if not 1 <= len(args.rest) <= 2:
+        raise UserError(
+            "tc %s" % " ".join([args.what] + args.rest), expected="SERVICE SUBTYPE [HEX]"
+        )
+    args.service, args.subtype = int(args.what), _int(args.rest[0])
+    args.data = args.rest[1] if len(args.rest) > 1 else ""
     try:
         data = bytes.fromhex(args.data)
     except ValueError:

@@ -20,6 +20,7 @@ import sys
 
 from obsw_host.errors import UserError
 from obsw_host.mission import locate
+from obsw_host.obc import service
 from obsw_host.obc.config import ConfigError
 from obsw_host.obc.config import load as load_config
 from obsw_host.obc.state import StateLock, StateLocked, default_state
@@ -45,6 +46,21 @@ def add_parser(sub):
     r.add_argument("config", nargs="?", help=MISSION_HELP)
     r.add_argument("--state", help="the state folder (default: the mission's)")
     r.set_defaults(func=reset)
+    i = s.add_parser(
+        "install-service",
+        help="write the systemd unit that runs this mission's OBC (Type=notify, WatchdogSec)",
+    )
+    i.add_argument("config", nargs="?", help=MISSION_HELP)
+    i.add_argument("--state", help="the state folder (default: the mission's, else %s)" % (
+        service.DEFAULTS["state"]))  # fmt: skip
+    i.add_argument("--user", help="the user the OBC runs as (default %(default)s)",
+                   default=service.DEFAULTS["user"])  # fmt: skip
+    i.add_argument("--obsw", help="the obsw command (default: the one running now)")
+    i.add_argument("--watchdog-sec", type=int, default=service.DEFAULTS["watchdog_sec"],
+                   help="systemd's WatchdogSec= (default %(default)s s)")  # fmt: skip
+    i.add_argument("--root", default="/", help="write under this folder instead of / (images)")
+    i.add_argument("--dry-run", action="store_true", help="print the unit, write nothing")
+    i.set_defaults(func=install_service)
 
 
 def add_serve_arguments(x):
@@ -96,6 +112,10 @@ def serve(args):
                     print(problem, file=sys.stderr, flush=True)
                 return EXIT_REFUSED
         config = load(args)
+        if config.runs("frames"):  # refuse at once, before any process starts
+            from obsw_host.frames import policy
+
+            policy.check(config)
         topology = Topology(config)
         if args.process:
             return _serve_process(topology, args, out)
@@ -164,6 +184,33 @@ def reset(args):
     except StateLocked as e:
         return _refuse("%s: not reset" % e)
     print(("removed %s" if removed else "nothing to remove at %s") % config.state)
+    return 0
+
+
+def install_service(args):
+    try:
+        config = load_config(args.config)
+        state = args.state or (config.state if "state" in config.doc else None)
+        text = service.unit_text(
+            mission=os.path.abspath(config.path),
+            obsw=args.obsw
+            or os.path.join(os.path.dirname(os.path.abspath(sys.executable)), "obsw"),  # fmt: skip
+            state=os.path.abspath(state) if state else None,
+            user=args.user,
+            watchdog_sec=args.watchdog_sec,
+        )
+    except (ConfigError, UserError, ValueError) as e:
+        return _refuse(e)
+    if args.dry_run:
+        print(text, end="")
+        return 0
+    try:
+        path = service.install(text, args.root)
+    except OSError as e:
+        return _refuse("cannot write the unit under %s: %s" % (args.root, e))
+    print("wrote %s" % path)
+    if args.root == "/":
+        print("now: systemctl daemon-reload && systemctl enable --now %s" % service.UNIT_NAME)
     return 0
 
 

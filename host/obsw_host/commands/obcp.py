@@ -73,6 +73,7 @@ def add_client_options(p):
     p.add_argument("--timeout", type=float, default=2.0, help="seconds per request")
     p.add_argument("--json", action="store_true", help="print JSON for scripts")
     p.add_argument("-v", "--verbose", action="store_true", help="print every packet")
+    p.add_argument("--log", metavar="FILE", help="append every TC and TM to this session log")
 
 
 def add_actions(s):
@@ -185,6 +186,7 @@ def _run(args, fn):
     from obsw_host.pus.obcp_ground import explain
 
     ground, obcp = _client(args)  # bad input: typed errors, one line from obsw_host.cli
+    _session(ground, args)
     with ground:
         try:
             tx = fn(obcp)
@@ -200,6 +202,17 @@ def _run(args, fn):
         for reply in tx.replies:
             _print_reply(reply)
     return 0 if tx.ok else 1
+
+
+def _session(ground, args):
+    """Sequence counts that differ from an earlier run's (unique request IDs), and the
+    session log of ``--log`` (also `obsw ground --log .. obcp`)."""
+    from obsw_host.commands import ground as ground_command
+    from obsw_host.pus.monitor import SessionLog
+
+    ground_command._fresh(ground)
+    if getattr(args, "log", None):
+        ground.session = SessionLog(args.log)
 
 
 def _print_reply(reply):

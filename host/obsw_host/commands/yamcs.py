@@ -8,6 +8,8 @@ mission's PUS process and CFDP entity in-process, or with ``--obc HOST:PORT`` li
 
 import json
 import os
+import shutil
+import signal
 import sys
 import tempfile
 import threading
@@ -48,7 +50,7 @@ def add_parser(sub):
     )
     x.add_argument("--files", help="the on-board CFDP filestore (default: DIR/sat)")
     x.add_argument("--seconds", type=float, help="stop after this many seconds")
-    x.set_defaults(func=run)
+    x.set_defaults(func=run_in_temp)
 
 
 def _instance_options(x):
@@ -62,6 +64,10 @@ def _instance_options(x):
         help="PUS packets over TCP, or TC/TM frames with CLTUs and COP-1 over UDP",
     )
     x.add_argument("--http-port", type=int, help="web and API port (default: the mission's)")
+    x.add_argument(
+        "--keys",
+        help="SDLS key file (frames mode): TC and TM protected with Yamcs' AES-256-GCM SDLS",
+    )
     for name in YAMCS_LINKS:
         x.add_argument(
             "--%s-port" % name.replace("_", "-"),
@@ -99,19 +105,25 @@ def xtce(args):
 
 def _write(folder, ids, args, ports=None):
     """Write the mission's Yamcs instance into ``folder``; returns (instance name, MDB path)."""
+    from obsw.frames.sdls_keys import KeyFileError
+
     from obsw_host.yamcs import database
     from obsw_host.yamcs.instance import instance_name, write_instance
 
     name = instance_name(ids.name)
-    mdb = write_instance(
-        folder,
-        database.from_ids(ids),
-        args.mode,
-        ports=ports or _ports(args, ids),
-        http_port=_http_port(args, ids),
-        ids=ids,
-        name=name,
-    )
+    try:
+        mdb = write_instance(
+            folder,
+            database.from_ids(ids),
+            args.mode,
+            ports=ports or _ports(args, ids),
+            http_port=_http_port(args, ids),
+            ids=ids,
+            name=name,
+            keys=getattr(args, "keys", None),
+        )
+    except KeyFileError as e:
+        raise UserError(str(e)) from None
     return name, mdb
 
 
@@ -122,6 +134,10 @@ def config(args):
         "Yamcs instance %r (%s links) in %s, mission database %s"
         % (name, args.mode, args.dir, mdb)
     )
+    if args.keys and args.mode == "frames":
+        print(
+            "SDLS: AES-256-GCM on TC and TM from %s, keys in %s/etc/sdls" % (args.keys, args.dir)
+        )
     return 0
 
 
@@ -186,6 +202,7 @@ def run(args):
             tm_frames_port=ports["tm_frames"],
             ports=ports,
             ids=ids,
+            keys=args.keys if args.mode == "frames" else None,
         )
         what = "the spacecraft of %s" % (ids.mission_file or ids.sdb_file)
     try:
@@ -210,3 +227,21 @@ def run(args):
     finally:
         sat.close()
     return 0
+
+
+def run_in_temp(args):
+    """``run``; without ``--dir`` its instance (Yamcs' data, some MB) lives in a new temporary
+    folder that is removed when Yamcs stops, by Ctrl-C, SIGTERM, ``--seconds`` or an error."""
+    signal.signal(signal.SIGTERM, _interrupt)
+    print("starting Yamcs (Java; up to a minute) ...", file=sys.stderr, flush=True)
+    if args.dir:
+        return run(args)
+    args.dir = tempfile.mkdtemp(prefix="obsw-yamcs-")
+    try:
+        return run(args)
+    finally:
+        shutil.rmtree(args.dir, ignore_errors=True)
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt

@@ -20,7 +20,8 @@ class Ground:
     ``packets`` holds the TM packets decoded, ``channel_packets`` the same as (VC ID, packet).
     With ``security`` (an ``obsw.frames.sdls.TcSecurity``) each segment is signed with its
     channel's SA before FOP-1 (ApplySecurity in virtual channel generation), and ``state`` (a
-    ``keys.StateFile``) saves the sequence numbers after each one.
+    ``keys.StateFile``) saves the sequence numbers after each one. With ``tm_security`` (an
+    ``obsw.frames.sdls_gcm.TmSecurity``) TM frames of secured VCs are verified and decrypted.
     """
 
     def __init__(
@@ -38,6 +39,7 @@ class Ground:
         corrupt=None,
         security=None,
         state=None,
+        tm_security=None,
     ):
         self.links = list(links)
         self.scid = scid
@@ -50,7 +52,7 @@ class Ground:
         self.corrupt = corrupt
         self.decoders = [CaduDecoder(tm_frame_length, tm_randomize) for _ in self.links]
         self.dedup = Deduplicator(5.0)
-        self.demux = TmDemultiplexer(scid)
+        self.demux = TmDemultiplexer(scid, security=tm_security)
         self.queue = deque()
         self.notifications = []
         self.packets = deque()

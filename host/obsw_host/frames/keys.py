@@ -11,9 +11,14 @@ import os
 import stat
 
 from obsw.frames.sdls import SecurityAssociation
-from obsw.frames.sdls_keys import KeyFileError, dump_sas, load_security
+from obsw.frames.sdls_gcm import GCM, GcmSecurityAssociation
+from obsw.frames.sdls_keys import HMAC, KeyFileError, dump_sas, load_security, load_tm_security
 
 ESSENTIAL_SPI = 63  # the SA of the essential (high priority) commands, on their MAP
+TM_SPI_BASE = 64  # TM SAs: SPI 64 + VC ID
+EP_SPI = 62  # the SA of the SDLS extended procedures (key and SA management), on its own MAP
+EP_MAP = 62
+MASTER_ID = 1  # the first master key, made with the key file
 
 
 def inside_git_tree(path):
@@ -29,34 +34,93 @@ def inside_git_tree(path):
 
 
 def generate(
-    path, vcids=(0,), essential_map=63, mac_length=16, window=64, ahead=None, allow_git=False
+    path,
+    vcids=(0,),
+    essential_map=63,
+    mac_length=16,
+    window=64,
+    ahead=None,
+    allow_git=False,
+    algorithm=HMAC,
+    tm_vcids=(),
+    ep=False,
 ):
     """Write a new key file: one SA per VC (SPI = VC ID + 1) and, unless ``essential_map`` is
-    None, one for the essential MAP of the first VC (SPI 63), each with a fresh 256-bit key."""
+    None, one for the essential MAP of the first VC (SPI 63), each with a fresh 256-bit key;
+    ``algorithm`` "hmac-sha256", "aes-gcm" or "aes-gmac". With ``tm_vcids`` (GCM only), one
+    AES-GCM SA per TM VC too (SPI = 64 + VC ID). With ``ep``, the SA of the extended procedures
+    (SPI 62 on MAP 62) and the key store ``path + '.keystore'`` holding master key 1."""
     if not allow_git and inside_git_tree(path):
         raise KeyFileError("%s is inside a git work tree: keep keys out of repositories" % path)
-    sas = [
-        SecurityAssociation(v + 1, v, os.urandom(32), None, mac_length, 4, window, None, ahead)
-        for v in vcids
-    ]
-    if essential_map is not None:
-        sas.append(
-            SecurityAssociation(
-                ESSENTIAL_SPI,
-                vcids[0],
-                os.urandom(32),
-                essential_map,
-                mac_length,
-                4,
-                window,
-                None,
-                ahead,
+    if algorithm == HMAC and tm_vcids:
+        raise KeyFileError("TM SAs are AES-GCM: give algorithm aes-gcm or aes-gmac")
+
+    def sa(spi, vcid, map_id=None, alg=algorithm):
+        if alg == HMAC:
+            return SecurityAssociation(
+                spi, vcid, os.urandom(32), map_id, mac_length, 4, window, None, ahead
             )
+        return GcmSecurityAssociation(
+            spi, vcid, os.urandom(32), map_id, mac_length, window, None, ahead, alg
         )
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-    with os.fdopen(fd, "w") as f:
-        f.write(dump_sas(sas) + "\n")
+
+    sas = [sa(v + 1, v) for v in vcids]
+    if essential_map is not None:
+        sas.append(sa(ESSENTIAL_SPI, vcids[0], essential_map))
+    if ep:
+        sas.append(sa(EP_SPI, vcids[0], EP_MAP))
+    for v in tm_vcids:
+        tm = sa(TM_SPI_BASE + v, v, None, GCM)
+        tm.link = "tm"
+        sas.append(tm)
+    write_sas(path, sas)
+    if ep:
+        from obsw.frames.sdls_ep import ACTIVE, KeyStore
+
+        store = KeyStore()
+        store.add(MASTER_ID, os.urandom(32), ACTIVE)
+        save_keystore(keystore_path(path), store, replace=False)
     return sas
+
+
+def keystore_path(key_path):
+    return key_path + ".keystore"
+
+
+def load_keystore(path):
+    """The KeyStore (``obsw.frames.sdls_ep``) at ``path``, refused when others can read it."""
+    from obsw.frames.sdls_ep import EpError, KeyStore
+
+    try:
+        return KeyStore.load(read_key_file(path))
+    except (EpError, ValueError, KeyError, TypeError) as e:
+        raise KeyFileError("%s is not a key store: %s" % (path, e)) from None
+
+
+def save_keystore(path, store, replace=True):
+    """Write ``store`` to ``path`` (owner only), atomically over an existing file."""
+    _write_secret(path, store.dump() + "\n", replace)
+
+
+def write_sas(path, sas, replace=False):
+    """Write ``sas`` as the key file ``path``, readable by its owner only; with ``replace``
+    over an existing file, atomically (the old file stays whole until the new one is)."""
+    _write_secret(path, dump_sas(sas) + "\n", replace)
+
+
+def _write_secret(path, text, replace):
+    if not replace:
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        return
+    tmp = path + ".tmp"
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(fd, "w") as f:
+        f.write(text)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
 
 
 def state_path(key_path):
@@ -66,25 +130,47 @@ def state_path(key_path):
 def load(path, state=None, segment_header=True):
     """(TcSecurity, StateFile) of key file ``path``, with its sequence numbers restored from
     ``state`` (a path; by default ``path + '.state'``; missing is fine: a fresh file starts at
-    0; False: no state file, and the StateFile is None)."""
-    mode = os.stat(path).st_mode
+    0; False: no state file, and the StateFile is None). The TM SAs of the file, if any, are
+    ``StateFile.tm`` (see ``load_all``)."""
+    security, _, keeper = load_all(path, state, segment_header)
+    return security, keeper
+
+
+def read_key_file(path):
+    """The text of key file ``path``; KeyFileError when others can read it or it is missing."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise KeyFileError("key file %s does not exist" % path) from None
     if mode & (stat.S_IRWXG | stat.S_IRWXO):
         raise KeyFileError("%s can be read by others (chmod 600 it)" % path)
     with open(path) as f:
-        security = load_security(f.read(), segment_header)
+        return f.read()
+
+
+def load_all(path, state=None, segment_header=True):
+    """(TcSecurity, TmSecurity or None, StateFile or None) of key file ``path``; as ``load``.
+    Sending SAs that reserve IVs in blocks save the state file before each new block."""
+    text = read_key_file(path)
+    security = load_security(text, segment_header)
+    tm = load_tm_security(text)
     if state is False:
-        return security, None
-    keeper = StateFile(state or state_path(path), security)
+        return security, tm, None
+    keeper = StateFile(state or state_path(path), security, tm)
     keeper.load()
-    return security, keeper
+    security.on_reserve = keeper.save
+    if tm is not None:
+        tm.on_reserve = keeper.save
+    return security, tm, keeper
 
 
 class StateFile:
     """Saves ``security.context()`` (sequence numbers) with an atomic replace."""
 
-    def __init__(self, path, security):
+    def __init__(self, path, security, tm=None):
         self.path = path
         self.security = security
+        self.tm = tm
         self.saves = 0
 
     def load(self):
@@ -97,6 +183,8 @@ class StateFile:
             raise KeyFileError("%s is not a state file: %s" % (self.path, e)) from None
         try:
             self.security.restore(ctx)
+            if self.tm is not None:
+                self.tm.restore(ctx)
         except (ValueError, TypeError, IndexError) as e:
             raise KeyFileError("%s is not a state file: %s" % (self.path, e)) from None
         return True
@@ -105,7 +193,10 @@ class StateFile:
         tmp = self.path + ".tmp"
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
         with os.fdopen(fd, "w") as f:
-            json.dump(self.security.context(), f)
+            ctx = self.security.context()
+            if self.tm is not None:
+                ctx = ctx + self.tm.context()
+            json.dump(ctx, f)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, self.path)

@@ -18,6 +18,7 @@ process, which also serves TCs to that APID (e.g. TC[5,6] to disable an event). 
 ``state`` (a ``keys.StateFile``) saves the sequence numbers each time a frame is accepted.
 """
 
+import os
 import select
 import socket
 import struct
@@ -40,14 +41,40 @@ def sdb_events(sdb):
     return sdb.apid("frames"), tuple(ids)
 
 
-def security_options(key_path, sdb, state_path=None):
+def security_options(key_path, sdb, state_path=None, segment_header=True):
     """The FrameProcessorHost options that authenticate TC frames with the key file at
     ``key_path`` and report rejections as the events of ``sdb`` (a spacecraft database)."""
     from obsw_host.frames import keys
 
-    security, state = keys.load(key_path, state_path)
+    security, tm_security, state = keys.load_all(key_path, state_path, segment_header)
     event_apid, event_ids = sdb_events(sdb)
-    return {"security": security, "state": state, "event_apid": event_apid, "event_ids": event_ids}
+    ep = {}
+    store_path = keys.keystore_path(key_path)
+    has_ep_sa = [sa for sa in security.sas.values() if sa.map_id == keys.EP_MAP]
+    if segment_header and has_ep_sa and os.path.exists(store_path):
+        from obsw.frames.sdls_ep import ExtendedProcedures
+
+        engine = ExtendedProcedures(keys.load_keystore(store_path), security, tm_security)
+        sas = list(security.sas.values()) + (
+            list(tm_security.sas.values()) if tm_security is not None else []
+        )
+
+        def save():  # keys and SA states survive power cycles: both files replaced atomically
+            keys.save_keystore(store_path, engine.store)
+            keys.write_sas(key_path, sas, replace=True)
+            if state is not None:
+                state.save()
+
+        engine.on_change = save
+        ep = {"ep": engine, "ep_map": keys.EP_MAP, "ep_apid": event_apid}
+    return {
+        **ep,
+        "security": security,
+        "tm_security": tm_security,
+        "state": state,
+        "event_apid": event_apid,
+        "event_ids": event_ids,
+    }
 
 
 class _Clock:

@@ -64,8 +64,13 @@ def _station_class():
 class Chain:
     """The chain (see the module text); ``start()``/``stop()`` or a context manager."""
 
-    def __init__(self, work, out=None, timeout=10.0):
+    # the reconfiguration module's autonomous recovery in the chain: a hung OBC is power-cycled
+    # after 8 s without a SpaceCAN heartbeat (the OBC's processes restart faster than that)
+    RECOVERY = {"deadline": 8.0, "boot_grace": 20.0, "off_ms": 300, "max_failures": 10}
+
+    def __init__(self, work, out=None, timeout=10.0, recovery=None):
         self.work = work
+        self.recovery = dict(self.RECOVERY, **(recovery or {}))
         self.out = out
         self.timeout = timeout
         self.state = os.path.join(work, "obc-state")
@@ -158,7 +163,9 @@ class Chain:
         self.links = [FdLink(ends[0][0], "A"), FdLink(ends[1][0], "B")]
         sim_dir = os.path.join(self.work, "reconfig")
         os.makedirs(sim_dir, exist_ok=True)
-        self.sim = ReconfigSim(sim_dir, obc_command=self._obc_command, out=self.out)
+        self.sim = ReconfigSim(
+            sim_dir, obc_command=self._obc_command, out=self.out, recovery=self.recovery
+        )
         security, state = keys.load(self.sim.key_file, os.path.join(self.work, "station.state"))
         self.ids = MissionIds.sample()  # the sample's, as write_config gives the OBC
         self.station = _station_class()(

@@ -4,12 +4,15 @@ A mission file's section overrides these key by key (``section(config, "pus")``)
 else in the OBC writes a default of its own.
 """
 
+from obsw.reconfig import recovery as _recovery
+
 PUS = {
     "period": 0.1,  # seconds per activity cycle
     "playback_rate": 64,  # packets per second service 15 plays back
     "device_timeout": 5.0,  # seconds service 2 waits for a device
     "follow_period": 0.25,  # seconds between looks for components that (re)appeared
     "time_code": "cuc",  # ST[09] time reports: "cuc" (TM[9,2]) or "cds" (TM[9,3])
+    "monitoring": [],  # ST[12] limit checks installed at the first start (obc.monitoring)
 }
 CFDP = {"peers": {}}  # ports and ids: obsw_host.ports and obsw_host.ids (the mission's)
 OBCP = {"timeout": 2.0, "activity_timeout": 30.0, "level": 2, "step_period": 0.01}
@@ -36,7 +39,18 @@ PLATFORM = {
     "window": 60.0,  # ... within this many seconds: power-cycle the OBC
     "power_cycle": {"component": "CpduN", "line": 0, "off_ms": 500},
     "crash_loop": 3,  # this many deaths in a row before a first heartbeat: stop the process
+    # supervision (obsw_host.obc.supervision): the hardware watchdog and health telemetry
+    "watchdog": None,  # watchdog device (e.g. "/dev/watchdog"); None: no hardware watchdog
+    "watchdog_timeout": 15,  # seconds without a kick before the board resets (Pi: at most 15)
+    "critical": None,  # processes the watchdog waits for; None: every process
+    "health_period": 1.0,  # seconds between samples of the OBC's health telemetry
+    "health_root": "/",  # where /proc and /sys are (a simulated tree in tests)
+    "disk": None,  # the file system whose use is reported; None: the state folder's
+    "thermal_zone": "thermal_zone0",  # /sys/class/thermal/<zone>/temp: the SoC's sensor
 }
+# the reconfiguration module's autonomous recovery of the OBC (delivered to the boards in their
+# mission.json, obsw.reconfig.mission); the module's own fallback is the same table, in the core
+RECOVERY = dict(_recovery.DEFAULTS, lines=list(_recovery.DEFAULTS["lines"]))
 SECTIONS = {
     "pus": PUS,
     "cfdp": CFDP,
@@ -44,6 +58,7 @@ SECTIONS = {
     "spacecan": SPACECAN,
     "frames": FRAMES,
     "platform": PLATFORM,
+    "recovery": RECOVERY,
 }
 
 

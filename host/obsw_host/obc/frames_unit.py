@@ -8,6 +8,7 @@ import tty
 
 from obsw.il.node import Node
 
+from obsw_host.frames import policy
 from obsw_host.frames.links import FdLink, SerialLink
 from obsw_host.frames.processor import FrameProcessorHost, security_options
 from obsw_host.il.transport import SocketTransport
@@ -74,9 +75,12 @@ class FramesUnit:
         ids = topology.ids
         ports = ids.ports
         security = {}
-        if opts.get("keys"):  # TC frames authenticated (SDLS) with this key file
+        key_path = policy.check(config)  # secure by default: keys, or "tc_security": "none"
+        if key_path is None:
+            out(policy.OFF_WARNING)
+        else:  # TC (and TM, where the file has SAs for it) protected with SDLS
             state = os.path.join(config.state, "frames.keys.state")
-            security = security_options(config.resolve(opts["keys"]), sdb, state)
+            security = security_options(key_path, sdb, state)
         self.fp = FrameProcessorHost(
             links[0],
             links[1],

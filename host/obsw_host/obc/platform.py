@@ -31,6 +31,7 @@ from obsw.il.errors import InteractionError
 from obsw.il.node import Node
 
 from obsw_host.il.transport import SocketTransport
+from obsw_host.obc.supervision import Supervision
 from obsw_host.obc.topology import PLATFORM, Topology
 
 EXIT_REFUSED = 2  # a process's exit status when it refuses its configuration
@@ -60,7 +61,9 @@ class Child:
 class PlatformManager:
     """Supervises the processes of ``config`` (see the module text)."""
 
-    def __init__(self, config, *, out=print, python=sys.executable, clock=time.monotonic):
+    def __init__(
+        self, config, *, out=print, python=sys.executable, clock=time.monotonic, notifier=None
+    ):
         topology = config if isinstance(config, Topology) else Topology(config)
         config = topology.config
         self.topology = topology
@@ -86,6 +89,8 @@ class PlatformManager:
         self._stop = threading.Event()
         self.finished = threading.Event()  # set when every process is stopped
         self._thread = None
+        self.supervision = Supervision(self, notifier)  # watchdog and systemd
+        self._next_status = 0.0
 
     def _say(self, text):
         self.log.append((self.clock(), text))
@@ -216,6 +221,23 @@ class PlatformManager:
                 child.early_deaths = 0
             child.last_beat = self.clock()
         self._flush_events()
+        now = self.clock()
+        self.supervision.step(now)
+        if now >= self._next_status:
+            self._next_status = now + float(self.settings["health_period"])
+            self._send_status()
+
+    def _send_status(self):
+        """Restarts and watchdog state to the PUS process's ``Obc`` health component."""
+        fresh = self.clock() - 2 * float(self.settings["heartbeat"])
+        if not all(c.last_beat is not None and c.last_beat >= fresh for c in self.children
+                   if not c.stopped):  # fmt: skip
+            return  # a process is down or late: its heartbeat matters more than this figure
+        r = self.supervision.report()
+        try:
+            self.platform.status(r["restarts"], r["watchdog"])
+        except InteractionError:
+            pass  # best effort: the next one follows
 
     def start(self):
         for child in self.children:
@@ -243,6 +265,7 @@ class PlatformManager:
         self._stop.set()
         if self._thread is not None:
             self._thread.join(5.0)
+        self.supervision.stop()
         for child in self.children:
             p = child.popen
             if p is not None and p.poll() is None:

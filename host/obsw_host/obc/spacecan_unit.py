@@ -2,6 +2,7 @@
 nodes and device access (service 2's path to the nodes), in a thread of its own."""
 
 import threading
+import time
 
 from obsw_host.spacecan.obc import ObcSpaceCan
 
@@ -37,13 +38,24 @@ class SpaceCanUnit:
         self.obc.start()
         if self.opts.get("simulate"):
             self.obc.simulate()
-        self._thread = threading.Thread(target=self.obc.serve, name="spacecan", daemon=True)
+        self.last_loop = time.monotonic()
+        self._thread = threading.Thread(
+            target=self.obc.serve, kwargs={"until": self._loop}, name="spacecan", daemon=True
+        )
         self._thread.start()
         self.out("%r on %s" % (self.obc, self.obc.interface))
         return self
 
+    def _loop(self):
+        """Called by the master's loop at each turn: its work still moves."""
+        self.last_loop = time.monotonic()
+        return False
+
     def alive(self):
-        return self._thread is not None and self._thread.is_alive()
+        """The master's loop turned within 2 s (a loop blocked in a call is hung)."""
+        if self._thread is None or not self._thread.is_alive():
+            return False
+        return time.monotonic() - self.last_loop < 2.0
 
     def stop(self):
         self.obc.stop()

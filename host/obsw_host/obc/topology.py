@@ -25,7 +25,10 @@ HEALTH_BASE = 0x7F00  # interface ids of the processes' health components: base 
 PLATFORM = Interface(
     "Platform",
     0x7EFF,
-    [Operation("report", 1, ("event", "process", "pid"), description="raise a platform event")],
+    [
+        Operation("report", 1, ("event", "process", "pid"), description="raise a platform event"),
+        Operation("status", 2, ("restarts", "watchdog"), description="supervision figures"),
+    ],
     description="the platform manager's events, raised by the PUS process",
 )
 PLATFORM_EVENTS = ("started", "died", "restarted", "power_cycle", "stopped")
@@ -37,6 +40,20 @@ FRAME_PROCESSOR = Interface(
         Attribute("uart_b_dropped", 2, DATA, type="u32", description="TM frames UART B lost"),
     ],
     description="the frame processor's counters",
+)
+OBC_HEALTH = Interface(
+    "Obc",
+    0x7E20,
+    [
+        Attribute("cpu_load", 1, DATA, type="f32", unit="%", description="CPU busy, all cores"),
+        Attribute("memory_used", 2, DATA, type="f32", unit="%", description="RAM not available"),
+        Attribute("disk_used", 3, DATA, type="f32", unit="%", description="state file system"),
+        Attribute("temperature", 4, DATA, type="f32", unit="degC", description="SoC sensor"),
+        Attribute("uptime", 5, DATA, type="u32", unit="s", description="since the OBC booted"),
+        Attribute("restarts", 6, DATA, type="u32", description="process restarts since start"),
+        Attribute("watchdog", 7, DATA, type="u8", description="hardware watchdog state"),
+    ],
+    description="the OBC's own health (obsw_host.obc.health), published by the PUS process",
 )
 
 

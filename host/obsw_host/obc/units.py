@@ -24,16 +24,23 @@ from obsw.store import Store
 
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.il.transport import SocketTransport
-from obsw_host.obc.topology import PLATFORM, PLATFORM_EVENTS
+from obsw_host.obc import monitoring
+from obsw_host.obc.health import HostHealth, ObcHealth
+from obsw_host.obc.topology import OBC_HEALTH, PLATFORM, PLATFORM_EVENTS
 from obsw_host.pus.onboard import Onboard
 
 
 class PlatformEvents:
     """The PUS process's side of ``PLATFORM``: events raised on its application process."""
 
-    def __init__(self, app, sdb):
+    def __init__(self, app, sdb, health=None):
         self.app = app
         self.sdb = sdb
+        self.health = health
+
+    def status(self, restarts, watchdog):
+        if self.health is not None:
+            self.health.status(restarts, watchdog)
 
     def report(self, event, process, pid):
         if event not in PLATFORM_EVENTS:
@@ -97,6 +104,8 @@ class PusUnit:
         self.out = out
         opts = topology.section("pus")
         self.components = [c.build() for c in process.components]
+        self.health = self._health(topology)
+        self.components.append((OBC_HEALTH, self.health))
         self.interfaces = topology.interfaces()
         self.ids = ids = topology.ids
         playback_to = None
@@ -137,10 +146,20 @@ class PusUnit:
         self.onboard.follow_period = float(opts["follow_period"])
         self.app = self.onboard.app
         self.obcp = self.app.services.get(18)
-        self.node.provide(PLATFORM, PlatformEvents(self.app, sdb))
+        self.node.provide(PLATFORM, PlatformEvents(self.app, sdb, self.health))
+        monitoring.install(self.app, sdb, opts["monitoring"])  # first start: the mission's
         self._running = False
 
     # -------------------------------------------------------------------------- building
+
+    def _health(self, topology):
+        """The ``Obc`` health component (``obsw_host.obc.health``)."""
+        opts = topology.section("platform")
+        self.health_period = float(opts["health_period"])
+        host = HostHealth(
+            opts["health_root"], opts["disk"] or self.config.state, opts["thermal_zone"]
+        )
+        return ObcHealth(host)
 
     def _cfdp(self, opts):
         from obsw.cfdp.remote_copy import REMOTE_COPY, RemoteCopy
@@ -197,6 +216,11 @@ class PusUnit:
                 return
             await asyncio.sleep(0.005)
 
+    async def _health_task(self):
+        while self._running:
+            self.health.sample()
+            await asyncio.sleep(self.health_period)
+
     async def _engine_task(self):
         """Step the OBCP engine between the activity loop's cycles too: a procedure's next
         statement runs within ``step_period`` of its reply, not at the next cycle."""
@@ -214,6 +238,7 @@ class PusUnit:
     def start(self):
         self._running = True
         self.onboard.tasks.append(lambda: drive_transport(self.transport, self.node))
+        self.onboard.tasks.append(self._health_task)
         if self.cfdp is not None:
             self.onboard.tasks.append(self._cfdp_task)
         if self.engine is not None:

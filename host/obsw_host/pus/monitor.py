@@ -14,6 +14,7 @@ from obsw.pus.services.s01_verification import describe
 from obsw.utc import format_utc
 
 from obsw_host.pus import text
+from obsw_host.pus.display import tm_seconds
 from obsw_host.pus.onboard import TAI_MINUS_UNIX
 
 _COLOURS = {"TC": "36", "fail": "31", "high": "31", "medium": "33", "low": "33", "ok": "32"}
@@ -26,10 +27,11 @@ def utc_now():
 class Display:
     """One line per packet for an operator (see the module text)."""
 
-    def __init__(self, sdb=None, colour=False, raw=False):
+    def __init__(self, sdb=None, colour=False, raw=False, config=None):
         self.sdb = sdb
         self.colour = colour
         self.raw = raw  # raw parameter values instead of engineering ones
+        self.config = config  # the mission's PusConfig: its TM time code (default: PUS-C's)
         self.sent = {}  # (apid, seq) -> TC this ground sent, to name verification reports
 
     def _paint(self, line, kind):
@@ -48,8 +50,11 @@ class Display:
         )
         return self._paint(line, "TC")
 
-    def tm(self, tm, decoded):
-        when = format_utc(tm.time) if isinstance(tm.time, (int, float)) and tm.time else utc_now()
+    def tm(self, tm, decoded, when=None, config=None):
+        """One line for a TM: its on-board time in UTC, else ``when`` (a logged time), else
+        now."""
+        tai = tm_seconds(tm, config or self.config)
+        when = format_utc(tai) if tai else (when or utc_now())
         head = "%s  TM apid %4d seq %5d  TM[%d,%d] " % (
             when,
             tm.apid,
@@ -64,6 +69,13 @@ class Display:
             body, kind = self._verification(decoded)
         elif tm.service == 5 and "severity" in decoded:
             body, kind = self._event(decoded)
+        elif tm.service == 9 and isinstance(decoded.get("time"), (int, float)):
+            body = "%s: %s UTC, rate 2**%s s, status %s" % (
+                text.name(tm.service, tm.subtype) or "time report",
+                format_utc(decoded["time"]),
+                decoded.get("exponent", "?"),
+                decoded.get("status", "?"),
+            )
         else:
             body = text.name(tm.service, tm.subtype)
             summary = self.values(decoded)
@@ -161,4 +173,4 @@ def replay(path, sdb=None, colour=False):
                         raw.hex(),
                     )
                 else:
-                    yield display.tm(result[0], result[1])
+                    yield display.tm(result[0], result[1], record.get("utc"), g.proc.config)

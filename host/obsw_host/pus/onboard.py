@@ -208,6 +208,8 @@ class Onboard:
         self.tasks = []  # more coroutine functions to run on the process's loop
         self.providers = [self.node.provide(itf, impl) for itf, impl in components]
         self.pool = ParameterPool(sdb, self.node)
+        if store is not None:  # values set through service 20 survive a restart
+            self.pool.persist(store)
         self.events = EventManager(sdb, self.node)
         self.events.connect(self.app)
         self._own_parameters()

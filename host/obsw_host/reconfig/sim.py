@@ -4,7 +4,10 @@
 per controller (COM and OBC UARTs) and the CAN hub, starts the nominal and the redundant
 controller as MicroPython unix-port processes, and supervises what the board's hardware does:
 the TPS3813 window watchdogs and the CPDU_REQ stuck-line detectors reset (restart) a
-controller, and CPDU line ``obc_line`` powers the OBC process (off kills it, on starts it).
+controller, and the CPDU lines ``obc_lines`` power the nominal and the redundant OBC process
+(off kills that OBC, on starts it). With ``recovery`` (the mission's ``recovery`` section) the
+controllers recover the OBC by themselves (`obsw.reconfig.recovery`); the sample OBC then talks
+to them over the OBC UARTs too (heartbeats, context, DS3231 time).
 """
 
 import os
@@ -104,6 +107,35 @@ def roots():
     return core, host
 
 
+def descendants(pid):
+    """The pids of a process's children, grandchildren, ... (Linux /proc; [] elsewhere)."""
+    out = []
+    todo = [pid]
+    while todo:
+        p = todo.pop()
+        try:
+            tasks = os.listdir("/proc/%d/task" % p)
+        except OSError:
+            continue
+        for t in tasks:
+            try:
+                with open("/proc/%d/task/%s/children" % (p, t)) as f:
+                    kids = [int(x) for x in f.read().split()]
+            except (OSError, ValueError):
+                continue
+            out += kids
+            todo += kids
+    return out
+
+
+def _signal_all(pids, sig):
+    for pid in pids:
+        try:
+            os.kill(pid, sig)
+        except OSError:
+            pass
+
+
 class _Proc:
     def __init__(self, name, popen, sim):
         self.name = name
@@ -124,9 +156,13 @@ class _Proc:
     def alive(self):
         return self.popen.poll() is None
 
+    def signal_tree(self, sig):
+        """``sig`` to the process and all it started (a hang or a power cut stops them all)."""
+        _signal_all([self.popen.pid] + descendants(self.popen.pid), sig)
+
     def kill(self):
         if self.popen.poll() is None:
-            self.popen.send_signal(signal.SIGKILL)
+            self.signal_tree(signal.SIGKILL)
         try:
             self.popen.wait(5.0)
         except subprocess.TimeoutExpired:
@@ -144,6 +180,9 @@ class ReconfigSim:
         obc_calls=(),
         scid=None,
         obc_line=0,
+        obc_lines=None,
+        recovery=None,
+        obc_boot_delay=0.0,
         initial_lines=0x001,
         bit_error_gap=0,
         stuck_s=0.3,
@@ -161,7 +200,12 @@ class ReconfigSim:
         os.makedirs(self.dir, exist_ok=True)
         # the mission's ids (default: the sample's), on the controllers' "flash" as on a board
         self.ids = ids = ids or MissionIds.sample()
-        board_file(ids, self.dir)
+        settings = None  # the recovery thresholds, on the "flash" too (None: recovery off)
+        if recovery is not None:
+            settings = dict(recovery)
+            lines = list(settings.get("lines", obc_lines or (obc_line,)))
+            settings["lines"] = lines if len(lines) == 2 else [lines[0], 1 - lines[0]]
+        board_file(ids, self.dir, recovery=settings)
         self.nodes = ids.reconfig_nodes
         self.essential_map = ids.maps["essential"]
         scid = ids.scid if scid is None else scid
@@ -169,6 +213,11 @@ class ReconfigSim:
         self.obc_command = obc_command  # callable(sim) -> argv of the OBC, or the sample OBC
         self.scid = scid
         self.obc_line = obc_line
+        self.obc_lines = tuple(obc_lines) if obc_lines is not None else (obc_line,)
+        self.recovery = recovery
+        self.obc_boot_delay = obc_boot_delay
+        self.obcs = {}  # line -> the OBC process it powers
+        self.obc_which = 0  # the OBC (index in obc_lines) being started, for obc_command
         self.initial_lines = initial_lines
         self.bit_error_gap = bit_error_gap
         self.stuck_s = stuck_s
@@ -202,7 +251,7 @@ class ReconfigSim:
         self._kicks = [0, 0]
         self._req_since = [None, None]
         self._restart_at = [None, None]
-        self._powered = None
+        self._powered = {}
 
     # -- log ----------------------------------------------------------------------------------
 
@@ -263,7 +312,7 @@ class ReconfigSim:
         self._stop.set()
         if self._sup is not None:
             self._sup.join(2.0)
-        for p in self.ctrl + [self.obc]:
+        for p in self.ctrl + list(self.obcs.values()):
             if p is not None:
                 p.kill()
         if self.hub is not None:
@@ -304,22 +353,32 @@ class ReconfigSim:
         self._kicks[role] = None
         self._req_since[role] = None
 
-    def _spawn_obc(self):
+    def _spawn_obc(self, which):
         core, host = roots()
         old = os.environ.get("PYTHONPATH")
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([core, host] + ([old] if old else [])))
+        self.obc_which = which
+        fds = ()
         if self.obc_command is not None:
             cmd = list(self.obc_command(self))
         else:
             cmd = [sys.executable, "-m", "obsw_host.reconfig.obc"]
             cmd += [str(self.hub.ports[0]), str(self.hub.ports[1])]
             cmd += ["--nodes", "%d,%d" % self.nodes]
+            cmd += ["--line", str(self.obc_lines[which])]
+            if self.recovery is not None:
+                fds = tuple(self.obc_uart)
+                cmd += ["--uart", ",".join(str(fd) for fd in fds)]
+                cmd += ["--boot-delay", str(self.obc_boot_delay)]
             if self.obc_boots == 0:
                 for c in self.obc_calls:
                     cmd += ["--call", c]
-        p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        p = subprocess.Popen(
+            cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, pass_fds=fds
+        )
         self.obc_boots += 1
         self.obc = _Proc("obc", p, self)
+        self.obcs[self.obc_lines[which]] = self.obc
 
     # -- the hardware around the controllers --------------------------------------------------
 
@@ -379,16 +438,21 @@ class ReconfigSim:
                 why = why or dog.poll(now * 1000)
                 if why is not None:
                     self._reset(role, RESET_WATCHDOG, "watchdog: kick %s" % why)
-            powered = bool(self.lines() >> self.obc_line & 1)
-            if powered != self._powered:
-                self._powered = powered
+            q = self.lines()
+            for which, line in enumerate(self.obc_lines):
+                powered = bool(q >> line & 1)
+                if powered == self._powered.get(line):
+                    continue
+                self._powered[line] = powered
+                name = "OBC" if len(self.obc_lines) == 1 else ("OBC", "redundant OBC")[which]
                 if powered:
-                    self.log("supervisor: OBC power line on -> OBC boots")
-                    self._spawn_obc()
+                    self.log("supervisor: %s power line on -> %s boots" % (name, name))
+                    self._spawn_obc(which)
                 else:
-                    self.log("supervisor: OBC power line off")
-                    if self.obc is not None:
-                        self.obc.kill()
+                    self.log("supervisor: %s power line off" % name)
+                    p = self.obcs.pop(line, None)
+                    if p is not None:
+                        p.kill()
             time.sleep(0.005)
 
     # -- faults -------------------------------------------------------------------------------
@@ -398,6 +462,14 @@ class ReconfigSim:
         if self.obc is not None:
             self.obc.kill()
             self.log("fault: OBC process killed (pid %d)" % self.obc.popen.pid)
+
+    def hang_obc(self):
+        """The OBC hangs (SIGSTOP): alive to the kernel, silent on every link."""
+        if self.obc is not None:
+            self.obc.signal_tree(signal.SIGSTOP)
+            self.log(
+                "fault: OBC stopped, with every process it started (pid %d)" % self.obc.popen.pid
+            )
 
     def stick_req(self, role):
         """Firmware fault in a controller: CPDU_REQ driven high, main loop hung."""

@@ -243,6 +243,7 @@ def main(argv):
     from obsw.reconfig import mission
 
     ids = mission.load(argv[6] + "/" + mission.FILE) or {}  # as on a board's flash
+    ids.setdefault("recovery", {"enabled": False})  # a board's default is on; a sim's is off
     app = ReconfigApp(hal, essential_security=security, **ids)
     tag = "NR"[role]
 

@@ -310,11 +310,13 @@ def write_instance(
     instances=None,
     ids=None,
     name=INSTANCE,
+    keys=None,
 ):
     """Write a Yamcs server for ``spacecraft`` into ``folder``: one instance named ``name`` with
     ``mode`` links on ``ports``, or the ``instances`` given as {name: (mode, ports)} (one
     server, several instances). ``ids``: the mission's ids (default: the database's alone).
-    Returns the MDB path."""
+    With ``keys`` (an SDLS key file), the ``frames`` instances protect TC and TM with Yamcs'
+    SDLS (``obsw_host.yamcs.sdls``). Returns the MDB path."""
     ids = ids or spacecraft.ids
     instances = instances or {name: (mode, ports)}
     defaults = ids.ports.yamcs()
@@ -337,6 +339,10 @@ def write_instance(
         config = instance_config(
             spacecraft, mode_, dict(defaults, **(ports_ or {})), "mdb/" + mdb_name, ids
         )
+        if keys is not None and mode_ == "frames":
+            from obsw_host.yamcs.sdls import secure_links
+
+            secure_links(config["dataLinks"], keys, etc)
         cfdp = config["services"][-1]["args"]
         cfdp["incomingBucket"] = name + "_down"
         cfdp["localEntities"][0]["bucket"] = name + "_down"  # where files to it land

@@ -6,7 +6,8 @@ with the sample solar panel (``obsw_host.pus.onboard.Onboard``), the on-board CF
 - ``packets``: the packet gateway (Yamcs' TCP packet links <-> the processes' UDP);
 - ``frames``: the frame processor (``obsw_host.frames.processor.FrameProcessorHost``) with
   link A on UDP: CLTUs from Yamcs in, TM frames out to Yamcs' frame link (link B idle); TC
-  frames without segment header (the MAP service), TM frames not randomized.
+  frames without segment header (the MAP service), TM frames not randomized; with ``keys``
+  (an SDLS key file) TC and TM frames are protected as its SAs say.
 ``ports()`` gives the ground ports to write into the Yamcs instance. Everything listens on
 127.0.0.1 only; ports are chosen by the system unless ``ports`` gives them (``pus``,
 ``cfdp``: the gateway's TCP ports; ``cltu``: the frame processor's UDP port for CLTUs).
@@ -93,6 +94,8 @@ class SampleSpacecraft:
         ground_entity=None,
         ports=None,
         ids=None,
+        keys=None,
+        key_state=None,
     ):
         ports = ports or {}
         self.mode = mode
@@ -137,6 +140,11 @@ class SampleSpacecraft:
                 self.link_a = UdpFrameLink(peer, ports.get("cltu", 0), drop=drop)
                 self.link_b = UdpFrameLink(None)
                 self.link_b.enabled = False
+                security = {}
+                if keys is not None:  # SDLS on TC and TM (AES-GCM SAs of the key file)
+                    from obsw_host.frames.processor import security_options
+
+                    security = security_options(keys, self.sdb, key_state, segment_header=False)
                 self.processor = FrameProcessorHost(
                     self.link_a,
                     self.link_b,
@@ -150,6 +158,7 @@ class SampleSpacecraft:
                     tm_randomize=False,
                     segment_header=False,
                     clcw_period=0.2,
+                    **security,
                 )
                 tm_input = (LOOPBACK, self.processor.tm_port)
             else:

@@ -20,6 +20,8 @@ package(
         "hal.py",
         "mission.py",
         "node.py",
+        "obclink.py",
+        "recovery.py",
         "safeguard.py",
         "watchdog.py",
     ],

@@ -66,7 +66,9 @@ class FrameProcessor:
     TC security: with ``security`` (an ``obsw.frames.sdls.TcSecurity``) every frame but a
     control command is verified after duplicate removal and before FARM-1; a rejected frame is
     counted (``tc_rejected``, and by outcome in ``security.counters``) and each of
-    ``rejected_listeners`` is called with (outcome, VC ID, SPI, sequence number).
+    ``rejected_listeners`` is called with (outcome, VC ID, SPI, sequence number). With
+    ``tm_security`` (an ``obsw.frames.sdls_gcm.TmSecurity``) the TM frames of the VCs it has
+    SAs for are encrypted and authenticated (SDLS AES-GCM).
     """
 
     def __init__(
@@ -88,6 +90,10 @@ class FrameProcessor:
         dedup_window=2.0,
         clcw_period=1.0,
         security=None,
+        tm_security=None,
+        ep=None,
+        ep_map=62,
+        ep_apid=None,
     ):
         self.scid = scid
         self.route = route
@@ -99,6 +105,16 @@ class FrameProcessor:
         if security is not None and security.segment_header != segment_header:
             raise ValueError("TC security and frame processor disagree on segment headers")
         self.security = security
+        if ep is not None and not (
+            security is not None
+            and segment_header
+            and [sa for sa in security.sas.values() if sa.map_id == ep_map]
+        ):
+            raise ValueError("SDLS extended procedures need an SA of their own on MAP %d" % ep_map)
+        self.ep = ep  # an obsw.frames.sdls_ep.ExtendedProcedures, or None
+        self.ep_map = ep_map
+        self.ep_apid = ep_apid
+        self._ep_count = 0
         self.rejected_listeners = []  # callables(outcome, vcid, spi, sn)
         self.farms = {}
         self._reassembly = {}
@@ -117,7 +133,9 @@ class FrameProcessor:
             if tm_default_vcid is None:
                 tm_default_vcid = plan["realtime"]
         self.tm_plan = plan
-        self.mux = TmMultiplexer(scid, tm_frame_length, tm_channels, self._ocf)
+        self.mux = TmMultiplexer(
+            scid, tm_frame_length, tm_channels, self._ocf, security=tm_security
+        )
         self.tm_vc_of_apid = tm_vc_of_apid or {}
         if tm_default_vcid is None:
             tm_default_vcid = self.mux.channels[-1].vcid if tm_channels else 0
@@ -208,6 +226,9 @@ class FrameProcessor:
                     if self.essential is not None:
                         self.essential(unit)
                 return
+            if self.ep is not None and seg.map_id == self.ep_map:
+                self._extended_procedures(frame.vcid, seg)
+                return
             data = self._reassembly[frame.vcid].push(seg)
             if data is None:
                 return
@@ -217,6 +238,29 @@ class FrameProcessor:
         for p in packets:
             self._count("packets_routed")
             self.route(((p[0] & 7) << 8) | p[1], p)
+
+    def _extended_procedures(self, vcid, seg):
+        """EP PDUs (frame data on the EP SA's MAP, which only that SA can secure): run them and
+        send the replies in a TM space packet on ``ep_apid``."""
+        unit = self._reassembly[vcid].push(seg)
+        if unit is None:
+            return
+        reply = self.ep.handle(unit)
+        if self.ep_apid is None:
+            return
+        n = len(reply) - 1
+        head = bytes(
+            (
+                self.ep_apid >> 8,
+                self.ep_apid & 0xFF,
+                0xC0 | (self._ep_count >> 8) & 0x3F,
+                self._ep_count & 0xFF,
+                n >> 8,
+                n & 0xFF,
+            )
+        )
+        self._ep_count = (self._ep_count + 1) & 0x3FFF
+        self.send_packet(head + reply)
 
     # -- telemetry --------------------------------------------------------------------------
 

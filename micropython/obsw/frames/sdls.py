@@ -102,6 +102,9 @@ class SecurityAssociation:
     the sequence numbers of both ends (``sn_sent`` sending, ``window`` receiving; ``window`` and
     ``ahead`` as in ReplayWindow)."""
 
+    algorithm = "hmac-sha256"
+    link = "tc"  # or "tm" (GCM SAs of TM virtual channels)
+
     def __init__(
         self,
         spi,
@@ -132,6 +135,8 @@ class SecurityAssociation:
         self.sn_max = (1 << (8 * sn_length)) - 1
         self.window = ReplayWindow(window, ahead)
         self.sn_sent = 0
+        self.sn_reserved = 0
+        self.reserve_block = 0  # 0: numbers are saved by the caller, not reserved in blocks
         self._mac = None
         self.key = None
         self.state = SA_UNKEYED
@@ -178,6 +183,40 @@ class SecurityAssociation:
     def mac(self, *parts):
         return self._mac.digest(*parts)[: self.mac_length]
 
+    @property
+    def trailer_length(self):
+        return self.mac_length
+
+    def next_sn(self, security):
+        """The sequence number of the next frame this SA sends (reserving a block first when
+        the SA keeps its numbers in blocks)."""
+        if self.sn_sent >= self.sn_max:
+            raise SdlsError("SA %d: sequence numbers exhausted, re-key it" % self.spi)
+        if self.reserve_block and self.sn_sent + 1 > self.sn_reserved:
+            security.reserve(self)
+        self.sn_sent += 1
+        return self.sn_sent
+
+    def seal(self, security, header, head, body):
+        """Security header, frame data and trailer of a TC frame with primary header
+        ``header`` (N(S) zero) and segment header ``head`` (b"" without)."""
+        sec_header = _be(self.spi, 2) + _be(self.next_sn(security), self.sn_length)
+        return sec_header + body + self.mac(header, head, sec_header, body)
+
+    def open(self, raw, n, lead):
+        """(sequence number, clear frame data) of the received TC frame ``raw[:n]`` (FECF
+        included) that names this SA; None when its MAC fails, False when it is too short."""
+        start = 5 + lead + 2
+        body = start + self.sn_length
+        trailer = n - 2 - self.mac_length
+        if trailer < body:
+            return False
+        view = memoryview(raw)
+        header = bytes(view[0:4]) + b"\x00"
+        if not equal(self.mac(header, view[5:trailer]), view[trailer : n - 2]):
+            return None
+        return _int(view[start:body]), bytes(view[body:trailer])
+
     def __repr__(self):
         return "SecurityAssociation(spi=%d vc=%d map=%s %s)" % (
             self.spi,
@@ -212,6 +251,7 @@ class TcSecurity:
 
     def __init__(self, sas=(), segment_header=True):
         self.segment_header = segment_header
+        self.on_reserve = None  # called when an SA reserves a block of sequence numbers
         self.sas = {}  # SPI -> SA
         self.counters = {}
         for name in OUTCOME_NAMES:
@@ -261,14 +301,10 @@ class TcSecurity:
             sa = self.sa_for(vcid, map_id)
         elif sa.state != SA_OPERATIONAL or not self._valid_for(sa, vcid, map_id):
             raise SdlsError("SA %d cannot secure VC %d MAP %s" % (sa.spi, vcid, map_id))
-        if sa.sn_sent >= sa.sn_max:
-            raise SdlsError("SA %d: sequence numbers exhausted, re-key it" % sa.spi)
         lead = 1 if self.segment_header else 0
-        n = 5 + len(data) + sa.header_length + sa.mac_length + 2
+        n = 5 + len(data) + sa.header_length + sa.trailer_length + 2
         if n > 1024:
             raise SdlsError("secured TC frame of %d octets, above 1024" % n)
-        sa.sn_sent += 1
-        sec_header = _be(sa.spi, 2) + _be(sa.sn_sent, sa.sn_length)
         header = bytes(
             (
                 (0x20 if bypass else 0) | (scid >> 8),
@@ -279,9 +315,15 @@ class TcSecurity:
             )
         )
         head = bytes(data[:lead])
-        body = bytes(data[lead:])
-        mac = sa.mac(header, head, sec_header, body)
-        return head + sec_header + body + mac
+        return head + sa.seal(self, header, head, bytes(data[lead:]))
+
+    def reserve(self, sa):
+        """Called before ``sa`` sends with a number at or above what was reserved: reserve the
+        next block (``sa.reserve_block`` numbers) and save the state first (``on_reserve``),
+        so that no number is ever sent twice, whenever the power goes."""
+        sa.sn_reserved = sa.sn_sent + sa.reserve_block
+        if self.on_reserve is not None:
+            self.on_reserve()
 
     # -- receiving end ------------------------------------------------------------------------
 
@@ -305,21 +347,16 @@ class TcSecurity:
             return self._reject(BAD_SPI), None, 0, None
         if sa.state != SA_OPERATIONAL:
             return self._reject(NOT_OPERATIONAL), sa, 0, None
-        start = 5 + lead + 2
-        body = start + sa.sn_length
-        trailer = n - 2 - sa.mac_length
-        if trailer < body:
-            return self._reject(TOO_SHORT), sa, 0, None
-        view = memoryview(raw)
-        header = bytes(view[0:4]) + b"\x00"
-        computed = sa.mac(header, view[5:trailer])
-        if not equal(computed, view[trailer : n - 2]):
+        got = sa.open(raw, n, lead)
+        if got is None:
             return self._reject(BAD_MAC), sa, 0, None
-        sn = _int(view[start:body])
+        if got is False:
+            return self._reject(TOO_SHORT), sa, 0, None
+        sn, clear = got
         if not sa.window.acceptable(sn):
             return self._reject(REPLAY), sa, sn, None
         self.counters["ok"] += 1
-        return OK, sa, sn, bytes(view[5 : 5 + lead]) + bytes(view[body:trailer])
+        return OK, sa, sn, bytes(raw[5 : 5 + lead]) + clear
 
     def commit(self, sa, sn):
         """The frame secured by ``sa`` with ``sn`` was accepted (by FARM-1): never again."""
@@ -331,7 +368,11 @@ class TcSecurity:
     def context(self):
         """What must survive a restart: per SPI, the last sequence number sent and the highest
         one accepted (a list of [spi, sent, top])."""
-        return [[spi, self.sas[spi].sn_sent, self.sas[spi].window.top] for spi in sorted(self.sas)]
+        out = []
+        for spi in sorted(self.sas):
+            sa = self.sas[spi]
+            out.append([spi, max(sa.sn_sent, sa.sn_reserved), sa.window.top])
+        return out
 
     def restore(self, ctx):
         """Take back what ``context`` gave; numbers never go down. Accepting resumes above the
@@ -341,6 +382,7 @@ class TcSecurity:
             if sa is None:
                 continue
             sa.sn_sent = max(sa.sn_sent, int(entry[1]))
+            sa.sn_reserved = sa.sn_sent  # the next frame reserves a new block first
             top = int(entry[2])
             if top > sa.window.top:
                 sa.window.top = top

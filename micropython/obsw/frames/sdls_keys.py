@@ -5,6 +5,12 @@
               "mac_length": 16, "sn_length": 4, "window": 64, "ahead": null,
               "state": "operational"}]}
 
+``algorithm``: "hmac-sha256" (default: authentication, ``sn_length``-octet sequence number),
+"aes-gcm" (authenticated encryption) or "aes-gmac" (authentication only), both AES-256 with the
+IV as sequence number (``obsw.frames.sdls_gcm``; ``sn_length`` does not apply, ``reserve`` is
+the IV block saved ahead, 64 by default). ``link``: "tc" (default) or "tm" (one SA per TM VC,
+GCM only). SPIs are unique across the file.
+
 ``map_id`` null: the SA secures every MAP of its VC that has no SA of its own. ``window``: how
 far below the highest accepted sequence number a number not seen yet is still taken;
 ``ahead``: how far above it (null: any). ``state`` is
@@ -25,6 +31,9 @@ from obsw.frames.sdls import (
     SecurityAssociation,
     TcSecurity,
 )
+from obsw.frames.sdls_gcm import GCM, GMAC, GcmSecurityAssociation, TmSecurity
+
+HMAC = "hmac-sha256"
 
 FORMAT = "obsw-sdls-keys"
 VERSION = 1
@@ -44,6 +53,9 @@ _FIELDS = (
     "window",
     "ahead",
     "state",
+    "algorithm",
+    "link",
+    "reserve",
 )
 
 
@@ -91,20 +103,44 @@ def load_sas(text):
                 key = binascii.unhexlify(e.get("key", ""))
             except (ValueError, TypeError):
                 raise KeyFileError("%s: key is not hex" % where) from None
+        algorithm = e.get("algorithm", HMAC)
+        link = e.get("link", "tc")
+        if algorithm not in (HMAC, GCM, GMAC):
+            raise KeyFileError("%s: algorithm %r unknown" % (where, algorithm))
+        if link not in ("tc", "tm") or (link == "tm" and algorithm == HMAC):
+            raise KeyFileError("%s: link %r with %s" % (where, link, algorithm))
         try:
-            sa = SecurityAssociation(
-                _number(e, "spi", None, where),
-                _number(e, "vcid", None, where),
-                key,
-                _number(e, "map_id", None, where),
-                _number(e, "mac_length", 16, where),
-                _number(e, "sn_length", 4, where),
-                _number(e, "window", 64, where),
-                state,
-                _number(e, "ahead", None, where),
-            )
+            if algorithm == HMAC:
+                sa = SecurityAssociation(
+                    _number(e, "spi", None, where),
+                    _number(e, "vcid", None, where),
+                    key,
+                    _number(e, "map_id", None, where),
+                    _number(e, "mac_length", 16, where),
+                    _number(e, "sn_length", 4, where),
+                    _number(e, "window", 64, where),
+                    state,
+                    _number(e, "ahead", None, where),
+                )
+            else:
+                sa = GcmSecurityAssociation(
+                    _number(e, "spi", None, where),
+                    _number(e, "vcid", None, where),
+                    key,
+                    _number(e, "map_id", None, where),
+                    _number(e, "mac_length", 16, where),
+                    _number(e, "window", 64, where),
+                    state,
+                    _number(e, "ahead", None, where),
+                    algorithm,
+                    _number(e, "reserve", 64, where),
+                )
         except SdlsError as err:
             raise KeyFileError("%s: %s" % (where, err)) from None
+        sa.link = link
+        for other in out:
+            if other.spi == sa.spi:
+                raise KeyFileError("%s: SPI %d given twice" % (where, sa.spi))
         out.append(sa)
     return out
 
@@ -112,9 +148,20 @@ def load_sas(text):
 def load_security(text, segment_header=True):
     """A TcSecurity holding the SAs of a key file's text."""
     try:
-        return TcSecurity(load_sas(text), segment_header)
+        return TcSecurity([sa for sa in load_sas(text) if sa.link == "tc"], segment_header)
     except KeyFileError:
         raise
+    except SdlsError as e:
+        raise KeyFileError(str(e)) from None
+
+
+def load_tm_security(text):
+    """A TmSecurity holding the TM SAs of a key file's text (None when it has none)."""
+    sas = [sa for sa in load_sas(text) if sa.link == "tm"]
+    if not sas:
+        return None
+    try:
+        return TmSecurity(sas)
     except SdlsError as e:
         raise KeyFileError(str(e)) from None
 
@@ -123,17 +170,23 @@ def dump_sas(sas):
     """The key file text of ``sas``."""
     entries = []
     for sa in sas:
-        entries.append(
-            {
-                "spi": sa.spi,
-                "vcid": sa.vcid,
-                "map_id": sa.map_id,
-                "key": "" if sa.key is None else binascii.hexlify(sa.key).decode(),
-                "mac_length": sa.mac_length,
-                "sn_length": sa.sn_length,
-                "window": sa.window.size,
-                "ahead": sa.window.ahead,
-                "state": SA_STATE_NAMES[sa.state],
-            }
-        )
+        algorithm = getattr(sa, "algorithm", HMAC)
+        entry = {
+            "spi": sa.spi,
+            "vcid": sa.vcid,
+            "map_id": sa.map_id,
+            "key": "" if sa.key is None else binascii.hexlify(sa.key).decode(),
+            "mac_length": sa.mac_length,
+            "window": sa.window.size,
+            "ahead": sa.window.ahead,
+            "state": SA_STATE_NAMES[sa.state],
+        }
+        if algorithm == HMAC:
+            entry["sn_length"] = sa.sn_length
+        else:
+            entry["algorithm"] = algorithm
+            entry["reserve"] = sa.reserve_block
+        if sa.link != "tc":
+            entry["link"] = sa.link
+        entries.append(entry)
     return json.dumps({"format": FORMAT, "version": VERSION, "sas": entries})

@@ -84,11 +84,15 @@ class TmDemultiplexer:
 
     ``feed(frame_bytes)`` returns the list of packets (raises FrameError on a bad frame);
     ``clcw`` holds the last CLCW seen in an OCF; ``mc_gaps`` counts master channel count gaps.
+    With ``security`` (an ``obsw.frames.sdls_gcm.TmSecurity``) the frames of VCs with an SA are
+    verified and decrypted first; a frame that fails is dropped whole, its CLCW too, and
+    counted in ``security.counters``.
     """
 
-    def __init__(self, scid, fecf=True):
+    def __init__(self, scid, fecf=True, security=None):
         self.scid = scid
         self.fecf = fecf
+        self.security = security
         self.channels = {}
         self.clcw = None
         self.frames = 0
@@ -108,6 +112,11 @@ class TmDemultiplexer:
             self.mc_gaps += 1
         self._mc = (frame.mc_count + 1) & 0xFF
         self.frames += 1
+        if self.security is not None:
+            outcome, clear = self.security.open(frame.vcid, frame.data)
+            if clear is None:
+                return []
+            frame.data = clear
         if frame.ocf is not None and not frame.ocf[0] & 0x80:
             self.clcw = Clcw.unpack(frame.ocf)
         ch = self.channels.get(frame.vcid)

@@ -72,6 +72,10 @@ class TmMultiplexer:
     highest-priority channel that has one; with ``flush`` a partly filled channel is padded
     with an idle packet; with ``idle`` and nothing to send, an only-idle-data frame on
     ``idle_vcid``. Otherwise None.
+
+    With ``security`` (an ``obsw.frames.sdls_gcm.TmSecurity``) the frames of each VC that has
+    an SA carry SDLS: the packets fill the data field less the security header and trailer,
+    and the field is protected (encrypted and authenticated) as the frame is closed.
     """
 
     def __init__(
@@ -83,6 +87,7 @@ class TmMultiplexer:
         fecf=True,
         idle_vcid=7,
         idle_pattern=b"\x55",
+        security=None,
     ):
         self.scid = scid
         self.frame_length = frame_length
@@ -91,6 +96,7 @@ class TmMultiplexer:
         self.fecf = fecf
         self.idle_vcid = idle_vcid
         self.idle_pattern = idle_pattern
+        self.security = security
         self.mc_count = 0
         self.idle_count = 0
         self.frames = 0
@@ -107,9 +113,14 @@ class TmMultiplexer:
     def pending(self):
         return sum(c.pending() for c in self.channels)
 
+    def _room(self, vcid):
+        if self.security is None:
+            return self.data_length
+        return self.data_length - self.security.overhead(vcid)
+
     def frame(self, flush=False, idle=False):
-        d = self.data_length
         for c in self.channels:
+            d = self._room(c.vcid)
             got = c.take(d)
             if got is None and flush and c.pending():
                 c.pad(d)
@@ -119,6 +130,7 @@ class TmMultiplexer:
                 c.count = (c.count + 1) & 0xFF
                 return f
         if idle:
+            d = self._room(self.idle_vcid)
             pattern = (self.idle_pattern * (d // len(self.idle_pattern) + 1))[:d]
             f = self._close(self.idle_vcid, self.idle_count, pattern, FHP_IDLE)
             self.idle_count = (self.idle_count + 1) & 0xFF
@@ -129,6 +141,8 @@ class TmMultiplexer:
         ocf = self.ocf() if self.ocf is not None else None
         if self.ocf is not None and ocf is None:
             ocf = b"\x00\x00\x00\x00"
+        if self.security is not None:
+            data = self.security.seal(vcid, data)
         f = TmFrame(self.scid, vcid, data, self.mc_count, vc_count, fhp, ocf)
         self.mc_count = (self.mc_count + 1) & 0xFF
         self.frames += 1

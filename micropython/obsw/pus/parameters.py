@@ -7,9 +7,20 @@ subscribed again and its values are read again (``bind``, then ``follow`` or ``r
 Sets go through the node to the component (``aset`` from asyncio handlers, ``set`` from
 plain code), so the component stays the owner of its state.
 Parameters of no component (the process's own counters) are served by getter functions.
+
+With a context store (``persist``) every value set through the pool (service 20, and the
+event-action and scheduled TCs that carry service 20 sets) is saved atomically under
+``parameters`` and survives a restart: at start a saved value is the value of a parameter of
+no component, goes to the setter of a process-local one when it is provided, and is set again
+on a component each time the component (re)appears, before its values are read. A component
+that restarts with its defaults thus gets the operators' settings back.
 """
 
+from binascii import hexlify, unhexlify
+
 from obsw.il.errors import InteractionError
+
+STORE_NAME = "parameters"  # the context store's entry of the persisted values
 
 _ZERO = {1: False, 2: 0, 3: 0, 4: 0, 5: 0.0, 6: 0, 7: b"", 8: ""}
 
@@ -37,6 +48,10 @@ class ParameterPool:
         self._subs = []
         self._routes = {}  # component -> the route its values were last read through
         self.reads = 0  # attribute reads of components that (re)appeared, by follow()
+        self.store = None
+        self.saved = {}  # pid -> value set through the pool, persisted with ``store``
+        self.reapplied = 0  # saved values set again on components that (re)appeared
+        self.rejected = 0  # saved values that could not be taken back
         for p in sdb.parameters.values():
             if p.component is not None:
                 self._by_topic[(p.component, p.name)] = p.id
@@ -58,7 +73,42 @@ class ParameterPool:
         """Serve a parameter of no component with ``getter()`` (and ``setter(value)``)."""
         p = self.sdb.parameter(key)
         self._getters[p.id] = (getter, setter)
+        if setter is not None and p.id in self.saved:
+            try:
+                setter(self.saved[p.id])
+            except (ValueError, TypeError):
+                self.rejected += 1
         return p.id
+
+    # -------------------------------------------------------------------------- persistence
+
+    def persist(self, store):
+        """Save every value set from now on in ``store`` (``obsw.store.Store``) and take back
+        what it holds (see the module text); returns how many values it held."""
+        self.store = store
+        saved = store.load(STORE_NAME) or {}
+        for key, raw in saved.items():
+            try:
+                pid = int(key)
+                p = self.parameter(pid)
+                value = _decode(raw)
+                p.type.check(value)
+            except (ValueError, TypeError, KeyError):
+                self.rejected += 1
+                continue
+            self.saved[pid] = value
+            if p.component is None and pid not in self._getters:
+                self.values[pid] = value
+        return len(self.saved)
+
+    def _remember(self, pid, value):
+        if self.store is None:
+            return
+        self.saved[pid] = value
+        self.store.save(STORE_NAME, dict((str(k), _encode(v)) for k, v in self.saved.items()))
+
+    def _saved_of(self, comp):
+        return [(pid, v) for pid, v in self.saved.items() if self.parameter(pid).component == comp]
 
     def bind(self):
         """Watch every component attribute on the node and read the current values of the
@@ -108,6 +158,12 @@ class ParameterPool:
         n = 0
         components = self._components()
         for comp in self.appeared():
+            for pid, value in self._saved_of(comp):
+                try:
+                    self.node.set(self.parameter(pid).qualified, value, timeout=self.timeout)
+                    self.reapplied += 1
+                except InteractionError:
+                    self.rejected += 1
             for name, pid in components[comp]:
                 try:
                     self.values[pid] = self.node.get(name, timeout=self.timeout)
@@ -121,6 +177,13 @@ class ParameterPool:
         n = 0
         components = self._components()
         for comp in self.appeared():
+            for pid, value in self._saved_of(comp):
+                try:
+                    qualified = self.parameter(pid).qualified
+                    await self.node.aset(qualified, value, timeout=self.timeout)
+                    self.reapplied += 1
+                except InteractionError:
+                    self.rejected += 1
             for name, pid in components[comp]:
                 try:
                     self.values[pid] = await self.node.aget(name, timeout=self.timeout)
@@ -172,12 +235,15 @@ class ParameterPool:
             if local[1] is None:
                 raise ParameterError("parameter %s has no setter" % p.qualified, pid)
             local[1](value)
+            self._remember(pid, value)
             return
         if self.node is None or p.component is None:
             self.values[pid] = value
+            self._remember(pid, value)
             return
         self.node.set(p.qualified, value, timeout=self.timeout)
         self.values[pid] = value
+        self._remember(pid, value)
 
     async def aset(self, pid, value):
         """``set`` for asyncio handlers: a remote component is awaited, not polled."""
@@ -187,9 +253,23 @@ class ParameterPool:
             return
         await self.node.aset(p.qualified, value, timeout=self.timeout)
         self.values[pid] = value
+        self._remember(pid, value)
 
     def close(self):
         for s in self._subs:
             s.cancel()
         self._subs = []
         self._routes = {}
+
+
+def _encode(value):
+    """A value as JSON can keep it: octet strings as ``{"hex": ...}``."""
+    if isinstance(value, (bytes, bytearray)):
+        return {"hex": hexlify(value).decode()}
+    return value
+
+
+def _decode(raw):
+    if isinstance(raw, dict):
+        return bytes(unhexlify(raw["hex"]))
+    return raw

@@ -10,10 +10,12 @@ for a while, and an unhealthy application stops kicking the watchdog.
 import struct
 
 from obsw.compat import const, micropython
+from obsw.reconfig import obclink
 from obsw.reconfig.cpdu import Cpdu
 from obsw.reconfig.ds3231 import DS3231, TimeSync
 from obsw.reconfig.eeprom import M24512
 from obsw.reconfig.essential import (
+    DECISION_APID,
     ESSENTIAL_MAP,
     HPC_POWER_CYCLE,
     HPC_PRIORITY,
@@ -24,15 +26,29 @@ from obsw.reconfig.essential import (
     Hpc,
     Report,
 )
-from obsw.reconfig.hal import NOMINAL, PORT_COM, RESET_NAMES
+from obsw.reconfig.hal import NOMINAL, PORT_COM, PORT_OBC, RESET_NAMES
 from obsw.reconfig.node import NODE_NOMINAL, NODE_REDUNDANT, CpduNode
-from obsw.reconfig.safeguard import Safeguard
+from obsw.reconfig.recovery import (
+    KIND_NAMES,
+    POWER_CYCLE,
+    SOURCE_CAN,
+    SOURCE_UART,
+    Recovery,
+    log_pack,
+    log_unpack,
+)
+from obsw.reconfig.safeguard import RecordError, Safeguard
 from obsw.reconfig.watchdog import Watchdog
 from obsw.spacecan import events as ev
 
 RECORD_STATE = const(0)  # boots, resets by cause, last commanded CPDU bits
 RECORD_CONTEXT = const(1)  # the OBC's context word (store_context)
 RECORD_SDLS = const(2)  # per SA of the essential TCs: the highest sequence number accepted
+# a second area of the safeguard memory, after the first's 8 pages, with 2-page slots
+OBC_AREA_PAGE = const(8)
+RECORD_OBC_CONTEXT = const(0)  # the OBC's context (mode, time, counters, OBCPs), opaque here
+RECORD_RECOVERY_LOG = const(1)  # the newest recovery decisions
+LOG_ENTRIES = const(12)
 
 H_RTC = const(0x01)
 H_SGM = const(0x02)
@@ -73,6 +89,7 @@ class ReconfigApp:
         tm_frame_length=64,
         cpdu_options=None,
         essential_security=None,
+        recovery=None,
     ):
         self.hal = hal
         self.role = hal.role
@@ -80,6 +97,12 @@ class ReconfigApp:
         self.cpdu_budget_us = cpdu_budget_us
         devices = [M24512(hal.i2c, a) for a in hal.eeprom_addresses]
         self.sgm = Safeguard(devices, records=4)
+        self.obc_sgm = Safeguard(devices, records=2, slot_pages=2, base_page=OBC_AREA_PAGE)
+        self.recovery = Recovery(recovery)
+        self.decisions = []  # the newest recovery decisions, oldest first (also in the log)
+        self.link = obclink.Decoder()
+        self.link_counters = {"heartbeats": 0, "context_writes": 0, "context_reads": 0}
+        self.link_counters["time_reads"] = 0
         self.rtc = DS3231(hal.i2c, hal.rtc_address)
         self.sync = TimeSync(self.rtc)
         self.watchdog = Watchdog(hal, watchdog_open_ms, watchdog_timeout_ms)
@@ -120,6 +143,7 @@ class ReconfigApp:
         self._other_seen = 0
         self._bad_until = 0
         self._last_heartbeat = None
+        self._can_heartbeat = None
         self._next_status = 0
         self._next_report = 0
         self._next_save = 0
@@ -150,8 +174,14 @@ class ReconfigApp:
             if ctx is not None and len(ctx) == 4:
                 self.context = struct.unpack(">I", ctx)[0]
             self._restore_sdls()
+            log = self.obc_sgm.read(RECORD_RECOVERY_LOG)
+            if log is not None:
+                self.decisions = log_unpack(log)
         except (OSError, ValueError) as e:
             self._error(e, now)
+        self.recovery.start(now)
+        if self.decisions:
+            self.recovery.count = self.decisions[-1].count
         self.boots = (self.boots + 1) & 0xFFFF
         if 0 <= self.cause < 4:
             self.resets[self.cause] = (self.resets[self.cause] + 1) & 0xFF
@@ -254,6 +284,11 @@ class ReconfigApp:
                 self.essential.feed(data, now)
                 if self.essential.frames.security is not None:
                     self._save_sdls()
+            data = hal.uart_read(PORT_OBC)
+            if data:
+                for frame_type, payload in self.link.feed(data):
+                    self._obc_frame(frame_type, payload, now)
+            self._recover(now)
             for mask, value in self.essential.take_writes(now):
                 if not self.lines(mask, value, HPC_PRIORITY):
                     self.essential.failed()
@@ -318,6 +353,92 @@ class ReconfigApp:
         last = r.health[r.monitor.active].last_heartbeat
         if last is not None:
             self._last_heartbeat = last
+        for h in r.health:  # the OBC's heartbeat on either bus keeps it alive
+            t = h.last_heartbeat
+            if t is not None and (self._can_heartbeat is None or t > self._can_heartbeat):
+                self._can_heartbeat = t
+                self.recovery.heartbeat(SOURCE_CAN, t)
+
+    # -- the OBC: UART link and autonomous recovery -------------------------------------------
+
+    def _obc_frame(self, frame_type, payload, now):
+        """One frame from the OBC's UART: heartbeat, context kept or given back, the time."""
+        out = None
+        if frame_type == obclink.T_HEARTBEAT:
+            self.link_counters["heartbeats"] += 1
+            self.recovery.heartbeat(SOURCE_UART, now)
+        elif frame_type == obclink.T_CONTEXT_WRITE:
+            self.link_counters["context_writes"] += 1
+            try:
+                ok = self.obc_sgm.write(RECORD_OBC_CONTEXT, payload) > 0
+            except (OSError, RecordError):
+                ok = False
+            status = obclink.OK if ok else obclink.FAILED
+            out = obclink.encode(obclink.T_ACK, bytes((frame_type, status)))
+        elif frame_type == obclink.T_CONTEXT_READ:
+            self.link_counters["context_reads"] += 1
+            try:
+                rec = self.obc_sgm.read(RECORD_OBC_CONTEXT)
+                status = obclink.NONE if rec is None else obclink.OK
+            except OSError:
+                rec, status = None, obclink.FAILED
+            out = obclink.encode(obclink.T_CONTEXT, bytes((status,)) + (rec or b""))
+        elif frame_type == obclink.T_TIME_READ:
+            self.link_counters["time_reads"] += 1
+            try:
+                if self.rtc.oscillator_stopped():
+                    out = obclink.time_reply(obclink.NONE)
+                else:
+                    day, ms = self.rtc.day_ms()
+                    out = obclink.time_reply(obclink.OK, day, ms)
+            except (OSError, ValueError):
+                out = obclink.time_reply(obclink.FAILED)
+        if out is not None:
+            self.hal.uart_write(PORT_OBC, out)
+
+    def _recover(self, now):
+        """The recovery policy's decision, carried out on the CPDU and reported."""
+        latched = self.hal.cpdu_readback()
+        if latched is None and not self.in_charge():
+            # no read-back to compare with: only the controller in charge acts
+            self.recovery.observe(self.bits, now)
+            return
+        act = self.recovery.poll(now, self.bits if latched is None else latched)
+        if act is None:
+            return
+        kind, mask, value, emask, evalue, line = act
+        expect = (emask, evalue) if latched is not None else None
+        ok = self.cpdu.run(
+            mask,
+            value,
+            self.hal.now_us,
+            budget_us=self.cpdu_budget_us,
+            priority=HPC_PRIORITY,
+            expect=expect,
+        )
+        result = ok
+        if ok and self.cpdu.skipped:
+            result = None
+        elif ok:
+            self.bits = self.cpdu.bits
+            self._dirty = True
+            if kind == POWER_CYCLE:
+                self.essential.later(now + self.recovery.off_ms / 1000, mask, mask)
+        self.recovery.observe(self.bits if latched is None else self.cpdu.bits, now)
+        d = self.recovery.done(now, result, now - (self._started or now))
+        self.decisions.append(d)
+        if len(self.decisions) > LOG_ENTRIES:
+            self.decisions.pop(0)
+        try:
+            self.obc_sgm.write(RECORD_RECOVERY_LOG, log_pack(self.decisions))
+        except (OSError, ValueError) as e:
+            self._error(e, now)
+        for c in self.essential.packet(DECISION_APID, d.pack()):
+            self.hal.uart_write(PORT_COM, c)
+        self._note(
+            "recovery: %s line %d (OBC silent %d ms, %d in window), OBC %d active"
+            % (KIND_NAMES[d.kind], d.line, d.silence_ms, d.failures, d.obc)
+        )
 
     def _status(self, now):
         self._next_status = now + self.status_period

@@ -85,8 +85,11 @@ class Cpdu:
             "battles_lost": 0,
             "waits": 0,
             "aborted": 0,
+            "skipped": 0,
         }
         self.last_result = None  # the bits latched by the last write
+        self.skipped = False  # the last write found its expectation unmet and drove nothing
+        self._expect = None
         self._mask = 0
         self._value = 0
         self._priority = 0
@@ -107,13 +110,20 @@ class Cpdu:
         """The battle wait for a priority: higher waits longer (and so wins)."""
         return self.battle_us * (2 * priority + (2 if self.role == NOMINAL else 1))
 
-    def write(self, mask, value, priority=0):
-        """Start setting the lines in ``mask`` to ``value`` (others keep their state)."""
+    def write(self, mask, value, priority=0, expect=None):
+        """Start setting the lines in ``mask`` to ``value`` (others keep their state).
+
+        ``expect`` = (mask, value): a compare-and-set; inside the critical section the latched
+        lines are read back and, when they differ from ``expect``, nothing is driven and the
+        write ends with ``skipped`` True (the other controller has made the change already).
+        """
         if self.state != IDLE:
             raise CpduBusyError(self.state)
         self._mask = mask & CPDU_MASK
         self._value = value & CPDU_MASK
         self._priority = priority
+        self._expect = expect
+        self.skipped = False
         self.state = WAIT_OTHER
 
     def reset(self):
@@ -176,6 +186,12 @@ class Cpdu:
             latched = hal.cpdu_readback()
             if latched is not None:
                 self.bits = latched
+            e = self._expect
+            if e is not None and latched is not None and latched & e[0] != e[1] & e[0]:
+                self.skipped = True
+                self.counters["skipped"] += 1
+                self.state = DROP
+                return False
             self._new = (self.bits & ~self._mask) | (self._value & self._mask)
             self.state = DATA
         elif s == DATA:
@@ -188,8 +204,9 @@ class Cpdu:
         elif s == DROP:
             hal.req(0)
             self.state = IDLE
-            self.counters["writes"] += 1
-            self.last_result = self.bits
+            if not self.skipped:
+                self.counters["writes"] += 1
+                self.last_result = self.bits
             return True
         return False
 
@@ -198,7 +215,7 @@ class Cpdu:
         self._t = now
         self._wait = wait
 
-    def run(self, mask, value, clock, budget_us=20000, priority=0):
+    def run(self, mask, value, clock, budget_us=20000, priority=0, expect=None):
         """Do a whole write now, stepping on ``clock()`` until done or ``budget_us`` passes.
 
         Returns True when latched; on running out of time the attempt is abandoned cleanly
@@ -206,7 +223,7 @@ class Cpdu:
         """
         if self.state != IDLE:
             return False
-        self.write(mask, value, priority)
+        self.write(mask, value, priority, expect)
         start = clock()
         while True:
             now = clock()

@@ -41,6 +41,7 @@ STATUS_FAILED = const(4)  # CPDU access failed
 ESSENTIAL_MAP = const(63)
 HPTM_VCID = const(6)
 HPTM_APID = const(0x07E)
+DECISION_APID = const(0x07D)  # HPTM: the recovery decisions (obsw.reconfig.recovery.Decision)
 HPC_PRIORITY = const(3)  # CPDU battle priority of an HPC (above SpaceCAN's 0)
 
 _ARGS = {
@@ -165,21 +166,35 @@ class Report:
         return d
 
 
-def security_from_file(path):
-    """The TcSecurity of the SDLS key file at ``path``, or None when there is none. A key file
-    that cannot be read as one gives a TcSecurity with no SA: every TC frame is then rejected,
-    but the module keeps running (a boot that raised would reset it forever)."""
+def security_from_file(path, insecure=None, log=print):
+    """The TcSecurity of the SDLS key file at ``path``. Secure by default: without a key file,
+    or with one that cannot be read as one, a TcSecurity with no SA (every TC frame rejected,
+    while the module keeps running: a boot that raised would reset it forever). Only when the
+    file ``insecure`` exists (the mission's explicit choice, put there by ``obsw board
+    deploy``) and there is no key file: None, TC frames unauthenticated. ``log`` gets one line
+    at every boot that is not the normal, keyed one."""
+    from obsw.frames.sdls import SdlsError, TcSecurity
+
     try:
         f = open(path)
     except OSError:
-        return None
-    from obsw.frames.sdls import SdlsError, TcSecurity
+        if insecure is not None:
+            try:
+                open(insecure).close()
+            except OSError:
+                pass
+            else:
+                log("SDLS OFF (%s): essential TCs accepted without authentication" % insecure)
+                return None
+        log("SDLS: no key file %s: every essential TC is refused" % path)
+        return TcSecurity(())
     from obsw.frames.sdls_keys import load_security
 
     try:
         with f:
             return load_security(f.read())
     except (SdlsError, OSError, ValueError):
+        log("SDLS: %s is not a usable key file: every essential TC is refused" % path)
         return TcSecurity(())
 
 
@@ -313,12 +328,18 @@ class Essential:
         """The app could not get the CPDU for the last write."""
         self.last_status = STATUS_FAILED
 
+    def later(self, due, mask, value):
+        """Queue a line change for ``due`` (the second half of a power cycle)."""
+        self._writes.append([due, mask & CPDU_MASK, value])
+
     def report(self, report):
         """CADUs carrying one HPTM packet with ``report`` (a Report) for the COM UART."""
         self.report_requested = False
-        pkt = SpacePacket(
-            0, self.hptm_apid, report.pack(), False, 3, self.seq.next(self.hptm_apid)
-        )
+        return self.packet(self.hptm_apid, report.pack())
+
+    def packet(self, apid, data):
+        """CADUs carrying one HPTM packet of ``apid`` with ``data`` on the HPTM channel."""
+        pkt = SpacePacket(0, apid, data, False, 3, self.seq.next(apid))
         self.mux.channel(self.hptm_vcid).push(pkt.pack())
         out = []
         while True:

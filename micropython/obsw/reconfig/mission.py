@@ -5,15 +5,20 @@ to each board's flash beside ``tc.keys``; ``load`` turns it into ``ReconfigApp``
 
     {"scid": 66, "nodes": [10, 11], "essential_map": 63, "hptm_vc": 6}
 
-``nodes`` are the SpaceCAN node ids of the nominal and the redundant controller. A board
+``nodes`` are the SpaceCAN node ids of the nominal and the redundant controller; an optional
+``recovery`` object holds the autonomous recovery's thresholds (``obsw.reconfig.recovery``:
+the keys of its ``DEFAULTS``, each optional). A board
 without the file runs with the application's built-in ids and says so once (``load`` returns
 None); a file that is there but wrong raises ``MissionFileError`` naming the key.
 """
 
 import json
 
+from obsw.reconfig.recovery import DEFAULTS as RECOVERY_DEFAULTS
+
 FILE = "mission.json"
 KEYS = ("scid", "nodes", "essential_map", "hptm_vc")
+OPTIONAL = ("recovery",)
 
 
 class MissionFileError(ValueError):
@@ -36,8 +41,8 @@ def parse(doc):
     if not isinstance(doc, dict):
         raise MissionFileError("", "expected a JSON object")
     for key in doc:
-        if key not in KEYS:
-            raise MissionFileError(key, "unknown key (one of %s)" % ", ".join(KEYS))
+        if key not in KEYS and key not in OPTIONAL:
+            raise MissionFileError(key, "unknown key (one of %s)" % ", ".join(KEYS + OPTIONAL))
     for key in KEYS:
         if key not in doc:
             raise MissionFileError(key, "missing")
@@ -54,12 +59,36 @@ def parse(doc):
             raise MissionFileError(
                 "nodes", "expected two different node ids 1-127, got %r" % nodes
             )
-    return {
+    out = {
         "scid": _int(doc, "scid", 0, 1023),
         "node_ids": (nodes[0], nodes[1]),
         "essential_map": _int(doc, "essential_map", 0, 63),
         "hptm_vc": _int(doc, "hptm_vc", 0, 6),
     }
+    if "recovery" in doc:
+        out["recovery"] = _recovery(doc["recovery"])
+    return out
+
+
+def _recovery(doc):
+    """The recovery thresholds, checked key by key."""
+    if not isinstance(doc, dict):
+        raise MissionFileError("recovery", "expected a JSON object")
+    for key in doc:
+        if key not in RECOVERY_DEFAULTS:
+            raise MissionFileError("recovery." + key, "unknown key")
+        v = doc[key]
+        if key == "enabled":
+            ok = isinstance(v, bool)
+        elif key == "lines":
+            ok = isinstance(v, list) and len(v) == 2 and v[0] != v[1]
+            ok = ok and all(isinstance(n, int) and not isinstance(n, bool) for n in v)
+            ok = ok and all(0 <= n < 12 for n in v)
+        else:
+            ok = isinstance(v, (int, float)) and not isinstance(v, bool) and v > 0
+        if not ok:
+            raise MissionFileError("recovery." + key, "unusable value %r" % (v,))
+    return doc
 
 
 def load(path=FILE):

@@ -15,11 +15,13 @@ argument's type. An unknown function or argument, a missing or repeated argument
 acceptance (the values cannot be delimited otherwise). The operation is called through the
 node; an asynchronous one reports progress step 1 when it has started and completes when
 it finishes. The component's refusal, its absence or a timeout fail the completion with the
-function ID in the failure data. Functions of no component (the process's own) are plain
+function ID in the failure data; a refusal (``ComponentError``) adds what the component said,
+as CBOR ``[code, message, data]``. Functions of no component (the process's own) are plain
 callables given to ``local``.
 """
 
-from obsw.il.errors import CallTimeoutError, InteractionError, UnavailableError
+from obsw import cbor
+from obsw.il.errors import CallTimeoutError, ComponentError, InteractionError, UnavailableError
 from obsw.pus.fields import field
 from obsw.pus.messages import SERVICE_FUNCTION_MANAGEMENT, TC_FUNCTION_PERFORM
 from obsw.pus.sdb import SdbError, field_type
@@ -89,11 +91,22 @@ def functions(sdb):
     return table
 
 
+def component_error_record(error):
+    """What a component said when it refused (``ComponentError``), as CBOR
+    ``[code, message, data]`` for the failure data after the function ID."""
+    try:
+        return cbor.dumps([error.code, error.message, error.data])
+    except (TypeError, ValueError):  # data CBOR cannot carry: the code and the text still go
+        return cbor.dumps([str(error.code), str(error.message), None])
+
+
 def _failure(error, data):
     if isinstance(error, CallTimeoutError):
         return PusFailure(FAILURE_TIMEOUT, error.message, data)
     if isinstance(error, UnavailableError):
         return PusFailure(FAILURE_UNAVAILABLE, error.message, data)
+    if isinstance(error, ComponentError):
+        data = data + component_error_record(error)
     return PusFailure(FAILURE_COMPONENT, str(error), data)
 
 

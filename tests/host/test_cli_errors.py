@@ -12,7 +12,6 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 ENV = dict(
     os.environ,
     PYTHONPATH=os.pathsep.join([os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]),
-    OBSW_MISSION=os.path.join(ROOT, "examples", "sample"),  # the mistakes are not about it
 )
 
 # (name, arguments, a piece of the one line); {d} is a scratch folder, {port} a busy UDP port

@@ -16,7 +16,6 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 ENV = dict(
     os.environ,
     PYTHONPATH=os.pathsep.join([os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]),
-    OBSW_MISSION=os.path.join(ROOT, "examples", "sample"),  # the ground's database: the sample's
 )
 STATE_BITS = 0x000A0001  # CpduN (node 10), parameter 1: a register
 

@@ -104,7 +104,8 @@ def test_the_guide_runs_from_an_empty_folder(workdir):
             script.append(WAIT_FOR_OUTCOME)
         if line.startswith("obsw obc serve"):
             script.append("for i in $(seq 60); do obsw ground --mission missions/my-sat "
-                          "--timeout 0.5 ping >/dev/null 2>&1 && break; sleep 0.5; done")  # fmt: skip
+                          "--timeout 0.5 ping >/dev/null 2>&1 && break; "
+                          "sleep 0.5; done")  # fmt: skip
     script.append("kill %1 && wait")  # the reader's Ctrl-C
     t0 = time.monotonic()
     r = run("\n".join(script), str(workdir))

@@ -9,6 +9,8 @@ frames are accepted without authentication. Anything else refuses to start with 
 from obsw.frames.sdls import SA_OPERATIONAL
 from obsw.frames.sdls_keys import KeyFileError, load_sas
 
+from obsw_host.obc import defaults
+
 OFF_WARNING = (
     'frames: TC SECURITY OFF (frames.tc_security is "none"): every well-formed TC frame is '
     "accepted, from anyone"
@@ -22,7 +24,7 @@ def check(config):
     from obsw_host.obc.config import ConfigError
 
     opts = config.section("frames")
-    mode = opts.get("tc_security", "sdls")
+    mode = opts.get("tc_security", defaults.FRAMES["tc_security"])
     if mode not in ("sdls", "none"):
         raise ConfigError("frames.tc_security", 'expected "sdls" or "none", got %r' % (mode,))
     path = opts.get("keys")

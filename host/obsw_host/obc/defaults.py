@@ -30,6 +30,7 @@ FRAMES = {
     "tm_frame_length": 256,
     "clcw_period": 0.5,
     "uart_queue": 64,  # frames waiting for a UART; beyond, the oldest is dropped (counted)
+    "tc_security": "sdls",  # TC frames authenticated; "none" only when the mission says so
 }
 PLATFORM = {
     "heartbeat": 0.5,  # seconds between heartbeats

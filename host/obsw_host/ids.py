@@ -406,7 +406,7 @@ def add_arguments(parser, sdb_help="spacecraft database JSON (overrides the miss
         metavar="DIR",
         default=argparse.SUPPRESS,
         help="mission folder (with mission.json) or mission file (default: ./mission.json, "
-        "else the sample spacecraft)",
+        "else $OBSW_MISSION, else the nearest mission.json)",
     )
     parser.add_argument("--sdb", default=argparse.SUPPRESS, help=sdb_help)
 

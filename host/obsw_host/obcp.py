@@ -2,7 +2,7 @@
 
 ``serve`` provides the engine component (``obsw.pluto.obcp.ENGINE``) and runs it from one
 loop with the transport: I/O, idle providers, then the procedures that are due. Run it with
-``obsw pluto engine [--dir DIR] [--sdb SDB.json]`` or ``python -m obsw_host.obcp``; other
+``obsw pluto engine [--mission DIR] [--sdb SDB.json]`` or ``python -m obsw_host.obcp``; other
 processes load and start procedures through a proxy and subscribe to its events.
 ``examples/obcp_engine_demo.py`` drives a procedure through the engine and the solar panel.
 """
@@ -14,8 +14,6 @@ import signal
 import sys
 import time
 
-DEFAULT_SDB = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "sdb.json")
-
 
 def known_interfaces():
     """Interfaces of the host's components: where the engine learns their operations."""
@@ -24,12 +22,9 @@ def known_interfaces():
     return [SOLAR_PANEL]
 
 
-def load_sdb(path=None):
-    """The spacecraft database for name and type checks: ``path``, else the packaged one;
-    an ``obsw.pus.sdb.Sdb`` when it loads as one, else the plain JSON document."""
-    path = path or DEFAULT_SDB
-    if not os.path.exists(path):
-        return None
+def load_sdb(path):
+    """The spacecraft database at ``path`` for name and type checks: an ``obsw.pus.sdb.Sdb``
+    when it loads as one, else the plain JSON document."""
     try:
         from obsw.pus.sdb import load
 
@@ -50,7 +45,7 @@ def serve(directory=None, name="obcp-engine", sdb=None, poll=0.2, out=None, cloc
     transport = SocketTransport(node, directory)
     engine = provide(
         node,
-        sdb if sdb is not None else load_sdb(),
+        sdb,
         known_interfaces(),
         timeout=2.0,
         activity_timeout=30.0,
@@ -105,7 +100,10 @@ def main(argv=None):
 def add_arguments(p):
     p.add_argument("--dir", help="name directory (default $OBSW_IL_DIR or a temp dir)")
     p.add_argument("--name", default="obcp-engine", help="node name")
-    p.add_argument("--sdb", help="spacecraft database JSON (default: the packaged one)")
+    p.add_argument("--mission", metavar="DIR",
+                   help="mission folder whose database names things (default: $OBSW_MISSION, "
+                   "else the nearest mission.json)")  # fmt: skip
+    p.add_argument("--sdb", help="spacecraft database JSON (overrides the mission's)")
     p.add_argument("--poll", type=float, default=0.2,
                    help="seconds between evaluations of a waited-for condition")  # fmt: skip
     p.add_argument("--quiet", action="store_true")
@@ -113,7 +111,16 @@ def add_arguments(p):
 
 def run_args(args):
     out = None if args.quiet else (lambda s: print(s, flush=True))
-    return serve(args.dir, args.name, load_sdb(args.sdb), args.poll, out)
+    return serve(args.dir, args.name, load_sdb(args.sdb or _mission_sdb(args.mission)),
+                 args.poll, out)  # fmt: skip
+
+
+def _mission_sdb(mission):
+    """The database file of the mission (``locate``: one-line error when there is none)."""
+    from obsw_host.mission import locate
+    from obsw_host.obc import config
+
+    return config.load(locate(mission)).sdb_path
 
 
 if __name__ == "__main__":

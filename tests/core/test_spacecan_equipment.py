@@ -116,9 +116,12 @@ class TestOperations(unittest.TestCase):
         self.assertEqual((rec["status"], rec["service"], rec["subtype"]), ("completed", 8, 1))
         self.assertEqual(obc.calls, [(1, {1: 0x0A5})])
         frames = obc.requests_to(NODE)
-        self.assertEqual([f[0] for f in frames], [0, 0])  # two fragments on bus A
+        self.assertEqual([f[0] for f in frames], [0, 0, 0])  # all on bus A
         packet = frames[0][1][2:] + frames[1][1][2:]  # after each 2-byte fragment header
         self.assertEqual(packet, bytes((8, 1, 1, 1, 1, 0x00, 0xA5)))  # (8,1) f=1 n=1 a=1 u16
+        # then the node's parameters read back, so the function's effect reads at once
+        self.assertEqual(frames[2][1][2:], bytes((20, 1, 3, 1, 2, 3)))  # (20,1) of ids 1..3
+        self.assertEqual(cpdu.state_bits, 0x0A5)
         self.assertIn("accepted", [u["status"] for u in updates if isinstance(u, dict)])
         self.assertEqual(cpdu.pulse(2, 100).result(WAIT)["status"], "completed")
         self.assertEqual(cpdu.pulse(line=3, ms=5).result(WAIT)["status"], "completed")

@@ -19,7 +19,7 @@ ENV.pop("OBSW_MISSION", None)
 
 
 WAIT_FOR_OUTCOME = (
-    "for i in $(seq 40); do obsw obcp --sdb missions/my-sat/sdb.json status"
+    "for i in $(seq 40); do obsw obcp --mission missions/my-sat status"
     " | grep -q 'last outcome' && break; sleep 0.25; done"
 )
 
@@ -101,8 +101,9 @@ def test_the_guide_runs_from_an_empty_folder(workdir):
         if " activate " in line:  # a reader looks at the status once the procedure ran
             script.append(WAIT_FOR_OUTCOME)
         if line.startswith("obsw obc serve"):
-            script.append("for i in $(seq 60); do obsw ground --timeout 0.5 ping >/dev/null "
-                          "2>&1 && break; sleep 0.5; done")  # fmt: skip
+            script.append("for i in $(seq 60); do obsw ground --mission missions/my-sat "
+                          "--timeout 0.5 ping >/dev/null 2>&1 && break; "
+                          "sleep 0.5; done")  # fmt: skip
     script.append("kill %1 && wait")  # the reader's Ctrl-C
     t0 = time.monotonic()
     r = run("\n".join(script), str(workdir))

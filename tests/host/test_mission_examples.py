@@ -6,10 +6,12 @@ follows a mission today: ping, parameters of the plug-in, service 8 functions, i
 import fnmatch
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -44,14 +46,27 @@ def free_base(apid):
 
 
 class Obc:
-    """`obsw obc serve MISSION` in its own session, stopped with its children at the end."""
+    """`obsw obc serve MISSION` in its own session, its output read as it comes, stopped with
+    its children at the end."""
 
     def __init__(self, folder, state, env):
         self.proc = subprocess.Popen(
             OBSW + ["obc", "serve", folder, "--state", str(state)], env=env,
             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True,
         )  # fmt: skip
+        self.lines = []
+        self.reader = threading.Thread(target=self._read, daemon=True)
+        self.reader.start()
         self.output = None
+
+    def _read(self):
+        for line in self.proc.stdout:
+            self.lines.append(line.decode(errors="replace"))
+
+    def pids_of(self, process):
+        """Every pid the OBC reported for its process ``process``, in order."""
+        found = [re.search(r"OBC process '%s' \(pid (\d+)\) up" % process, x) for x in self.lines]
+        return [int(m.group(1)) for m in found if m]
 
     def stop(self):
         if self.output is not None:
@@ -61,18 +76,19 @@ class Obc:
         except ProcessLookupError:  # it ended by itself
             pass
         try:
-            out, _ = self.proc.communicate(timeout=15)
+            self.proc.wait(timeout=15)
         except subprocess.TimeoutExpired:
             os.killpg(self.proc.pid, signal.SIGKILL)
-            out, _ = self.proc.communicate()
-        self.output = out.decode(errors="replace")
+            self.proc.wait()
+        self.reader.join(5)
+        self.output = "".join(self.lines)
         return self.output
 
 
-def wait_for_ping(ground, obc):
+def wait_for_ping(ground, obc, env=ENV):
     end = time.monotonic() + 60
     while time.monotonic() < end:
-        r = obsw(*ground, "--timeout", "0.5", "ping")
+        r = obsw(*ground, "--timeout", "0.5", "ping", env=env)
         if r.returncode == 0:
             return
         assert obc.proc.poll() is None, obc.stop()
@@ -119,9 +135,8 @@ def test_mission_new_passes_the_check_and_runs(tmp_path):
     env = dict(ENV, OBSW_PORT_BASE=str(base))
     obc = Obc(str(folder), tmp_path / "state", env)
     try:
-        wait_for_ping(["ground", "--mission", folder, "--port", base + 10], obc)
-        r = obsw("ground", "--sdb", folder / "sdb.json", "--port", base + 10, "params", "get",
-                 "pus.tc_received")  # fmt: skip
+        wait_for_ping(["ground", "--mission", folder], obc, env)
+        r = obsw("ground", "--mission", folder, "params", "get", "pus.tc_received", env=env)
         assert r.returncode == 0, r.stderr
     finally:
         out = obc.stop()
@@ -133,7 +148,7 @@ def test_aurora_differs_from_the_sample_and_passes_the_check():
     a, s = load(AURORA), load(sample.MISSION_DIR)
     assert a.name != s.name and a.sdb.mission != s.sdb.mission
     assert set(a.sdb.apids.values()).isdisjoint(s.sdb.apids.values())
-    assert a.sdb.scid != s.sdb.scid
+    assert a.sdb.scid != s.sdb.scid  # the spacecraft id lives in the database now
     assert a.sdb.tm_vcs != s.sdb.tm_vcs
     assert set(a.sdb.filestores).isdisjoint(s.sdb.filestores)
     assert set(a.sdb.filestores.values()).isdisjoint(s.sdb.filestores.values())
@@ -152,33 +167,76 @@ def test_aurora_differs_from_the_sample_and_passes_the_check():
     assert os.listdir(os.path.join(AURORA, "procedures")) == ["detumble.plt"]
 
 
+def wait_until(predicate, timeout=30.0):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        v = predicate()
+        if v:
+            return v
+        time.sleep(0.2)
+    return predicate()
+
+
 def test_aurora_runs_from_its_folder(tmp_path):
-    """As far as the system follows the mission today (see docs/fly-your-own-spacecraft.md)."""
-    base = free_base(42)
-    env = dict(ENV, OBSW_PORT_BASE=str(base))
-    ground = ["--sdb", os.path.join(AURORA, "sdb.json"), "--apid", 42, "--port", base + 42]
+    """Issue 23's check: a mission written by someone else runs from its folder alone, through
+    the real CLI and nothing but ``--mission``: the OBC, its plug-in supervised, the ground,
+    its procedure and CFDP (Yamcs: tests/host/test_yamcs_e2e.py)."""
+    env = dict(ENV, OBSW_PORT_BASE=str(free_base(42)))  # the ground and the OBC alike
+
+    def ground(*args):
+        return obsw("ground", "--mission", AURORA, *args, env=env)
+
+    def obcp(*args):
+        return obsw("obcp", "--mission", AURORA, *args, env=env)
+
     obc = Obc(AURORA, tmp_path / "state", env)
     try:
-        wait_for_ping(["ground"] + ground, obc)
-        r = obsw("ground", *ground, "params", "get", "Magnetorquer.max_dipole", "adcs.gain")
+        wait_for_ping(["ground", "--mission", AURORA], obc, env)
+        r = ground("params", "get", "Magnetorquer.max_dipole", "adcs.gain",
+                   "Magnetorquer.coil_temp", "Magnetorquer.coil_current")  # fmt: skip
         assert r.returncode == 0, r.stderr
-        assert "Magnetorquer.max_dipole = 0.2" in r.stdout  # from the plug-in's own process
+        assert "Magnetorquer.max_dipole = 0.2 A.m^2" in r.stdout  # from the plug-in's process
         assert "adcs.gain = 250" in r.stdout
-        assert obsw("ground", *ground, "function", "Magnetorquer.enable").returncode == 0
-        r = obsw("ground", *ground, "params", "get", "Magnetorquer.enabled")
+        assert re.search(r"Magnetorquer.coil_temp = [-0-9.]+ degC \(raw \d+\)", r.stdout), r.stdout
+        assert "Magnetorquer.coil_current = " in r.stdout and " mA" in r.stdout
+        assert ground("function", "Magnetorquer.enable").returncode == 0
+        r = ground("params", "get", "Magnetorquer.enabled")
         assert "Magnetorquer.enabled = True" in r.stdout, r.stdout + r.stderr
-        r = obsw("ground", *ground, "function", "Magnetorquer.set_dipole", "x=0.3", "y=0", "z=0")
+        r = ground("function", "Magnetorquer.set_dipole", "x=0.3", "y=0", "z=0")
         assert r.returncode != 0  # the component refuses beyond max_dipole: a failure report
-        r = obsw("obcp", *ground, "load-ref", "detumble", ".", "detumble.plt")
+
+        # a SpaceCAN node's function, its effect readable at once
+        assert ground("function", "CpduA.set_state_bits", "state=5").returncode == 0
+        r = ground("params", "get", "CpduA.state_bits")
+        assert "CpduA.state_bits = 5" in r.stdout, r.stdout + r.stderr
+
+        # the plug-in's process killed: the platform manager restarts it, its parameters
+        # are served again by the new process
+        pid = obc.pids_of("adcs")[-1]
+        os.kill(pid, signal.SIGKILL)
+        assert wait_until(lambda: obc.pids_of("adcs")[-1] != pid), obc.stop()
+        r = wait_until(lambda: ground("params", "get", "Magnetorquer.max_dipole").stdout)
+        assert "Magnetorquer.max_dipole = 0.2 A.m^2" in r, obc.stop()
+        assert ground("function", "Magnetorquer.enable").returncode == 0
+
+        # its procedure, from its own procedures folder
+        r = obcp("load-ref", "detumble", ".", "detumble.plt")
         assert r.returncode == 0, r.stdout + r.stderr
-        assert obsw("obcp", *ground, "activate", "detumble").returncode == 0
-        end = time.monotonic() + 20
-        while time.monotonic() < end:
-            r = obsw("obcp", *ground, "status")
-            if "last outcome confirmed" in r.stdout:
-                break
-            time.sleep(0.3)
+        assert obcp("activate", "detumble").returncode == 0
+        r = wait_until(lambda: "last outcome confirmed" in obcp("status").stdout)
+        r = obcp("status")
         assert "detumble" in r.stdout and "last outcome confirmed" in r.stdout, r.stdout
+
+        # a file up with CFDP, to the mission's filestore entity: byte-identical on board
+        ground_files = tmp_path / "ground"
+        ground_files.mkdir()
+        data = os.urandom(20000)
+        (ground_files / "up.bin").write_bytes(data)
+        r = obsw("cfdp", "put", "--mission", AURORA, "--root", ground_files, "up.bin",
+                 "up.bin", env=env)  # fmt: skip
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "delivered up.bin to entity 9" in r.stdout
+        assert (tmp_path / "state" / "files" / "up.bin").read_bytes() == data
     finally:
         out = obc.stop()
     assert "CFDP entity 9" in out and "APID 42" in out

@@ -157,6 +157,8 @@ def test_every_example_runs(page, tmp_path):
         OBSW_MISSION=str(work / "sample"),  # the reader's session names its mission once
         PYTHONPATH=os.pathsep.join([str(work), str(ROOT / "micropython"), str(ROOT / "host")]),
     )
+    if page == pathlib.Path("README.md"):  # the front page works on a fresh clone as written
+        del env["OBSW_MISSION"]
     os.makedirs(env["OBSW_IL_DIR"])
     os.makedirs(env["HOME"])
     ports = {"5100": str(base + 100), "5101": str(base + 101)}

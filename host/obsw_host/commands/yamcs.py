@@ -233,6 +233,7 @@ def run_in_temp(args):
     """``run``; without ``--dir`` its instance (Yamcs' data, some MB) lives in a new temporary
     folder that is removed when Yamcs stops, by Ctrl-C, SIGTERM, ``--seconds`` or an error."""
     signal.signal(signal.SIGTERM, _interrupt)
+    mission_ids.from_args(args)  # no mission: its one line before anything starts
     print("starting Yamcs (Java; up to a minute) ...", file=sys.stderr, flush=True)
     if args.dir:
         return run(args)

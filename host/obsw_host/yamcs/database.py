@@ -149,11 +149,7 @@ def from_sdb(db, ids):
     return sc
 
 
-def load(path=None):
-    """The Spacecraft of the database file ``path`` (default: the sample database)."""
-    if path is None:
-        from obsw_host.sample import SDB_PATH
-
-        path = SDB_PATH
+def load(path):
+    """The Spacecraft of the database file ``path``."""
     with open(path) as f:
         return loads(f.read(), path)

@@ -22,7 +22,7 @@ already uses is left out (the node's own member wins).
 """
 
 from obsw.compat import const
-from obsw.il.errors import ComponentError, InteractionError
+from obsw.il.errors import ComponentError
 from obsw.il.interface import (  # noqa: F401 (check_unique_ids: re-exported for the OBC)
     DATA,
     EVENT,
@@ -224,9 +224,26 @@ class Equipment:
                         {"argument": pname, "value": args[i]},
                     )
                 values[aid] = args[i]
-            self._forward(job, "call_function", (self.node_id, fid, values or None))
+            self._forward(
+                job, "call_function", (self.node_id, fid, values or None), then=self._read_back
+            )
 
         return perform
+
+    def _read_back(self, job, value):
+        """A function's effect readable as soon as its job ends: the node's parameters are read
+        back first; the function succeeded, so a failed read-back still ends the job with
+        ``value`` (the housekeeping reports bring the values later)."""
+        ids = sorted(self.nodedef.parameters)
+        if not ids:
+            job.succeed(value)
+            return
+
+        def keep(rec):
+            self._parameter_result(rec)
+            return value
+
+        self._forward(job, "request_parameters", (self.node_id, ids), keep, fallback=(value,))
 
     def _parameter_ids(self, names):
         if names is None or names == []:
@@ -288,8 +305,10 @@ class Equipment:
     def _ping(self, job):
         self._forward(job, "ping", (self.node_id,))
 
-    def _forward(self, job, member, args, on_result=None):
-        entry = [None, job, on_result]
+    def _forward(self, job, member, args, on_result=None, then=None, fallback=None):
+        """Call the master's ``member``; its outcome (through ``on_result``) ends ``job``, or
+        goes to ``then(job, value)``; with ``fallback`` ``(value,)`` a failure ends it so."""
+        entry = [None, job, on_result, then, fallback]
 
         def status(pending, state, value):
             if state == RUNNING:
@@ -308,18 +327,21 @@ class Equipment:
     def _finish(self, entry):
         if entry in self._outstanding:
             self._outstanding.remove(entry)
-        p, job, on_result = entry
+        p, job, on_result, then, fallback = entry
         if job.done:
             return
         try:
             value = p.outcome()
             if on_result is not None:
                 value = on_result(value)
-        except InteractionError as e:
-            job.fail(e)
-            return
         except Exception as e:  # a malformed record must fail the job, not the caller's loop
-            job.fail(e)
+            if fallback is not None:
+                job.succeed(fallback[0])
+            else:
+                job.fail(e)
+            return
+        if then is not None:
+            then(job, value)
             return
         job.succeed(value)
 

@@ -26,8 +26,11 @@ def obc_services(config_path=None):
     with no fixed port bound."""
     config = obc_config.load(config_path)
     config.doc = copy.deepcopy(config.doc)
+    ports = config.doc.setdefault("ports", {})
+    for name in ("pus", "cfdp", "cfdp_ground"):  # any free port: the mission's OBC may be up
+        ports[name] = 0
     if "cfdp" in config.doc:
-        config.doc["cfdp"]["port"] = 0
+        config.doc["cfdp"].pop("port", None)
     topology = Topology(config)
     process = topology.process_of("pus")
     state = tempfile.mkdtemp(prefix="obsw-coverage-")

@@ -37,7 +37,21 @@ TWO_ENDS = (
 )
 FILE19K = "a 19 KB file held four times (the data, both RAM filestores, the expected copy)"
 TOKENS = "a 12 KB procedure text of 6,000 tokens (48 KB of token columns) in a 103 KiB heap"
+MEMORY = (
+    "memory areas with their copies as files in a RAM filestore (10 KiB chunks), the PUS "
+    "application and its services: beyond a 103 KiB heap"
+)
 CORTEX_M_SKIPS = {
+    "test_pus_random_requests.py": TWO_ENDS,
+    "test_pus_s06_files.py": MEMORY,
+    "test_pus_s15_copy.py::TestCopyByTimeWindow::test_from_to_after_before": HEAP,
+    "test_pus_s15_copy.py::TestCopyByTimeWindow::test_refusals": HEAP,
+    "test_pus_s15_storage.py::TestRetrieval::test_by_time_range_on_the_playback_channel": HEAP,
+    "test_pus_s21_by_reference.py": MEMORY,
+    "test_reconfig_recovery.py::TestInTheApplication::test_context_kept_and_given_back": EEPROM,
+    "test_reconfig_recovery.py::TestInTheApplication::test_heartbeats_keep_the_obc_on": EEPROM,
+    "test_reconfig_recovery.py::TestInTheApplication::test_silence_power_cycles_then_switches_over": EEPROM,
+    "test_reconfig_recovery.py::TestInTheApplication::test_time_from_the_ds3231": EEPROM,
     "test_cbor.py::TestDeterministic::test_shortest_float": FLOAT,
     "test_cbor.py::TestVectors::test_decode_vectors": FLOAT,
     "test_cbor.py::TestVectors::test_encode_vectors": FLOAT,

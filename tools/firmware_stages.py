@@ -50,7 +50,8 @@ CORTEX_M_SKIPS = {
     "test_pus_s21_by_reference.py": MEMORY,
     "test_reconfig_recovery.py::TestInTheApplication::test_context_kept_and_given_back": EEPROM,
     "test_reconfig_recovery.py::TestInTheApplication::test_heartbeats_keep_the_obc_on": EEPROM,
-    "test_reconfig_recovery.py::TestInTheApplication::test_silence_power_cycles_then_switches_over": EEPROM,
+    "test_reconfig_recovery.py::TestInTheApplication::"
+    "test_silence_power_cycles_then_switches_over": EEPROM,
     "test_reconfig_recovery.py::TestInTheApplication::test_time_from_the_ds3231": EEPROM,
     "test_cbor.py::TestDeterministic::test_shortest_float": FLOAT,
     "test_cbor.py::TestVectors::test_decode_vectors": FLOAT,

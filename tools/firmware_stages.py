@@ -43,6 +43,8 @@ MEMORY = (
 )
 CORTEX_M_SKIPS = {
     "test_pus_random_requests.py": TWO_ENDS,
+    "test_pus_mission_services.py::TestProvider::"
+    "test_random_application_data_gets_a_verdict_never_an_exception": TWO_ENDS,
     "test_pus_s06_files.py": MEMORY,
     "test_pus_s15_copy.py::TestCopyByTimeWindow::test_from_to_after_before": HEAP,
     "test_pus_s15_copy.py::TestCopyByTimeWindow::test_refusals": HEAP,

@@ -90,11 +90,11 @@ def _qemu(args):
         q = board.qemu(args.qemu_args)
         # SIGTERM (a service manager, `kill`) ends QEMU too, as Ctrl-C does, not only this
         # process; SIGHUP (the terminal closed) likewise
-        for signum in (signal.SIGTERM, signal.SIGHUP):
-            signal.signal(signum, _interrupt)
-        print("QEMU board on %s (obsw board deploy|test|repl --port %s); Ctrl-C ends it"
-              % (q.pty, q.pty), flush=True)  # fmt: skip
-        try:
+        try:  # from here on a signal (even right after the line below) still closes QEMU
+            for signum in (signal.SIGTERM, signal.SIGHUP):
+                signal.signal(signum, _interrupt)
+            print("QEMU board on %s (obsw board deploy|test|repl --port %s); Ctrl-C ends it"
+                  % (q.pty, q.pty), flush=True)  # fmt: skip
             q.proc.wait()
         except KeyboardInterrupt:
             pass

@@ -63,6 +63,19 @@ def next_sequence(entity_id, width=2, folder=None):
         os.close(fd)
 
 
+def parse_transaction(what):
+    """``SOURCE:SEQ`` as (source, sequence number); None for a directory name (no colon)."""
+    if ":" not in what:
+        return None
+    try:
+        src, seq = (int(x, 0) for x in what.split(":"))
+    except ValueError:
+        from obsw_host.errors import UserError
+
+        raise UserError("transaction %r" % what, expected="SOURCE:SEQ") from None
+    return src, seq
+
+
 class Result:
     """The outcome of a put, get or status request."""
 
@@ -323,15 +336,9 @@ class CfdpClient:
         self._fresh_seq()
         ent = self.entity
         now = time.monotonic()
-        transaction = ":" in what
+        transaction = parse_transaction(what)
         if transaction:
-            try:
-                src, seq = (int(x, 0) for x in what.split(":"))
-            except ValueError:
-                from obsw_host.errors import UserError
-
-                raise UserError("transaction %r" % what, expected="SOURCE:SEQ") from None
-            message = msgs.remote_status_report_request((src, seq), "")
+            message = msgs.remote_status_report_request(transaction, "")
         else:
             listing = "listing-%d-%d.txt" % (self.local_id, ent.seq)
             message = msgs.directory_listing_request(what, listing)

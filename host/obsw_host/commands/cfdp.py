@@ -11,6 +11,7 @@ import sys
 import time
 
 from obsw_host import ids as mission_ids
+from obsw_host.cfdp.client import parse_transaction
 from obsw_host.net import DEFAULT_HOST
 
 
@@ -228,6 +229,7 @@ def cmd_get(args):
 
 
 def cmd_status(args):
+    parse_transaction(args.what)  # a mistake is one line before any port is bound
     with _client(args) as c:
         result = c.status(args.what)
     if args.json:

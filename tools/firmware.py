@@ -161,6 +161,54 @@ def _files_under(folder):
     return [str(p) for p in pathlib.Path(folder).rglob("*") if p.is_file()]
 
 
+# lines make writes for a clean build of the pinned source (one per step: CC, GEN, LINK, ...):
+# the first build's progress is measured against these, later ones against their last build
+_STEPS = {"mpy-cross": 157, "firmware.dfu": 527, "firmware.elf": 591}
+PROGRESS_EVERY = 10.0  # seconds between progress lines
+
+
+def _lines(path):
+    with open(path, "rb") as f:
+        return sum(1 for _ in f)
+
+
+def _record_steps(path, n):
+    """Keep the largest step count seen (a clean build's), not an incremental build's few."""
+    try:
+        n = max(n, int(path.read_text()))
+    except (OSError, ValueError):
+        pass
+    path.write_text(str(n))
+
+
+def _run_with_progress(cmd, log_file, log, out, artifact):
+    """make into ``log_file``; a progress line every PROGRESS_EVERY seconds while it runs."""
+    steps = out / ".obsw-steps"
+    try:
+        total = int(steps.read_text())
+    except (OSError, ValueError):
+        total = _STEPS.get(artifact)
+    proc = subprocess.Popen(cmd, stdout=log_file, stderr=subprocess.STDOUT)
+    t0 = time.monotonic()
+    while True:
+        try:
+            return proc.wait(timeout=PROGRESS_EVERY)
+        except subprocess.TimeoutExpired:
+            done, dt = _lines(log), time.monotonic() - t0
+            if total:
+                pct = min(99, 100 * done // total)
+                say(
+                    "building %s: %d%% (%d of about %d steps), %.0f s"
+                    % (artifact, pct, done, total, dt)
+                )
+            else:
+                say("building %s: %d steps, %.0f s" % (artifact, done, dt))
+        except BaseException:
+            proc.kill()  # Ctrl-C or SIGTERM: no make left running
+            proc.wait()
+            raise
+
+
 def _make(tree, out, artifact, inputs, args):
     """Run make unless ``out``'s stamp says these inputs built ``artifact`` already."""
     key = _hash_inputs(inputs, [str(tree)] + list(args))
@@ -176,11 +224,12 @@ def _make(tree, out, artifact, inputs, args):
     log = out.parent / (out.name + ".log")
     out.mkdir(parents=True, exist_ok=True)
     with open(log, "w") as f:
-        rc = subprocess.call(cmd, stdout=f, stderr=subprocess.STDOUT)
+        rc = _run_with_progress(cmd, f, log, out, artifact)
     if rc or not (out / artifact).is_file():
         tail = log.read_text().splitlines()[-25:]
         raise FirmwareError("build failed (log %s):\n%s" % (log, "\n".join(tail)))
     stamp.write_text(key)
+    _record_steps(out / ".obsw-steps", _lines(log))
     dt = time.monotonic() - t0
     say("built %s in %.1f s" % (out / artifact, dt))
     return out / artifact, dt

@@ -178,3 +178,26 @@ def test_flash_without_dfu_util_leaves_the_board_running(tmp_path):
         "obsw board: dfu-util not found: apt install dfu-util (the board was left running)"
     ]
     assert not log.exists()  # mpremote never ran: the board did not enter DFU mode
+
+
+def test_a_long_build_says_how_far_it_is(tmp_path, capsys, monkeypatch):
+    """make's output goes to a log; while it runs, a line every PROGRESS_EVERY seconds says how
+    many steps are done against the last clean build's count (or the pinned source's)."""
+    fw = board.firmware_tools()
+    monkeypatch.setattr(fw, "PROGRESS_EVERY", 0.2)
+    out = tmp_path / "build"
+    out.mkdir()
+    log = tmp_path / "build.log"
+    steps = "for i in 1 2 3 4 5 6 7 8; do echo CC file$i.c; sleep 0.1; done"
+    with open(log, "w") as f:
+        assert fw._run_with_progress(["sh", "-c", steps], f, log, out, "firmware.elf") == 0
+    lines = [s for s in capsys.readouterr().out.splitlines() if "building" in s]
+    assert lines, "no progress line"
+    assert "of about %d steps" % fw._STEPS["firmware.elf"] in lines[0]
+    fw._record_steps(out / ".obsw-steps", 8)
+    fw._record_steps(out / ".obsw-steps", 3)  # an incremental build does not lower it
+    assert (out / ".obsw-steps").read_text() == "8"
+    with open(log, "w") as f:
+        fw._run_with_progress(["sh", "-c", steps], f, log, out, "firmware.elf")
+    lines = [s for s in capsys.readouterr().out.splitlines() if "building" in s]
+    assert "of about 8 steps" in lines[-1], lines

@@ -7,6 +7,7 @@ import fcntl
 import json
 import os
 import pty
+import re
 import select
 import struct
 import subprocess
@@ -70,6 +71,9 @@ def test_watch_refuses_times_that_are_not_positive(bad):
     assert r.returncode == 2 and "--seconds" in r.stderr and "Traceback" not in r.stderr
 
 
+_ANSI = re.compile(rb"\x1b\[[0-9;?]*[A-Za-z]")
+
+
 class Terminal:
     """The master side of a pseudo-terminal: what it shows, read up to each needle in turn."""
 
@@ -82,7 +86,8 @@ class Terminal:
         ``seconds``); what came after it stays for the next call."""
         end = time.monotonic() + seconds
         want = needle.encode()
-        while want not in self.pending:
+        # what it shows, without the control sequences that redraws put between characters
+        while want not in _ANSI.sub(b"", self.pending):
             left = end - time.monotonic()
             assert left > 0, "%r not seen in %r" % (needle, self.pending[-600:])
             r, _, _ = select.select([self.fd], [], [], left)
@@ -93,8 +98,9 @@ class Terminal:
                     chunk = b""
                 assert chunk, "%r not seen before the end: %r" % (needle, self.pending[-600:])
                 self.pending += chunk
-        cut = self.pending.index(want) + len(want)
-        shown, self.pending = self.pending[:cut], self.pending[cut:]
+        text = _ANSI.sub(b"", self.pending)
+        cut = text.index(want) + len(want)
+        shown, self.pending = text[:cut], text[cut:]
         return shown.decode(errors="replace")
 
 

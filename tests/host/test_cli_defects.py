@@ -9,6 +9,7 @@ import os
 import signal
 import socket
 import subprocess
+import time
 
 import pytest
 from test_cli_ground import BOUND, ENV, OBSW, ROOT, Lines, obc, obsw  # noqa: F401
@@ -58,7 +59,12 @@ def test_ctrl_c_during_cfdp_put_cancels_and_the_receiver_keeps_nothing(tmp_path)
             text=True,
         )  # fmt: skip
         served.until(lambda line: line.startswith("metadata "))  # the transfer is under way
+        # the receiver held still: class 2 cannot finish without its Finished PDU, so the
+        # Ctrl-C comes during the transfer however fast the machine is
+        os.kill(serve.pid, signal.SIGSTOP)
         put.send_signal(signal.SIGINT)
+        time.sleep(0.2)
+        os.kill(serve.pid, signal.SIGCONT)
         out, err = put.communicate(timeout=BOUND)
         assert put.returncode == 130, out + err
         assert "Traceback" not in err

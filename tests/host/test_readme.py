@@ -159,6 +159,9 @@ def test_every_example_runs(page, tmp_path):
     )
     if page == pathlib.Path("README.md"):  # the front page works on a fresh clone as written
         del env["OBSW_MISSION"]
+    session_log = tmp_path / "session.log"
+    if page == GUIDE:
+        env["OBSW_SESSION_LOG"] = str(session_log)
     os.makedirs(env["OBSW_IL_DIR"])
     os.makedirs(env["HOME"])
     ports = {"5100": str(base + 100), "5101": str(base + 101)}
@@ -218,6 +221,41 @@ def test_every_example_runs(page, tmp_path):
         for server in servers:
             server.stop()
     print("%s: %d examples ran, %d skipped: %s" % (page, ran, len(skipped), skipped))
+    if page == GUIDE:
+        missing = served_services(work / "sample") - accepted_services(session_log)
+        assert not missing, "the operator's guide reaches no TC of services %s" % sorted(missing)
+
+
+GUIDE = pathlib.Path("docs/operators-guide.md")
+
+
+def served_services(mission):
+    """The services the mission's OBC takes TCs of, from the service tables it registers."""
+    from obsw_host.pus.coverage import obc_services
+
+    return {s for s, provider in obc_services(str(mission)).items() if provider.HANDLERS}
+
+
+def accepted_services(path):
+    """The services of the TCs of a session log whose acceptance succeeded (TM[1,1])."""
+    import json
+
+    from obsw.pus.tc import PusTc
+
+    sent, accepted = {}, set()
+    for line in path.read_text().splitlines():
+        record = json.loads(line)
+        if record["dir"] == "TC":
+            tc = PusTc.unpack(bytes.fromhex(record["raw"]))
+            sent[(tc.apid, tc.seq_count)] = tc.service
+            continue
+        decoded = record.get("decoded") or {}
+        request = decoded.get("request_id") if isinstance(decoded, dict) else None
+        if request and decoded.get("stage") == 1 and decoded.get("success"):
+            key = (request["apid"], request["seq_count"])
+            if key in sent:
+                accepted.add(sent[key])
+    return accepted
 
 
 def test_examples_are_many_and_every_skip_has_a_reason():

@@ -53,6 +53,7 @@ outside a parameter's range is refused before anything is sent. ``--json`` carri
 
 import argparse
 import json
+import os
 import sys
 
 from obsw_host import ids as mission_ids
@@ -75,7 +76,12 @@ def add_parser(sub):
     p.add_argument("--timeout", type=float, default=2.0, help="seconds per request")
     p.add_argument("--json", action="store_true", help="print JSON for scripts")
     p.add_argument("-v", "--verbose", action="store_true", help="print every packet")
-    p.add_argument("--log", metavar="FILE", help="append every TC and TM to this session log")
+    p.add_argument(
+        "--log",
+        metavar="FILE",
+        default=os.environ.get("OBSW_SESSION_LOG") or None,
+        help="append every TC and TM to this session log (default: $OBSW_SESSION_LOG)",
+    )
     p.add_argument(
         "--raw", action="store_true", help="raw parameter values (default: engineering values)"
     )
@@ -533,7 +539,7 @@ def _listen(args):
 def _learn(g, tm, decoded):
     """A report of a structure this ground has not seen: ask for its layout, decode again."""
     try:
-        g.hk_structures([decoded["sid"]])
+        g.learn_structure(decoded["sid"], kind=g.hk.kind_of(tm))
         return g.hk.decode_report(tm)
     except Exception:
         return decoded

@@ -219,7 +219,7 @@ def _diag(args):
     def go(g):
         hk, apid, w = g.hk, g.apid, args.what
         if w == "report":
-            return _issue(g, hk.one_shot(apid, [args.sid], "diag"))
+            return g.housekeeping(args.sid, kind="diag")
         if w == "create":
             params = _param_ids(g, args.parameters)
             return _issue(g, hk.create(apid, args.sid, args.interval, params, "diag"))

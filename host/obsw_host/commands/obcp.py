@@ -22,6 +22,7 @@
 """
 
 import json
+import os
 import sys
 import threading
 
@@ -73,7 +74,12 @@ def add_client_options(p):
     p.add_argument("--timeout", type=float, default=2.0, help="seconds per request")
     p.add_argument("--json", action="store_true", help="print JSON for scripts")
     p.add_argument("-v", "--verbose", action="store_true", help="print every packet")
-    p.add_argument("--log", metavar="FILE", help="append every TC and TM to this session log")
+    p.add_argument(
+        "--log",
+        metavar="FILE",
+        default=os.environ.get("OBSW_SESSION_LOG") or None,
+        help="append every TC and TM to this session log (default: $OBSW_SESSION_LOG)",
+    )
 
 
 def add_actions(s):

@@ -267,6 +267,10 @@ def named_row(row, sdb=None, raw=False):
             key, value = "time (UTC)", utc(value)
         elif key == "request":
             value = request_text(value, sdb)
+        elif key in ("address", "start_address") and isinstance(value, int):
+            value = "0x%08X" % value
+        elif key == "checksum" and isinstance(value, int):
+            value = "0x%04X" % value
         elif key in ("value", "limit", "low", "high", "expected") and isinstance(
             value, (int, float)
         ):
@@ -310,6 +314,9 @@ def readable(value, sdb=None, raw=False):
         return text.readable(value, sdb, raw)
     if "repository" in v and ("files" in v or "objects" in v):
         return _files(v)
+    special = _structure(v, sdb) or _reporting(v) or _forwarded(v) or _registers(v)
+    if special:
+        return special
     if set(v) in ({"functional"}, {"definitions"}):  # service 12's own tables (text)
         return text.readable(value, sdb, raw)
     if isinstance(v.get("paths"), list):
@@ -342,6 +349,59 @@ def readable(value, sdb=None, raw=False):
             "%s: %s" % (k, (utc(x) or "-") if _is_time(k) else _cell(x)) for k, x in v.items()
         )
     return text.readable(value, sdb, raw)
+
+
+def _structure(v, sdb):
+    """TM[3,10]/[3,12]: a report structure's definition, its parameters by name."""
+    if not {"sid", "enabled", "interval", "parameters"} <= set(v):
+        return ""
+    head = "structure %s: %s, collection interval %s" % (
+        v["sid"],
+        "enabled" if v["enabled"] else "disabled",
+        v["interval"],
+    )
+    rows = [{"parameter": parameter_name(sdb, p), "group": "-"} for p in v["parameters"]]
+    for n, g in enumerate(v.get("groups") or (), 1):
+        for p in g.get("parameters", ()):
+            group = "%d (x%s)" % (n, g.get("repetitions"))
+            rows.append({"parameter": parameter_name(sdb, p), "group": group})
+    return head + "\n" + (table(rows) if rows else "(no parameters)")
+
+
+def _reporting(v):
+    """TM[3,40]: functional reporting definitions, a row per report definition."""
+    defs = v.get("definitions") if set(v) == {"definitions"} else None
+    if not isinstance(defs, dict) or not all(isinstance(d, dict) for d in defs.values()):
+        return ""
+    rows = []
+    for fid, kinds in defs.items():
+        for kind, sids in kinds.items():
+            for sid, (enabled, interval) in sids.items():
+                on = "yes" if enabled else "no"
+                row = {"definition": fid, "kind": kind, "structure": sid, "enabled": on}
+                row["interval"] = interval
+                rows.append(row)
+    return table(rows) if rows else "(no functional reporting definitions)"
+
+
+def _forwarded(v):
+    """TM[14,4/8/12]: the structures forwarded in real time, by APID."""
+    if len(v) != 1 or next(iter(v)) not in ("hk", "diag"):
+        return ""
+    kind, by_apid = next(iter(v.items()))
+    if not isinstance(by_apid, dict):
+        return ""
+    rows = [{"apid": a, kind: ", ".join(map(str, ids)) or "all"} for a, ids in by_apid.items()]
+    return table(rows) if rows else "no %s structure forwarded" % kind
+
+
+def _registers(v):
+    """TM[2,6]: register dump, addresses in hex (node << 16 | parameter id on SpaceCAN)."""
+    regs = v.get("registers") if set(v) == {"registers"} else None
+    if not isinstance(regs, list):
+        return ""
+    rows = [{"address": "0x%08X" % a, "value": number(x)} for a, x in regs]
+    return table(rows) if rows else "(no registers)"
 
 
 def _timed(row):

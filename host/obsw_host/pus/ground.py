@@ -201,9 +201,19 @@ class Ground:
             self.test.connection_test(self.apid if apid is None else apid, target), timeout
         )
 
-    def housekeeping(self, sid, apid=None, timeout=None):
-        """TC[3,27] one-shot report of structure ``sid``; ``tx.reply['values']`` by name."""
-        return self._issue(self.hk.one_shot(self._apid(apid), [sid]), timeout)
+    def housekeeping(self, sid, apid=None, timeout=None, kind="hk"):
+        """TC[3,27] (``kind="diag"``: TC[3,28]) one-shot report of structure ``sid``;
+        ``tx.reply['values']`` by name. A structure this ground does not know yet (one created
+        by another client or session) is asked for first (TC[3,9] / TC[3,11])."""
+        self.learn_structure(sid, apid, timeout, kind)
+        return self._issue(self.hk.one_shot(self._apid(apid), [sid], kind), timeout)
+
+    def learn_structure(self, sid, apid=None, timeout=None, kind="hk"):
+        """Ask for structure ``sid``'s definition unless this ground knows it; True if known."""
+        known = self.hk.structures if kind == "hk" else self.hk.diagnostics
+        if sid not in known:
+            self.wait(self.hk.report_structures(self._apid(apid), [sid], kind), timeout)
+        return sid in known
 
     def hk_structures(self, sids, apid=None, timeout=None):
         """TC[3,9]; ``tx.replies`` holds one TM[3,10] per structure."""

@@ -200,13 +200,14 @@ class HousekeepingUser(ServiceUser):
 
     # -------------------------------------------------------------------------- reports
 
-    def _kind(self, tm):
+    def kind_of(self, tm):
+        """The set a report or structure TM belongs to: 'hk' or 'diag'."""
         return "diag" if tm.subtype in _DIAG_SUBTYPES else "hk"
 
     def decode_structure(self, tm):
         out = STRUCTURE_REPORT.unpack(tm.data)
         out["enabled"] = bool(out["enabled"])
-        self.learn(out["sid"], out["parameters"], self._kind(tm))
+        self.learn(out["sid"], out["parameters"], self.kind_of(tm))
         return out
 
     def decode_properties(self, tm):
@@ -225,7 +226,7 @@ class HousekeepingUser(ServiceUser):
         return {"definitions": out}
 
     def decode_report(self, tm):
-        kind = self._kind(tm)
+        kind = self.kind_of(tm)
         sid = SID_ONLY.unpack(tm.data, False)["sid"]
         pids = self._sets[kind].get(sid)
         if pids is None:

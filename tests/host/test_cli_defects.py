@@ -31,6 +31,16 @@ def udp_port():
     return port
 
 
+def udp_queued(port):
+    """Octets waiting in the receive queue of the UDP socket bound to ``port`` on 127.0.0.1."""
+    with open("/proc/net/udp") as f:
+        for line in f.readlines()[1:]:
+            fields = line.split()
+            if fields[1] == "0100007F:%04X" % port:
+                return int(fields[4].split(":")[1], 16)
+    return 0
+
+
 def test_ctrl_c_during_cfdp_put_cancels_and_the_receiver_keeps_nothing(tmp_path):
     ground, onboard = tmp_path / "ground", tmp_path / "onboard"
     ground.mkdir()
@@ -50,6 +60,9 @@ def test_ctrl_c_during_cfdp_put_cancels_and_the_receiver_keeps_nothing(tmp_path)
     served = Lines(serve.stdout)
     try:
         served.until(lambda line: line.startswith("cfdp entity 2 on udp"))
+        # the receiver held still: class 2 cannot finish without its Finished PDU, so the
+        # Ctrl-C comes during the transfer however fast or loaded the machine is
+        os.kill(serve.pid, signal.SIGSTOP)
         put = subprocess.Popen(
             OBSW + ["cfdp", "put", "big.bin", "--root", str(ground), "--segment", "64"]
             + ["--port", str(back), "--peer", "2=127.0.0.1:%d" % port],
@@ -58,12 +71,10 @@ def test_ctrl_c_during_cfdp_put_cancels_and_the_receiver_keeps_nothing(tmp_path)
             stderr=subprocess.PIPE,
             text=True,
         )  # fmt: skip
-        served.until(lambda line: line.startswith("metadata "))  # the transfer is under way
-        # the receiver held still: class 2 cannot finish without its Finished PDU, so the
-        # Ctrl-C comes during the transfer however fast the machine is
-        os.kill(serve.pid, signal.SIGSTOP)
+        end = time.monotonic() + BOUND
+        while not udp_queued(port) and time.monotonic() < end:  # the transfer is under way
+            time.sleep(0.05)
         put.send_signal(signal.SIGINT)
-        time.sleep(0.2)
         os.kill(serve.pid, signal.SIGCONT)
         out, err = put.communicate(timeout=BOUND)
         assert put.returncode == 130, out + err

@@ -126,6 +126,64 @@ def _unpack(archive):
     return dest / "micropython"
 
 
+# -- mbed TLS, for cryptolib ------------------------------------------------------------------
+# The pinned archive leaves MicroPython's lib/mbedtls submodule empty. cryptolib (the AES block
+# function SDLS GCM needs on the board) takes its AES from mbed TLS: Debian's source of it
+# (bookworm's mbedtls 2.28.3, the release modhashlib also supports) goes into that folder.
+MBEDTLS_VERSION = "2.28.3"
+MBEDTLS_ARCHIVE = "mbedtls_%s.orig.tar.gz" % MBEDTLS_VERSION
+MBEDTLS_URL = "http://deb.debian.org/debian/pool/main/m/mbedtls/" + MBEDTLS_ARCHIVE
+MBEDTLS_SHA256 = "3b4953aa55a681e084d31892d9904cc5328d6b4958ea57b90ae4b4f94ae69a8d"
+
+
+def _mbedtls_archive():
+    """Debian's mbed TLS source archive: $OBSW_MBEDTLS_SRC, build/fw's copy, else downloaded
+    from Debian's archive (checked against the pinned SHA-256); None if it cannot be had."""
+    import urllib.request
+
+    given = os.environ.get("OBSW_MBEDTLS_SRC")
+    path = pathlib.Path(given) if given else BUILD / MBEDTLS_ARCHIVE
+    if not path.is_file() and not given:
+        say("downloading %s" % MBEDTLS_URL)
+        try:
+            with urllib.request.urlopen(MBEDTLS_URL, timeout=60) as r:
+                data = r.read()
+        except OSError as e:
+            say("no mbed TLS source (%s): the images leave cryptolib out" % e)
+            return None
+        BUILD.mkdir(parents=True, exist_ok=True)
+        part = path.with_suffix(".part")
+        part.write_bytes(data)
+        os.replace(part, path)
+    if not path.is_file():
+        say("no mbed TLS source at %s: the images leave cryptolib out" % path)
+        return None
+    if hashlib.sha256(path.read_bytes()).hexdigest() != MBEDTLS_SHA256:
+        raise FirmwareError("%s is not Debian's mbedtls %s (sha256)" % (path, MBEDTLS_VERSION))
+    return path
+
+
+def add_mbedtls(tree):
+    """Put mbed TLS's source into ``tree``/lib/mbedtls if it is not there; True if it is."""
+    lib = tree / "lib" / "mbedtls"
+    if (lib / "library" / "aes.c").is_file():
+        return True
+    archive = _mbedtls_archive()
+    if archive is None:
+        return False
+    with tarfile.open(archive) as t:
+        members = [m for m in t.getmembers() if m.name.count("/") and m.isfile()]
+        top = members[0].name.split("/")[0]
+        for m in members:
+            rel = m.name[len(top) + 1 :]
+            if rel.startswith(("include/", "library/")):
+                dest = lib / rel
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                dest.write_bytes(t.extractfile(m).read())
+    say("mbed TLS %s source in %s (for cryptolib)" % (MBEDTLS_VERSION, lib))
+    return True
+
+
 # -- toolchains ---------------------------------------------------------------------------------
 
 
@@ -235,6 +293,15 @@ def _make(tree, out, artifact, inputs, args):
     return out / artifact, dt
 
 
+def _crypto_inputs(tree):
+    """The board fragment that adds cryptolib, and whether mbed TLS is there to add it."""
+    common = ROOT / "boards" / "common"
+    marker = tree / "lib" / "mbedtls" / "library" / "aes.c"
+    return [common / "cryptolib.mk", common / "obsw_mbedtls_config.h"] + (
+        [marker] if marker.is_file() else []
+    )
+
+
 def build_mpy_cross(src=None):
     tree = source(src)
     out = tree / "mpy-cross" / "build"
@@ -247,7 +314,9 @@ def build_pyboard(src=None):
     tree = source(src)
     build_mpy_cross(src)
     out = BUILD / "pyboard"
+    add_mbedtls(tree)
     inputs = _files_under(PYBOARD) + manifest_inputs(ROOT / "manifests" / "reconfig.py")
+    inputs += _crypto_inputs(tree)
     args = ["-C", str(tree / "ports" / "stm32"), "BOARD_DIR=" + str(PYBOARD), "BUILD=" + str(out)]
     _make(tree, out, "firmware.dfu", inputs, args)
     return out
@@ -336,7 +405,8 @@ def build_qemu(src=None, heap=None):
         "OBSW_STACK_LIMIT=%d" % pyboard_stack_limit(src),
         "FROZEN_MANIFEST=" + str(manifest),
     ]
-    inputs = _files_under(QEMU_BOARD) + manifest_inputs(manifest)
+    add_mbedtls(tree)
+    inputs = _files_under(QEMU_BOARD) + manifest_inputs(manifest) + _crypto_inputs(tree)
     return _make(tree, out, "firmware.elf", inputs, args)[0]
 
 
@@ -483,6 +553,14 @@ def stage_sizes():
     print("\nreconfig.py freezes every module reconfig_main.py imports: %s"
           % ("yes" if not missing else "no, it misses " + ", ".join(missing)))  # fmt: skip
     passed, failed = passed + (not missing), failed + bool(missing)
+    symbols = _pyboard_symbols()
+    has = "mp_module_cryptolib" in symbols and "mbedtls_aes_crypt_ctr" in symbols
+    if has or (source() / "lib" / "mbedtls" / "library" / "aes.c").is_file():
+        print("cryptolib (mbed TLS %s AES) in the Pyboard image: %s"
+              % (MBEDTLS_VERSION, "yes" if has else "no"))  # fmt: skip
+        passed, failed = passed + has, failed + (not has)
+    else:
+        print("cryptolib not in the images: no mbed TLS source (GCM runs over AES in Python)")
     print("firmware stage time %.1f s" % (time.monotonic() - t0))
     print("firmware: %d passed, %d failed" % (passed, failed))
     return 1 if failed else 0

@@ -25,3 +25,6 @@ MPY_CROSS_FLAGS += -march=armv7m
 MICROPY_VFS_LFS2 = 1
 USER_C_MODULES = $(BOARD_DIR)/cmodules
 FROZEN_MANIFEST ?= $(BOARD_DIR)/../../manifests/qemu.py
+
+# cryptolib on mbed TLS (see the fragment)
+include $(BOARD_DIR)/../common/cryptolib.mk

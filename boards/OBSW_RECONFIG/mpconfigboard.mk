@@ -18,3 +18,6 @@ MICROPY_VFS_LFS2 ?= 1
 
 # The image freezes the reconfiguration application and the core modules it needs.
 FROZEN_MANIFEST ?= $(BOARD_DIR)/../../manifests/reconfig.py
+
+# cryptolib on mbed TLS (see the fragment)
+include $(BOARD_DIR)/../common/cryptolib.mk

@@ -5,7 +5,8 @@ SpaceCAN load.
 The QEMU Cortex-M image (tools/firmware.py: mps2-an385, the core frozen, `cryptolib` on mbed
 TLS's AES, the Pyboard's heap and 32 KiB more for the bench's own rig: a SpaceCAN controller
 playing the OBC and the modelled EEPROMs and DS3231, which the application alone does not
-carry; the `heap` stage checks the application in the Pyboard's heap) runs under `-icount shift=7`: every guest instruction advances the virtual clock by 2**7 ns,
+carry; the `heap` stage checks the application in the Pyboard's heap) runs under
+`-icount shift=7`: every guest instruction advances the virtual clock by 2**7 ns,
 whatever the host does. The operations of tools/bench/board_ops.py read the board's CMSDK APB
 timer (25 MHz, 40 ns a tick) around each operation with the SysTick interrupt masked; 128 ns
 per instruction is 3.2 ticks, so a tick difference t fixes the instruction count I exactly

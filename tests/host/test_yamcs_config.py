@@ -1,6 +1,8 @@
 """The XTCE generated from the spacecraft database, the Yamcs instance, and Yamcs' own check."""
 
 import json
+import os
+import pathlib
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -11,7 +13,9 @@ from obsw_host.yamcs.instance import write_instance
 from obsw_host.yamcs.xtce import event_templates, generate
 from obsw_host.yamcs.xtce_types import XtceTypeError
 
+ROOT = str(pathlib.Path(__file__).resolve().parents[2])
 NS = {"x": "http://www.omg.org/spec/XTCE/20180204"}
+X = NS["x"]
 
 
 def extended_db(tmp_path):
@@ -197,11 +201,35 @@ def test_command_verifiers_follow_service_1(xtce):
 def test_unsupported_types_raise_typed_errors(tmp_path):
     with open(SDB_PATH) as f:
         doc = json.load(f)
-    doc["parameters"].append({"name": "pus.blob", "id": 120, "type": "octets"})
+    doc["parameters"].append({"name": "pus.bits", "id": 120, "type": [6, 12]})  # a bit string
     path = tmp_path / "sdb.json"
     path.write_text(json.dumps(doc))
-    with pytest.raises(XtceTypeError, match="PTC 7"):
+    with pytest.raises(XtceTypeError, match="PTC 6"):
         generate(database.load(str(path)))
+
+
+def test_octets_are_binary_after_their_length(tmp_path):
+    """PTC 7: a variable octet string is binary data whose size is the length before it (in
+    containers and in the TC[20,3] that sets it); a fixed one is that many octets."""
+    with open(SDB_PATH) as f:
+        doc = json.load(f)
+    doc["parameters"] += [
+        {"name": "pus.blob", "id": 120, "type": "octets", "writable": True},
+        {"name": "pus.key", "id": 121, "type": [7, 4]},
+    ]
+    doc["housekeeping"].append({"sid": 42, "interval": 1, "parameters": ["pus.blob", "pus.key"]})
+    path = tmp_path / "sdb.json"
+    path.write_text(json.dumps(doc))
+    root = ET.fromstring(generate(database.load(str(path))))
+    types = {t.get("name"): t for t in root.iter("{%s}BinaryParameterType" % X)}
+    size = types["blob_t"].find(".//x:DynamicValue/x:ParameterInstanceRef", NS)
+    assert size.get("parameterRef").endswith("/pus/blob_length")
+    assert types["key_t"].find(".//x:FixedValue", NS).text == "32"
+    hk = [c for c in root.iter("{%s}SequenceContainer" % X) if c.get("name") == "hk_42"][0]
+    refs = [e.get("parameterRef").split("/")[-1] for e in hk.iter("{%s}ParameterRefEntry" % X)]
+    assert refs == ["blob_length", "blob", "key"]
+    cmd = [c for c in root.iter("{%s}MetaCommand" % X) if c.get("name") == "set_blob"][0]
+    assert [a.get("name") for a in cmd.iter("{%s}Argument" % X)] == ["length", "value"]
 
 
 def test_cli_writes_the_xtce_and_the_instance(tmp_path, capsys):
@@ -222,6 +250,30 @@ def test_yamcs_check_accepts_configuration_and_mdb(tmp_path):
     folder = str(tmp_path / "yamcs")
     write_instance(
         folder, sc, instances={"packets": ("packets", None), "frames": ("frames", None)}
+    )
+    ok, output = server.check(folder)
+    assert ok, output[-3000:]
+    assert "SEVERE" not in output
+
+
+@pytest.mark.parametrize("mission", ["sample", "aurora", "new"])
+def test_every_example_and_a_new_mission_generate_xtce(mission, tmp_path):
+    folder = os.path.join(ROOT, "examples", mission)
+    if mission == "new":
+        folder = str(tmp_path / "lynx")
+        assert main(["mission", "new", "lynx", "--dir", folder]) == 0
+    out = tmp_path / "m.xml"
+    assert main(["yamcs", "xtce", "--mission", folder, "-o", str(out)]) == 0
+    assert ET.parse(str(out)).getroot().find("x:TelemetryMetaData", NS) is not None
+
+
+@pytest.mark.skipif(server.missing() is not None, reason=str(server.missing()))
+def test_yamcs_check_accepts_aurora(tmp_path):
+    """aurora differs from the sample in every tailorable way (octets among its types)."""
+    folder = str(tmp_path / "yamcs")
+    assert (
+        main(["yamcs", "config", "--mission", os.path.join(ROOT, "examples", "aurora"), folder])
+        == 0
     )
     ok, output = server.check(folder)
     assert ok, output[-3000:]

@@ -26,7 +26,13 @@ from obsw.pus.services.s01_verification import FAILURE_NAMES
 from obsw.pus.services.s12_layouts import FMON_STATUS_NAMES, STATUS_NAMES
 from obsw.pus.services.s20_parameters import DEFINITION_NAMES
 
-from obsw_host.yamcs.xtce_types import argument_type, linear, parameter_type
+from obsw_host.yamcs.xtce_types import (
+    argument_type,
+    linear,
+    octets_argument_type,
+    octets_type,
+    parameter_type,
+)
 
 XTCE_NS = "http://www.omg.org/spec/XTCE/20180204"
 U8, U16, U32, E8, E16 = (3, 4), (3, 12), (3, 14), (2, 8), (2, 16)
@@ -127,6 +133,7 @@ class Generator:
         self.cfg = config or (ids.pus_config if ids is not None else PusConfig())
         self.root = SpaceSystem(_label(sc.mission), "/" + _label(sc.mission))
         self.refs = {}  # parameter id -> absolute reference
+        self.entries = {}  # parameter id -> its container entries (a length before octets)
         self.apid = sc.required_apid("pus")
         self.source_id = ids.source_id if ids is not None else 0
 
@@ -239,17 +246,26 @@ class Generator:
         for pid in sorted(self.sc.params):
             p = self.sc.params[pid]
             s = self.system_of(p.path[:-1])
-            ptype = parameter_type(
-                "", p.pair, p.unit, limits=p.limits, calibration=p.calibration, labels=p.labels
-            )
-            self.refs[pid] = s.parameter(_label(p.path[-1]), ptype, p.description)
+            name = _label(p.path[-1])
+            entries = []
+            if p.pair[0] == 7:  # octets: a variable string of them goes after its length
+                if not p.pair[1]:
+                    length = parameter_type("", U16)
+                    entries.append(s.parameter(name + "_length", length, "octets of " + name))
+                ptype = octets_type("", p.pair, entries[0] if entries else None)
+            else:
+                ptype = parameter_type(
+                    "", p.pair, p.unit, limits=p.limits, calibration=p.calibration, labels=p.labels
+                )
+            self.refs[pid] = s.parameter(name, ptype, p.description)
+            self.entries[pid] = entries + [self.refs[pid]]
 
     def housekeeping(self):
         r = self.root
         sid = self.header_param("hk_structure_id", 16)
         self.report("hk_report", M.TM_HK_HK_REPORT, [sid])
         for st in self.sc.structures:
-            entries = [self.refs[pid] for pid in st.parameters]
+            entries = [e for pid in st.parameters for e in self.entries[pid]]
             r.containers.append(
                 _container("hk_%d" % st.sid, "hk_report", [(sid, st.sid)], entries, True)
             )
@@ -677,15 +693,20 @@ class Generator:
             if not p.writable:
                 continue
             s = self.system_of(p.path[:-1])
+            if p.pair == (7, 0):  # variable octets: their length, then them
+                value = [
+                    ("arg", "length", argument_type("", U16)),
+                    ("arg", "value", octets_argument_type("", p.pair, "length")),
+                ]
+            elif p.pair[0] == 7:
+                value = [("arg", "value", octets_argument_type("", p.pair))]
+            else:
+                value = [("arg", "value", _value_argument(p))]
             self.command(
                 s,
                 "set_" + _label(p.path[-1]),
                 M.TC_PARAM_SET_VALUES,
-                [
-                    ("fixed", "n", 1, 8),
-                    ("fixed", "parameter", pid, 16),
-                    ("arg", "value", _value_argument(p)),
-                ],
+                [("fixed", "n", 1, 8), ("fixed", "parameter", pid, 16)] + value,
                 "TC[20,3] set %s" % p.qualified,
             )
 

@@ -1,8 +1,10 @@
 """The twelve-step chain end to end (``obsw_host.obc.chain``), then its faults: each OBC process
 killed in turn, bus A cut, UART A cut, the whole OBC killed and power-cycled by the
 reconfiguration module on an essential TC, the whole OBC hung and power-cycled by the module
-alone. Every wait has a deadline; the figures are printed,
-nothing asserts on time."""
+alone. It runs for the sample (in three processes) and for aurora (its own processes, its
+plug-in component among them; other APIDs, SCID, VCs, node ids, CPDU names and the OBC on
+another CPDU line). Every wait has a deadline; the figures are printed, nothing asserts on
+time."""
 
 import os
 import signal
@@ -11,7 +13,7 @@ import time
 import pytest
 from obsw.reconfig.essential import HPC_POWER_CYCLE, Hpc
 from obsw.spacecan.master import MASTER
-from obsw_host.obc.chain import OBC_LINE, Chain
+from obsw_host.obc.chain import Chain
 from obsw_host.reconfig.sim import micropython_binary
 
 pytestmark = pytest.mark.skipif(
@@ -20,6 +22,11 @@ pytestmark = pytest.mark.skipif(
 )
 
 WAIT = 60.0
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+MISSIONS = {  # name -> (mission folder, processes: None for the mission's own)
+    "sample": (os.path.join(ROOT, "examples", "sample"), Chain.SAMPLE_PROCESSES),
+    "aurora": (os.path.join(ROOT, "examples", "aurora"), None),
+}
 
 
 def wait_for(predicate, timeout=WAIT, step=0.05):
@@ -78,10 +85,13 @@ def master_proxy(chain):
     return node.proxy(MASTER, timeout=5.0, retries=2), transport
 
 
-def test_twelve_steps_and_faults(tmp_path, capsys):
+@pytest.mark.parametrize("mission", sorted(MISSIONS))
+def test_twelve_steps_and_faults(mission, tmp_path, capsys):
     figures = []
     t_start = time.monotonic()
-    with Chain(str(tmp_path)) as chain:
+    folder, processes = MISSIONS[mission]
+    with Chain(str(tmp_path), mission=folder, processes=processes) as chain:
+        obc_bit = chain.obc_bit  # the line powering the OBC stays on
         led = Ledger(chain)
         figures.append(("chain up (first ping through frames)", chain.wait_up(WAIT)))
 
@@ -90,14 +100,14 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
         tx, end = chain.switch(0x005, timeout=20.0)
         assert tx.ok, tx.verification()
         assert end == "obcp.finished"
-        assert wait_for(lambda: chain.lines() == 0x005 | OBC_LINE)
+        assert wait_for(lambda: chain.lines() == 0x005 | obc_bit)
         figures.append(("CPDU switch: TC[18,3] to obcp.finished", time.monotonic() - t))
-        hk = wait_for(lambda: chain.cpdu_housekeeping()["CpduN.state_bits"] == 5)
+        hk = wait_for(lambda: chain.cpdu_housekeeping()["state_bits"] == 5 | obc_bit)
         assert hk
-        assert chain.sim.seen("[N] function 1 {1: 5} -> True")
+        assert chain.sim.seen("[N] function 1 {1: %d} -> True" % (5 | obc_bit))
 
         # each OBC process killed in turn: restarted, and the chain serves again
-        for name in ("core", "can", "frames"):
+        for name in chain.config.processes:
             pid = chain.pid_of(name)
             assert pid is not None
             t = time.monotonic()
@@ -108,7 +118,7 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
                             time.monotonic() - t))  # fmt: skip
         tx, end = chain.switch(0x003, name="after_restarts", timeout=20.0)
         assert (tx.ok, end) == (True, "obcp.finished")
-        assert wait_for(lambda: chain.lines() == 0x003 | OBC_LINE)
+        assert wait_for(lambda: chain.lines() == 0x003 | obc_bit)
 
         # bus A cut: the SpaceCAN traffic moves to bus B
         master, transport = master_proxy(chain)
@@ -117,7 +127,7 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
             t = time.monotonic()
             tx, end = chain.switch(0x007, name="bus_b", timeout=20.0)
             assert (tx.ok, end) == (True, "obcp.finished")
-            assert wait_for(lambda: chain.lines() == 0x007 | OBC_LINE)
+            assert wait_for(lambda: chain.lines() == 0x007 | obc_bit)
             figures.append(("bus A cut: switch completed on bus B", time.monotonic() - t))
             assert master.active_bus == 1
         finally:
@@ -142,14 +152,14 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
         chain.sim.kill_obc()
         assert not led.ping(timeout=1.0)
         t = time.monotonic()
-        chain.sim.send_hpc(Hpc(HPC_POWER_CYCLE, (0, 200)))
+        chain.sim.send_hpc(Hpc(HPC_POWER_CYCLE, (chain.obc_line, 200)))
         assert chain.sim.wait_for(lambda: chain.sim.obc_boots == boots + 1, WAIT)
         tries = led.ping_until_ok()
         figures.append(("OBC killed: power-cycled by an essential TC, serving again (%d pings)"
                         % tries, time.monotonic() - t))  # fmt: skip
         tx, end = chain.switch(0x005, name="after_power_cycle", timeout=20.0)
         assert (tx.ok, end) == (True, "obcp.finished")
-        assert wait_for(lambda: chain.lines() == 0x005 | OBC_LINE)
+        assert wait_for(lambda: chain.lines() == 0x005 | obc_bit)
 
         # a process failing again and again: the platform manager asks the reconfiguration
         # module, through the CPDU node, to power-cycle the whole OBC
@@ -160,7 +170,7 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
             os.kill(pid, signal.SIGKILL)
             assert wait_for(lambda p=pid: chain.pid_of("core") not in (None, p))
         assert chain.sim.wait_for(lambda: chain.sim.obc_boots == boots + 1, WAIT)
-        assert chain.sim.seen("asking CpduN to power-cycle the OBC")
+        assert chain.sim.seen("asking %s to power-cycle the OBC" % chain.power_cycler)
         tries = led.ping_until_ok()
         figures.append(("2 failures: platform manager had the OBC power-cycled (%d pings)"
                         % tries, time.monotonic() - t))  # fmt: skip
@@ -172,7 +182,9 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
         boots = chain.sim.obc_boots
         t = time.monotonic()
         chain.sim.hang_obc()
-        assert chain.sim.wait_for(lambda: chain.sim.seen("recovery: power_cycle line 0"), WAIT)
+        assert chain.sim.wait_for(
+            lambda: chain.sim.seen("recovery: power_cycle line %d" % chain.obc_line), WAIT
+        )
         assert chain.sim.wait_for(lambda: chain.sim.obc_boots == boots + 1, WAIT)
         try:
             tries = led.ping_until_ok()
@@ -184,6 +196,7 @@ def test_twelve_steps_and_faults(tmp_path, capsys):
         tx, end = chain.switch(0x003, name="after_hang", timeout=20.0)
         assert (tx.ok, end) == (True, "obcp.finished")
     with capsys.disabled():
-        print("\n  12-step chain and faults, %.1f s in all:" % (time.monotonic() - t_start))
+        took = time.monotonic() - t_start
+        print("\n  %s: 12-step chain and faults, %.1f s in all:" % (mission, took))
         for what, seconds in figures:
             print("    %-70s %6.2f s" % (what, seconds))

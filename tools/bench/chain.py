@@ -22,7 +22,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
-from obsw_host.obc.chain import OBC_LINE, SWITCH, Chain  # noqa: E402
+from obsw_host.obc.chain import SWITCH, Chain  # noqa: E402
 
 
 def percentiles(samples):
@@ -45,7 +45,8 @@ def switches(chain, n):
     """Activate the loaded switch procedures in turn; time to their obcp.finished event."""
     states = (0x005, 0x003)
     for i, state in enumerate(states):
-        tx = chain.obcp.load("sw%d" % i, SWITCH % (state | OBC_LINE), timeout=10.0)
+        text = SWITCH % (chain.cpdu, state | chain.obc_bit)
+        tx = chain.obcp.load("sw%d" % i, text, timeout=10.0)
         if not tx.ok:
             raise RuntimeError("load refused: %s" % tx.verification())
     out = []

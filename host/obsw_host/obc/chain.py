@@ -2,37 +2,41 @@
 
 ground (PUS user) -> TC frames in CLTUs on two pseudo-terminal UARTs -> frame processor ->
 PUS application process -> service 18 -> PLUTO procedure on the OBCP engine -> interaction
-layer -> CpduN equipment component -> SpaceCAN master -> CAN (the reconfiguration module's
+layer -> the CPDU's equipment component -> SpaceCAN master -> CAN (the reconfiguration module's
 UDP hub, buses A and B) -> both reconfiguration controllers as MicroPython unix-port processes
 -> CPDU lines switch -> housekeeping and verification back through TM frames.
 
-``Chain(work)`` writes a mission configuration with the OBC split into three processes
-(``core``: PUS, CFDP, OBCP and the sample solar panel; ``can``: SpaceCAN master and equipment;
-``frames``: the frame processor), starts the simulated reconfiguration module
-(``obsw_host.reconfig.sim.ReconfigSim``), whose CPDU line 0 powers the OBC: the OBC is
-``obsw obc serve`` of that configuration (the platform manager and its three processes).
-The ground station holds the other ends of the OBC's UARTs; the ground's PUS user talks to it.
+``Chain(work, mission=DIR)`` copies a mission folder (default: the sample's) into ``work`` and
+points its mission file at the chain's links: the SpaceCAN hub of the simulated
+reconfiguration module (``obsw_host.reconfig.sim.ReconfigSim``, on the mission's ids), two
+pseudo-terminal UARTs, free UDP ports and the module's TC keys. The mission's CPDU line that
+its platform manager power-cycles (``platform.power_cycle``) powers the OBC: the OBC is
+``obsw obc serve`` of that mission (the platform manager and the mission's processes, its
+plug-in components among them). The ground station holds the other ends of the OBC's UARTs;
+the ground's PUS user talks to it. Every name and id comes from the mission: the CPDU is the
+reconfiguration module's nominal node, the procedure drives its ``set_state_bits``.
 """
 
 import json
 import os
 import select
+import shutil
 import sys
 import threading
 import time
 
 from obsw_host.frames.links import FdLink
 from obsw_host.ids import MissionIds
+from obsw_host.obc import defaults
 
 SWITCH = """\
 // Switch CPDU lines through the nominal controller and confirm the new state.
 procedure
   main
-    initiate and confirm set_state_bits of CpduN with arguments state := %d end with;
+    initiate and confirm set_state_bits of %s with arguments state := %d end with;
   end main
 end procedure
 """
-OBC_LINE = 0x001  # CPDU line 0 powers the OBC: every state the chain sets keeps it on
 
 
 def _station_class():
@@ -68,13 +72,35 @@ class Chain:
     # after 8 s without a SpaceCAN heartbeat (the OBC's processes restart faster than that)
     RECOVERY = {"deadline": 8.0, "boot_grace": 20.0, "off_ms": 300, "max_failures": 10}
 
-    def __init__(self, work, out=None, timeout=10.0, recovery=None):
+    # the sample in three processes, so that each can be killed alone
+    SAMPLE_PROCESSES = {
+        "core": ["pus", "cfdp", "obcp", "SolarPanel"],
+        "can": ["spacecan"],
+        "frames": ["frames"],
+    }
+
+    def __init__(self, work, out=None, timeout=10.0, recovery=None, mission=None, processes=None):
+        from obsw_host.sample import MISSION_DIR
+
         self.work = work
+        self.mission_dir = os.path.join(work, "mission")  # the mission's copy, its paths kept
+        shutil.copytree(
+            mission or MISSION_DIR, self.mission_dir, ignore=shutil.ignore_patterns("__pycache__")
+        )
+        self.ids = MissionIds.locate(self.mission_dir)
+        nodes = {n.node_id: name for name, n in self.ids.sdb.nodes.items()}
+        self.cpdu = nodes[self.ids.reconfig_nodes[0]]  # the nominal controller's node
+        power = dict(defaults.PLATFORM["power_cycle"])
+        power.update((self.ids.config.doc.get("platform") or {}).get("power_cycle") or {})
+        self.power_cycler = power["component"]
+        self.obc_line = power["line"]  # the CPDU line that powers the OBC
+        self.obc_bit = 1 << self.obc_line  # every state the chain sets keeps it on
+        self.processes = processes or (None if mission else self.SAMPLE_PROCESSES)
         self.recovery = dict(self.RECOVERY, **(recovery or {}))
         self.out = out
         self.timeout = timeout
         self.state = os.path.join(work, "obc-state")
-        self.config_path = os.path.join(work, "mission.json")
+        self.config_path = os.path.join(self.mission_dir, "chain.json")
         self.sim = None
         self.station = None
         self.ground = None
@@ -101,27 +127,19 @@ class Chain:
         return controller, os.ttyname(device)
 
     def write_config(self, hub_ports, uart_a, uart_b):
-        from obsw_host.sample import MISSION_DIR, MISSION_PATH
-
-        base = MISSION_DIR
-        with open(MISSION_PATH) as f:
+        with open(self.ids.config.path) as f:
             doc = json.load(f)
         doc["name"] = "chain"
-        doc["sdb"] = os.path.join(base, doc["sdb"])
         doc["state"] = self.state
-        doc["processes"] = {
-            "core": ["pus", "cfdp", "obcp", "SolarPanel"],
-            "can": ["spacecan"],
-            "frames": ["frames"],
-        }
+        if self.processes:
+            doc["processes"] = self.processes
         doc["ports"] = {  # free ports: several chains may run at once
             "pus": self.pus_port,
             "cfdp": self.cfdp_port,
             "tm": self.tm_port,
             "playback": self.playback_port,
         }
-        doc["obcp"]["files"] = os.path.join(base, doc["obcp"]["files"])
-        doc["spacecan"].update(
+        doc.setdefault("spacecan", {}).update(
             interface="hub",
             channels=list(hub_ports),
             simulate=False,
@@ -129,14 +147,17 @@ class Chain:
             timeout=0.3,
             retries=3,
         )
-        doc["frames"].update(
+        frames = doc.setdefault("frames", {})
+        frames.pop("tc_security", None)  # signed TC frames, as the module's are
+        frames.update(
             uart_a=uart_a,
             uart_b=uart_b,
             clcw_period=0.2,
             keys=self.sim.key_file,  # the mission's TC keys: the OBC's and the module's
         )
-        doc["platform"].update(heartbeat=0.2, deadline=2.0, start_timeout=30.0, max_failures=20)
-        doc["platform"].update(self.platform)
+        platform = doc.setdefault("platform", {})
+        platform.update(heartbeat=0.2, deadline=2.0, start_timeout=30.0, max_failures=20)
+        platform.update(self.platform)
         partial = self.config_path + ".part"
         with open(partial, "w") as f:
             json.dump(doc, f, indent=2)
@@ -164,10 +185,15 @@ class Chain:
         sim_dir = os.path.join(self.work, "reconfig")
         os.makedirs(sim_dir, exist_ok=True)
         self.sim = ReconfigSim(
-            sim_dir, obc_command=self._obc_command, out=self.out, recovery=self.recovery
+            sim_dir,
+            obc_command=self._obc_command,
+            out=self.out,
+            recovery=self.recovery,
+            ids=self.ids,
+            obc_line=self.obc_line,
+            initial_lines=self.obc_bit,
         )
         security, state = keys.load(self.sim.key_file, os.path.join(self.work, "station.state"))
-        self.ids = MissionIds.sample()  # the sample's, as write_config gives the OBC
         self.station = _station_class()(
             self.links,
             self.ids.scid,
@@ -233,7 +259,7 @@ class Chain:
 
         Returns the transaction of the activation and the procedure's final event."""
         timeout = timeout or self.timeout
-        tx = self.obcp.load(name, SWITCH % (state | OBC_LINE), timeout=timeout)
+        tx = self.obcp.load(name, SWITCH % (self.cpdu, state | self.obc_bit), timeout=timeout)
         if not tx.ok:
             raise RuntimeError("load refused: %s" % tx.verification())
         since = len(self.ground.received)
@@ -254,11 +280,15 @@ class Chain:
                         return ids[eid]
         return None
 
-    def cpdu_housekeeping(self, sid=9):
-        """CpduN's parameters in a one-shot housekeeping report through the TM frames."""
-        names = ["CpduN.state_bits", "CpduN.health", "CpduN.in_charge"]
+    def cpdu_housekeeping(self, sid=99):
+        """The nominal CPDU's parameters (by attribute name) in a one-shot housekeeping report
+        through the TM frames."""
+        known = {p.qualified for p in self.sdb.parameters.values()}
+        names = ["%s.%s" % (self.cpdu, a) for a in ("state_bits", "health", "in_charge")]
+        names = [n for n in names if n in known]
         if sid not in self._hk:
-            self.ground.disable_hk([1])  # the sample's periodic report: one-shots only here
+            periodic = [st["sid"] for st in self.sdb.housekeeping if st["enabled"]]
+            self.ground.disable_hk(periodic)  # the mission's periodic reports: one-shots here
             tx = self.ground.create_hk(sid, 10, names)
             if not tx.ok:
                 raise RuntimeError("structure %d not created: %s" % (sid, tx.verification()))
@@ -268,7 +298,7 @@ class Chain:
             raise RuntimeError(
                 "no housekeeping report %d: %s %r" % (sid, tx.verification(), tx.reply)
             )
-        return tx.reply["values"]
+        return {k.split(".", 1)[1]: v for k, v in tx.reply["values"].items()}
 
     def lines(self):
         return self.sim.lines()
@@ -336,9 +366,9 @@ def demo(out=print):
             t = time.monotonic()
             tx, end = chain.switch(0x005, timeout=20.0)
             check(
-                "TC[18,3] -> PLUTO -> CpduN.set_state_bits -> SpaceCAN -> CPDU 0x%03x"
-                % chain.lines(),
-                tx.ok and end == "obcp.finished" and chain.lines() == 0x005,
+                "TC[18,3] -> PLUTO -> %s.set_state_bits -> SpaceCAN -> CPDU 0x%03x"
+                % (chain.cpdu, chain.lines()),
+                tx.ok and end == "obcp.finished" and chain.lines() == 0x005 | chain.obc_bit,
                 t,
             )
             t = time.monotonic()
@@ -346,11 +376,11 @@ def demo(out=print):
             hk = None
             while time.monotonic() < end_t:
                 hk = chain.cpdu_housekeeping()
-                if hk.get("CpduN.state_bits") == 5:
+                if hk.get("state_bits") == 5 | chain.obc_bit:
                     break
-            check("housekeeping through TM frames: CpduN.state_bits = %s" % hk.get(
-                "CpduN.state_bits"), hk.get("CpduN.state_bits") == 5, t)  # fmt: skip
-            for name in ("core", "can", "frames"):
+            check("housekeeping through TM frames: %s.state_bits = %s" % (chain.cpdu, hk.get(
+                "state_bits")), hk.get("state_bits") == 5 | chain.obc_bit, t)  # fmt: skip
+            for name in chain.config.processes:
                 pid = chain.pid_of(name)
                 t = time.monotonic()
                 os.kill(pid, signal.SIGKILL)
@@ -370,7 +400,7 @@ def demo(out=print):
             boots = chain.sim.obc_boots
             chain.sim.kill_obc()
             t = time.monotonic()
-            chain.sim.send_hpc(Hpc(HPC_POWER_CYCLE, (0, 200)))
+            chain.sim.send_hpc(Hpc(HPC_POWER_CYCLE, (chain.obc_line, 200)))
             chain.sim.wait_for(lambda: chain.sim.obc_boots == boots + 1, 30.0)
             check("OBC killed: power-cycled by an essential TC, serving again",
                   ping_until_ok(chain), t)  # fmt: skip

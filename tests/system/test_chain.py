@@ -200,3 +200,43 @@ def test_twelve_steps_and_faults(mission, tmp_path, capsys):
         print("\n  %s: 12-step chain and faults, %.1f s in all:" % (mission, took))
         for what, seconds in figures:
             print("    %-70s %6.2f s" % (what, seconds))
+
+
+def test_switch_over_to_the_redundant_obc(tmp_path, capsys):
+    """The OBC hangs, is power-cycled by the reconfiguration module, hangs again: with one
+    recovery already in the window the module switches to the redundant OBC (a second `obsw obc
+    serve` of the mission, its own state folder, another CPDU line), which answers the ground
+    through the same UARTs and runs procedures; no TC that was accepted is left without its
+    completion."""
+    figures = []
+    recovery = {"deadline": 4.0, "max_failures": 1, "window": 300.0}
+    with Chain(str(tmp_path), recovery=recovery) as chain:
+        led = Ledger(chain)
+        figures.append(("chain up (first ping through frames)", chain.wait_up(WAIT)))
+        nominal = chain.obc_line
+        for fault, decision in (("hung", "power_cycle"), ("hung again", "switch_over")):
+            led.ping_until_ok()
+            time.sleep(1.0)  # heartbeats flowing, no TC frame outstanding
+            boots = chain.sim.obc_boots
+            t = time.monotonic()
+            chain.sim.hang_obc()
+            seen = "recovery: %s line %d" % (decision, nominal)
+            assert chain.sim.wait_for(lambda s=seen: chain.sim.seen(s), WAIT), seen
+            assert chain.sim.wait_for(lambda b=boots: chain.sim.obc_boots == b + 1, WAIT)
+            tries = led.ping_until_ok()
+            figures.append(("OBC %s: %s, serving again (%d pings)" % (fault, decision, tries),
+                            time.monotonic() - t))  # fmt: skip
+        assert chain.active_line == chain.REDUNDANT_LINE
+        assert chain.sim.lines() >> nominal & 1 == 0  # the nominal OBC stays off
+        assert chain.sim.seen("supervisor: redundant OBC power line on")
+        assert os.listdir(chain.state + "-redundant")  # its own state folder
+        t = time.monotonic()
+        tx, end = chain.switch(0x006, name="on_the_redundant", timeout=20.0)
+        assert (tx.ok, end) == (True, "obcp.finished")
+        assert wait_for(lambda: chain.lines() == 0x006 | chain.obc_bit)
+        figures.append(("redundant OBC: CPDU switch by procedure", time.monotonic() - t))
+        assert led.lost() == []
+    with capsys.disabled():
+        print("\n  switch-over to the redundant OBC:")
+        for what, seconds in figures:
+            print("    %-70s %6.2f s" % (what, seconds))

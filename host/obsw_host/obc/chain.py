@@ -71,6 +71,8 @@ class Chain:
     # the reconfiguration module's autonomous recovery in the chain: a hung OBC is power-cycled
     # after 8 s without a SpaceCAN heartbeat (the OBC's processes restart faster than that)
     RECOVERY = {"deadline": 8.0, "boot_grace": 20.0, "off_ms": 300, "max_failures": 10}
+    # the redundant OBC's CPDU line: above the four lines the chain's procedures switch
+    REDUNDANT_LINE = 8
 
     # the sample in three processes, so that each can be killed alone
     SAMPLE_PROCESSES = {
@@ -93,10 +95,11 @@ class Chain:
         power = dict(defaults.PLATFORM["power_cycle"])
         power.update((self.ids.config.doc.get("platform") or {}).get("power_cycle") or {})
         self.power_cycler = power["component"]
-        self.obc_line = power["line"]  # the CPDU line that powers the OBC
-        self.obc_bit = 1 << self.obc_line  # every state the chain sets keeps it on
+        self.obc_line = power["line"]  # the CPDU line that powers the (nominal) OBC
         self.processes = processes or (None if mission else self.SAMPLE_PROCESSES)
         self.recovery = dict(self.RECOVERY, **(recovery or {}))
+        # the nominal and the redundant OBC: the same mission, each its own state folder
+        self.recovery["lines"] = [self.obc_line, self.REDUNDANT_LINE]
         self.out = out
         self.timeout = timeout
         self.state = os.path.join(work, "obc-state")
@@ -126,11 +129,13 @@ class Chain:
         self._uarts.append(device)  # kept open: a restarted frame processor finds it as it was
         return controller, os.ttyname(device)
 
-    def write_config(self, hub_ports, uart_a, uart_b):
+    def write_config(self, hub_ports, uart_a, uart_b, redundant=False):
+        """The mission file of the OBC about to boot (the redundant one: its own state folder
+        and its own CPDU line to ask a power cycle of)."""
         with open(self.ids.config.path) as f:
             doc = json.load(f)
         doc["name"] = "chain"
-        doc["state"] = self.state
+        doc["state"] = self.state + ("-redundant" if redundant else "")
         if self.processes:
             doc["processes"] = self.processes
         doc["ports"] = {  # free ports: several chains may run at once
@@ -158,14 +163,31 @@ class Chain:
         platform = doc.setdefault("platform", {})
         platform.update(heartbeat=0.2, deadline=2.0, start_timeout=30.0, max_failures=20)
         platform.update(self.platform)
+        if redundant:
+            cycle = dict(defaults.PLATFORM["power_cycle"], **(platform.get("power_cycle") or {}))
+            platform["power_cycle"] = dict(cycle, line=self.REDUNDANT_LINE)
         partial = self.config_path + ".part"
         with open(partial, "w") as f:
             json.dump(doc, f, indent=2)
         os.replace(partial, self.config_path)  # the test polls for the file: never half written
         return doc
 
+    @property
+    def active_line(self):
+        """The CPDU line of the OBC in service: the redundant one once switched over."""
+        if self.sim is not None and self.sim.lines() >> self.obc_line & 1 == 0:
+            if self.sim.lines() >> self.REDUNDANT_LINE & 1:
+                return self.REDUNDANT_LINE
+        return self.obc_line
+
+    @property
+    def obc_bit(self):
+        """The state bit of the OBC in service: every state the chain sets keeps it on."""
+        return 1 << self.active_line
+
     def _obc_command(self, sim):
-        self.write_config(sim.hub.ports, self.uart_paths[0], self.uart_paths[1])
+        redundant = sim.obc_which == 1
+        self.write_config(sim.hub.ports, self.uart_paths[0], self.uart_paths[1], redundant)
         return [sys.executable, "-m", "obsw_host.obc", self.config_path]
 
     def start(self):
@@ -190,8 +212,8 @@ class Chain:
             out=self.out,
             recovery=self.recovery,
             ids=self.ids,
-            obc_line=self.obc_line,
-            initial_lines=self.obc_bit,
+            obc_lines=(self.obc_line, self.REDUNDANT_LINE),
+            initial_lines=1 << self.obc_line,
         )
         security, state = keys.load(self.sim.key_file, os.path.join(self.work, "station.state"))
         self.station = _station_class()(

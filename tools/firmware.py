@@ -136,6 +136,9 @@ MBEDTLS_URL = "http://deb.debian.org/debian/pool/main/m/mbedtls/" + MBEDTLS_ARCH
 MBEDTLS_SHA256 = "3b4953aa55a681e084d31892d9904cc5328d6b4958ea57b90ae4b4f94ae69a8d"
 
 
+_NO_MBEDTLS = []  # why the source could not be had, once per process
+
+
 def _mbedtls_archive():
     """Debian's mbed TLS source archive: $OBSW_MBEDTLS_SRC, build/fw's copy, else downloaded
     from Debian's archive (checked against the pinned SHA-256); None if it cannot be had."""
@@ -143,6 +146,8 @@ def _mbedtls_archive():
 
     given = os.environ.get("OBSW_MBEDTLS_SRC")
     path = pathlib.Path(given) if given else BUILD / MBEDTLS_ARCHIVE
+    if _NO_MBEDTLS:
+        return None
     if not path.is_file() and not given:
         say("downloading %s" % MBEDTLS_URL)
         try:
@@ -150,6 +155,7 @@ def _mbedtls_archive():
                 data = r.read()
         except OSError as e:
             say("no mbed TLS source (%s): the images leave cryptolib out" % e)
+            _NO_MBEDTLS.append(str(e))
             return None
         BUILD.mkdir(parents=True, exist_ok=True)
         part = path.with_suffix(".part")
@@ -157,6 +163,7 @@ def _mbedtls_archive():
         os.replace(part, path)
     if not path.is_file():
         say("no mbed TLS source at %s: the images leave cryptolib out" % path)
+        _NO_MBEDTLS.append(str(path))
         return None
     if hashlib.sha256(path.read_bytes()).hexdigest() != MBEDTLS_SHA256:
         raise FirmwareError("%s is not Debian's mbedtls %s (sha256)" % (path, MBEDTLS_VERSION))

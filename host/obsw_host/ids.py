@@ -390,12 +390,16 @@ class MissionIds:
         """What the reconfiguration module's boards need to know of the mission, as written to
         their filesystem (``obsw.reconfig.mission``)."""
         nominal, redundant = self.reconfig_nodes
-        return {
+        doc = {
             "scid": self.scid,
             "nodes": [nominal, redundant],
             "essential_map": self.maps["essential"],
             "hptm_vc": self.tm_vcs["essential"],
         }
+        recovery = self.config.doc.get("recovery") if self.config else None
+        if recovery is not None:  # the autonomous recovery's thresholds, as the mission says
+            doc["recovery"] = dict(recovery)
+        return doc
 
 
 def add_arguments(parser, sdb_help="spacecraft database JSON (overrides the mission's)"):

@@ -485,3 +485,19 @@ def test_problems_lists_every_missing_id_once(mission):
         "sdb.json: events: no event 'files.copy_failed'; expected the built-in event's id",
         "sdb.json: apids.cfdp: missing; expected the APID of the cfdp process (0-2047)",
     ]
+
+
+def test_the_board_file_carries_the_missions_recovery_thresholds(tmp_path):
+    import json
+    import shutil
+
+    from obsw.reconfig.mission import parse
+
+    folder = tmp_path / "aurora"
+    shutil.copytree(os.path.join(ROOT, "examples", "aurora"), folder)
+    doc = json.loads((folder / "mission.json").read_text())
+    doc["recovery"] = {"deadline": 12.0, "max_failures": 2, "lines": [1, 0]}
+    (folder / "mission.json").write_text(json.dumps(doc))
+    written = json.loads(open(board_file(MissionIds.locate(str(folder)), str(tmp_path))).read())
+    assert written["recovery"] == doc["recovery"] and written["nodes"] == [20, 21]
+    parse(written)  # what a board reads, it takes

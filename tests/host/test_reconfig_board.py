@@ -201,3 +201,16 @@ def test_a_long_build_says_how_far_it_is(tmp_path, capsys, monkeypatch):
         fw._run_with_progress(["sh", "-c", steps], f, log, out, "firmware.elf")
     lines = [s for s in capsys.readouterr().out.splitlines() if "building" in s]
     assert "of about 8 steps" in lines[-1], lines
+
+
+def test_deploy_installs_the_missions_ids_or_says_it_did_not(fakes, tmp_path, capsys, monkeypatch):
+    tmp, calls = fakes
+    argv = ["board", "deploy", "--port", "/dev/ttyACM0", "--march", "armv7emsp"]
+    assert run(argv) == 0  # the sample, named by $OBSW_MISSION
+    assert "mission.json of sample-spacecraft installed" in capsys.readouterr().out
+    assert ":mission.json" in calls()[-1]
+    monkeypatch.delenv("OBSW_MISSION")
+    monkeypatch.chdir(tmp_path)  # no mission.json here or above
+    assert run(argv) == 0
+    assert "mission.json NOT installed" in capsys.readouterr().out
+    assert ":mission.json" not in calls()[-1]

@@ -3,6 +3,8 @@
 import signal
 import sys
 
+from obsw_host import ids as mission_ids
+
 
 def add_parser(sub):
     p = sub.add_parser("board", help="Pyboard firmware for the reconfiguration module")
@@ -47,6 +49,7 @@ def add_parser(sub):
                 help="mpy-cross architecture (default: the board's own, else armv7emsp)",
             )
             q.add_argument("--keys", help="the board's SDLS key file, installed as tc.keys")
+            mission_ids.add_arguments(q)
             q.add_argument(
                 "--insecure",
                 action="store_true",
@@ -108,18 +111,42 @@ def _interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
+def _mission(args):
+    """The ids of the mission deploy names or finds, or None when there is none to find (a
+    mission found with a mistake stops the deploy before anything is copied)."""
+    from obsw_host.errors import UserError
+
+    if getattr(args, "mission", None) is None and getattr(args, "sdb", None) is None:
+        try:
+            mission_ids.locate(None)
+        except UserError:
+            return None
+    ids = mission_ids.from_args(args)
+    ids.reconfig_board()
+    return ids
+
+
 def _deploy(args):
     from obsw_host import board
 
     def go():
+        ids = _mission(args)
         names = board.deploy(
             args.port,
             march=args.march,
             keys=args.keys,
             insecure=args.insecure,
             progress=_progress,
+            ids=ids,
         )
         print("%d modules deployed" % len(names))
+        if ids is not None:
+            print("mission.json of %s installed on the board" % ids.name)
+        else:
+            print(
+                "mission.json NOT installed (no mission: --mission DIR, ./mission.json or "
+                "$OBSW_MISSION): the board keeps the one it has, else its built-in ids"
+            )
         if args.keys:
             print("SDLS keys installed on the board as tc.keys (from %s)" % args.keys)
         elif args.insecure:

@@ -249,7 +249,7 @@ def folder(tmp_path):
 def test_the_sample_passes():
     m, problems = check(locate(sample.MISSION_DIR))
     assert problems == []
-    assert sorted(m.interfaces) == ["CpduN", "CpduR", "SolarPanel"]
+    assert sorted(m.interfaces) == ["CpduN", "CpduR", "OnboardTime", "SolarPanel"]
     assert m.sdb.apid("pus") == 10
 
 

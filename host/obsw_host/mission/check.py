@@ -21,6 +21,7 @@ from obsw_host.mission import defaults
 from obsw_host.mission.errors import Problem, did_you_mean, short
 from obsw_host.mission.schema import json_type, read_json, validate
 from obsw_host.obc.config import ConfigError, MissionConfig
+from obsw_host.obc.onboard_time import ONBOARD_TIME
 from obsw_host.obc.plugins import Component, PluginError
 from obsw_host.obc.registry import KINDS, WITH_PUS
 
@@ -80,7 +81,8 @@ class _Checker:
         self.file = mission_file
         self.folder = os.path.dirname(os.path.abspath(mission_file))
         self.problems = []
-        self.interfaces = {}  # component name -> Interface (plug-ins and nodes)
+        # component name -> Interface (the OBC's built-in ones, plug-ins and nodes)
+        self.interfaces = {ONBOARD_TIME.name: ONBOARD_TIME}
         self.unresolved = set()  # components whose module is at fault (said once, there)
         self.where = {}  # kind or component -> the process that runs it
         self.nodes = {}  # SpaceCAN node name -> node id, of the definitions that load

@@ -19,6 +19,7 @@ from obsw.il.interface import DATA, Attribute, Interface, Operation
 from obsw_host.ids import MissionIds
 from obsw_host.obc import defaults, plugins
 from obsw_host.obc.config import ConfigError
+from obsw_host.obc.onboard_time import ONBOARD_TIME
 from obsw_host.obc.registry import WITH_PUS
 
 HEALTH_BASE = 0x7F00  # interface ids of the processes' health components: base + index
@@ -200,7 +201,8 @@ class Topology:
     def interfaces(self):
         """Every component interface of the OBC, wherever it runs (the OBCP engine's)."""
         frames = [FRAME_PROCESSOR] if self.runs("frames") else []
-        return self.component_interfaces() + self.equipment_interfaces() + frames
+        pus = [ONBOARD_TIME] if self.runs("pus") else []  # the PUS process provides it
+        return self.component_interfaces() + self.equipment_interfaces() + frames + pus
 
     def describe(self):
         """The topology as data: processes, their units and components, and connections."""

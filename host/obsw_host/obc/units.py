@@ -26,8 +26,9 @@ from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.il.transport import SocketTransport
 from obsw_host.obc import monitoring
 from obsw_host.obc.health import HostHealth, ObcHealth
+from obsw_host.obc.onboard_time import ONBOARD_TIME, OnboardTime
 from obsw_host.obc.topology import OBC_HEALTH, PLATFORM, PLATFORM_EVENTS
-from obsw_host.pus.onboard import Onboard
+from obsw_host.pus.onboard import Onboard, tai_now
 
 
 class PlatformEvents:
@@ -106,6 +107,8 @@ class PusUnit:
         self.components = [c.build() for c in process.components]
         self.health = self._health(topology)
         self.components.append((OBC_HEALTH, self.health))
+        self.onboard_time = OnboardTime(os.path.join(config.state, "onboard_time.json"), tai_now)
+        self.components.append((ONBOARD_TIME, self.onboard_time))
         self.interfaces = topology.interfaces()
         self.ids = ids = topology.ids
         playback_to = None
@@ -142,6 +145,7 @@ class PusUnit:
             components=self.components,
             context=context,
             time_code=opts["time_code"],  # ST[09] reports: "cuc" (9,2) or "cds" (9,3)
+            time=self.onboard_time.now,
         )
         self.onboard.follow_period = float(opts["follow_period"])
         self.app = self.onboard.app

@@ -189,6 +189,7 @@ class Onboard:
         time_code="cuc",
         context=None,
         config=None,
+        time=None,
     ):
         self.sdb = sdb
         self.apid = apid if apid is not None else sdb.apid("pus")
@@ -213,7 +214,7 @@ class Onboard:
             self.apid,
             self._send,
             REAL_CLOCK,
-            time=tai_now,
+            time=time or tai_now,  # onboard time: the OBC's corrected one, else the host's
             store=store,
             period=period,
             max_tasks=max_tasks,

@@ -36,9 +36,12 @@ class Correlation:
         """The UTC of an onboard time."""
         return self.ref + (obt - self.ref - self.offset) / (1.0 + self.drift)
 
-    def correction(self):
-        """The function's arguments: ``offset_ms`` and ``drift_ppb`` to subtract on board."""
-        return {"offset_ms": round(self.offset * 1000), "drift_ppb": round(self.drift * 1e9)}
+    def correction(self, at=None):
+        """The function's arguments: ``offset_ms`` (the clock's error at UTC ``at``, when the TC
+        goes up; default the reference time) and ``drift_ppb``, to take off on board from
+        then on (``obsw_host.obc.onboard_time``)."""
+        offset = self.offset + self.drift * ((self.ref if at is None else at) - self.ref)
+        return {"offset_ms": round(offset * 1000), "drift_ppb": round(self.drift * 1e9)}
 
     def __repr__(self):
         return "Correlation(offset %.6f s at %.3f, drift %.3f ppm, rms %.6f s, %d reports)" % (
@@ -71,9 +74,11 @@ def correlate(samples, link_delay=0.0):
     return Correlation(ref, offset, drift, rms, n)
 
 
-def uplink(ground, correlation, apid=None, timeout=None):
-    """TC[8,1] ``OnboardTime.correct`` with the correction; the ground's Transaction."""
-    return ground.perform(FUNCTION, apid=apid, timeout=timeout, **correlation.correction())
+def uplink(ground, correlation, at=None, apid=None, timeout=None):
+    """TC[8,1] ``OnboardTime.correct`` with the correction for UTC ``at`` (now, in the time
+    reports' epoch); the ground's Transaction."""
+    args = correlation.correction(at)
+    return ground.perform(FUNCTION, apid=apid, timeout=timeout, **args)
 
 
 def samples_from(ground_received, decode):

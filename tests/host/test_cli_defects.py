@@ -70,6 +70,9 @@ def test_ctrl_c_during_cfdp_put_cancels_and_the_receiver_keeps_nothing(tmp_path)
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
+            # Ctrl-C as a terminal gives it, whatever this process inherited (a shell's
+            # background job ignores SIGINT, and so would the put)
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
         )  # fmt: skip
         end = time.monotonic() + BOUND
         while not udp_queued(port) and time.monotonic() < end:  # the transfer is under way

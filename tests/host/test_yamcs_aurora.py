@@ -112,7 +112,7 @@ def _start(argv, env, cwd):
 
 def _stop(proc):
     if proc.poll() is None:
-        os.killpg(proc.pid, signal.SIGINT)
+        os.killpg(proc.pid, signal.SIGTERM)
         try:
             proc.wait(30)
         except subprocess.TimeoutExpired:

@@ -282,7 +282,13 @@ def _make(tree, out, artifact, inputs, args):
         say("cached %s" % (out / artifact))
         return out / artifact, 0.0
     t0 = time.monotonic()
-    # make recompiles a frozen module when its source changes, not when the options do
+    # make recompiles a file when its source changes, not when the options do: a build with
+    # other options (cryptolib in or out, another heap) starts from a clean folder, and the
+    # frozen modules are always compiled again
+    options = "\n".join([str(tree)] + list(args) + [str(p) for p in inputs if "mbedtls" in str(p)])
+    was = out / ".obsw-options"
+    if out.exists() and (not was.is_file() or was.read_text() != options):
+        shutil.rmtree(out)
     shutil.rmtree(out / "frozen_mpy", ignore_errors=True)
     cmd = ["make", "-j" + JOBS] + list(args)
     say("$ " + " ".join(cmd))
@@ -294,6 +300,7 @@ def _make(tree, out, artifact, inputs, args):
         tail = log.read_text().splitlines()[-25:]
         raise FirmwareError("build failed (log %s):\n%s" % (log, "\n".join(tail)))
     stamp.write_text(key)
+    was.write_text(options)
     _record_steps(out / ".obsw-steps", _lines(log))
     dt = time.monotonic() - t0
     say("built %s in %.1f s" % (out / artifact, dt))

@@ -46,8 +46,7 @@ CORTEX_M_SKIPS = {
     "test_pus_mission_services.py::TestProvider::"
     "test_random_application_data_gets_a_verdict_never_an_exception": TWO_ENDS,
     "test_pus_s06_files.py": MEMORY,
-    "test_pus_s12_functional.py::TestFunctionalMonitoring::"
-    "test_bad_definitions_fail_the_start_and_add_nothing": TWO_ENDS,
+    "test_pus_s12_functional.py": TWO_ENDS,
     "test_pus_s15_copy.py::TestCopyByTimeWindow::test_from_to_after_before": HEAP,
     "test_pus_s15_copy.py::TestCopyByTimeWindow::test_refusals": HEAP,
     "test_pus_s15_storage.py::TestRetrieval::test_by_time_range_on_the_playback_channel": HEAP,

@@ -54,10 +54,13 @@ def run_file(path, counts, verbose, skips=None):
         print("FAIL import %s" % path)
         sys.print_exception(e)
         return
+    case = None
     for cname, cls in _cases(module):
         for tname in sorted(dir(cls)):
             if not tname.startswith("test"):
                 continue
+            case = None
+            gc.collect()  # each test on a collected heap: what one left is not the next's
             label = "%s::%s::%s" % (path, cname, tname)
             reason = _skip(skips, filename, label)
             if reason is not None:

@@ -136,6 +136,21 @@ def _signal_all(pids, sig):
             pass
 
 
+def _power_on(cmd, env, fds=()):
+    """A simulated controller's or OBC's process, its output read by the simulation, with the
+    signal dispositions of a machine that powers on: SIGINT not ignored, whatever the shell
+    that ran the simulation left (a background job inherits SIGINT ignored, and the OBC's
+    recovery then stalled)."""
+    return subprocess.Popen(
+        cmd,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        pass_fds=fds,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+
+
 class _Proc:
     def __init__(self, name, popen, sim):
         self.name = name
@@ -347,8 +362,7 @@ class ReconfigSim:
             str(self.bit_error_gap),
             self.key_file,
         ]
-        p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-        self.ctrl[role] = _Proc(ROLES[role], p, self)
+        self.ctrl[role] = _Proc(ROLES[role], _power_on(cmd, env), self)
         self._wdog[role] = Tps3813Model(self.wd[0], self.wd[1], time.monotonic() * 1000)
         self._kicks[role] = None
         self._req_since[role] = None
@@ -373,11 +387,8 @@ class ReconfigSim:
             if self.obc_boots == 0:
                 for c in self.obc_calls:
                     cmd += ["--call", c]
-        p = subprocess.Popen(
-            cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, pass_fds=fds
-        )
         self.obc_boots += 1
-        self.obc = _Proc("obc", p, self)
+        self.obc = _Proc("obc", _power_on(cmd, env, fds), self)
         self.obcs[self.obc_lines[which]] = self.obc
 
     # -- the hardware around the controllers --------------------------------------------------

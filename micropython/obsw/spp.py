@@ -284,6 +284,10 @@ class SequenceCounter:
     def peek(self, apid):
         return self._counts.get(apid, self._start)
 
+    def counts(self):
+        """{apid: the count of its next packet} of every APID that sent one."""
+        return dict(self._counts)
+
     def set(self, apid, value):
         self._counts[apid] = check_range("sequence count", value, SEQ_COUNT_MODULO - 1)
 

@@ -136,6 +136,7 @@ class TestIdleAndCounters(unittest.TestCase):
         self.assertEqual(c.next(1), 0x3FFF)
         self.assertEqual(c.next(1), 0)
         self.assertEqual(c.peek(2), 1)
+        self.assertEqual(c.counts(), {1: 1, 2: 1})  # what a context keeps
         c.reset(2)
         self.assertEqual(c.peek(2), 0)
         with self.assertRaises(spp.FieldRangeError):

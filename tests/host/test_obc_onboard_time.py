@@ -99,3 +99,14 @@ def test_the_obc_reports_the_corrected_time_and_keeps_it_across_a_restart(tmp_pa
             assert all(-2.0 - 3.0 < t - host < -2.0 + 0.5 for t in reports), (reports, host)
         finally:
             stop(proc)
+
+
+def test_set_from_the_ds3231_the_offset_follows_and_the_drift_stays(tmp_path):
+    raw = Clock(5000.0)
+    ot = OnboardTime(str(tmp_path / "t.json"), raw)
+    ot.correct(0, 1000)  # 1 ppm fast
+    ot.set_time(4000.0)  # the module's clock says: 1000 s earlier (a host clock after a cut)
+    assert ot.now() == pytest.approx(4000.0)
+    raw.t = 6000.0
+    assert ot.now() == pytest.approx(5000.0 - 1e-6 * 1000.0)
+    assert OnboardTime(str(tmp_path / "t.json"), raw).now() == pytest.approx(ot.now())

@@ -76,6 +76,20 @@ class Ledger:
         ]
 
 
+def restored_context(chain):
+    """(boots, saves, sequence counts kept) of the context the OBC in service read back
+    through the module at its last start (its log line)."""
+    import re
+
+    mark = "module link: context restored: "
+    lines = [text for _, text in chain.sim.events if mark in text]
+    assert lines, "no context restored through the module"
+    text = lines[-1]
+    boots = int(re.search(r"boots=(\d+)", text).group(1))
+    saves = int(re.search(r"saves=(\d+)", text).group(1))
+    return boots, saves, re.search(r"seq=(\{[^}]*\})", text).group(1) != "{}"
+
+
 def master_proxy(chain):
     from obsw.il.node import Node
     from obsw_host.il.transport import SocketTransport
@@ -157,6 +171,9 @@ def test_twelve_steps_and_faults(mission, tmp_path, capsys):
         tries = led.ping_until_ok()
         figures.append(("OBC killed: power-cycled by an essential TC, serving again (%d pings)"
                         % tries, time.monotonic() - t))  # fmt: skip
+        # its context came back through the module's UART link and safeguard memory
+        boots, saves, counts = restored_context(chain)
+        assert boots >= 1 and saves >= 1 and counts, (boots, saves)
         tx, end = chain.switch(0x005, name="after_power_cycle", timeout=20.0)
         assert (tx.ok, end) == (True, "obcp.finished")
         assert wait_for(lambda: chain.lines() == 0x005 | obc_bit)
@@ -227,6 +244,9 @@ def test_switch_over_to_the_redundant_obc(tmp_path, capsys):
             figures.append(("OBC %s: %s, serving again (%d pings)" % (fault, decision, tries),
                             time.monotonic() - t))  # fmt: skip
         assert chain.active_line == chain.REDUNDANT_LINE
+        # the redundant OBC carries on the nominal's context: its boots, its TM counts
+        boots, saves, counts = restored_context(chain)
+        assert boots >= 2 and saves >= 1 and counts, (boots, saves)
         assert chain.sim.lines() >> nominal & 1 == 0  # the nominal OBC stays off
         assert chain.sim.seen("supervisor: redundant OBC power line on")
         assert os.listdir(chain.state + "-redundant")  # its own state folder

@@ -162,6 +162,8 @@ class Chain:
         )
         platform = doc.setdefault("platform", {})
         platform.update(heartbeat=0.2, deadline=2.0, start_timeout=30.0, max_failures=20)
+        # the UART link to the module: context and time across power cycles and switch-overs
+        platform.update(module_uarts=list(self.sim.obc_uart_paths), context_period=0.5)
         platform.update(self.platform)
         if redundant:
             cycle = dict(defaults.PLATFORM["power_cycle"], **(platform.get("power_cycle") or {}))

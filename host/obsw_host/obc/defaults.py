@@ -49,6 +49,10 @@ PLATFORM = {
     "health_root": "/",  # where /proc and /sys are (a simulated tree in tests)
     "disk": None,  # the file system whose use is reported; None: the state folder's
     "thermal_zone": "thermal_zone0",  # /sys/class/thermal/<zone>/temp: the SoC's sensor
+    # the UART link to the reconfiguration module (obsw_host.obc.module_link): heartbeats,
+    # the OBC's context in its safeguard memory and the DS3231's time at start
+    "module_uarts": None,  # the serial devices to its two controllers; None: no link
+    "context_period": 1.0,  # seconds between context saves
 }
 # the reconfiguration module's autonomous recovery of the OBC (delivered to the boards in their
 # mission.json, obsw.reconfig.mission); the module's own fallback is the same table, in the core

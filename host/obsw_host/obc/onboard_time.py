@@ -67,6 +67,12 @@ class OnboardTime:
         raw = self.raw()
         return raw - self.error(raw)
 
+    def set_time(self, t):
+        """The onboard time is ``t`` now (from the module's DS3231 at start): the offset
+        becomes what the raw clock is off by, the drift stays."""
+        raw = self.raw()
+        self._apply(raw - t, self.drift, raw, self.corrections)
+
     def correct(self, offset_ms, drift_ppb):
         from obsw.il.errors import ComponentError
 
@@ -77,8 +83,14 @@ class OnboardTime:
             )
         raw = self.raw()
         offset = self.error(raw) + offset_ms / 1000.0
-        drift = self.drift + drift_ppb * 1e-9
-        saved = {"offset": offset, "drift": drift, "t0": raw, "corrections": self.corrections + 1}
+        self._apply(offset, self.drift + drift_ppb * 1e-9, raw, self.corrections + 1)
+        if self.il is not None:
+            self.il.emit("corrected", {"offset_ms": offset_ms, "drift_ppb": drift_ppb})
+        return True
+
+    def _apply(self, offset, drift, raw, corrections):
+        """Write the correction, then take it (a power cut leaves the old or the new one)."""
+        saved = {"offset": offset, "drift": drift, "t0": raw, "corrections": corrections}
         part = self.path + ".part"
         with open(part, "w") as f:
             json.dump(saved, f)
@@ -89,13 +101,10 @@ class OnboardTime:
         figures = {
             "offset_ms": round(offset * 1000),
             "drift_ppb": round(drift * 1e9),
-            "corrections": self.corrections + 1,
+            "corrections": corrections,
         }
         for name, value in figures.items():
             if self.il is not None:
                 self.il.update(name, value)  # sets it and publishes it
             else:
                 setattr(self, name, value)
-        if self.il is not None:
-            self.il.emit("corrected", {"offset_ms": offset_ms, "drift_ppb": drift_ppb})
-        return True

@@ -26,6 +26,7 @@ from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.il.transport import SocketTransport
 from obsw_host.obc import monitoring
 from obsw_host.obc.health import HostHealth, ObcHealth
+from obsw_host.obc.module_link import ModuleLink
 from obsw_host.obc.onboard_time import ONBOARD_TIME, OnboardTime
 from obsw_host.obc.topology import OBC_HEALTH, PLATFORM, PLATFORM_EVENTS
 from obsw_host.pus.onboard import Onboard, tai_now
@@ -151,6 +152,18 @@ class PusUnit:
         self.app = self.onboard.app
         self.obcp = self.app.services.get(18)
         self.node.provide(PLATFORM, PlatformEvents(self.app, sdb, self.health))
+        self.module = None
+        platform = topology.section("platform")
+        if platform.get("module_uarts"):  # the UART link to the reconfiguration module
+            self.module = ModuleLink(
+                [config.resolve(d) for d in platform["module_uarts"]],
+                self.app,
+                self.onboard_time,
+                self.engine,
+                float(platform["context_period"]),
+                out,
+            )
+            self.module.restore()
         monitoring.install(self.app, sdb, opts["monitoring"])  # first start: the mission's
         self._running = False
 
@@ -247,6 +260,9 @@ class PusUnit:
             self.onboard.tasks.append(self._cfdp_task)
         if self.engine is not None:
             self.onboard.tasks.append(self._engine_task)
+        if self.module is not None:
+            beat = self.onboard.period
+            self.onboard.tasks.append(lambda: self.module.run(beat, lambda: self._running))
         self.onboard.start()
         self.out(
             "PUS application process APID %d on udp %s:%d, services %s"
@@ -271,6 +287,8 @@ class PusUnit:
     def stop(self):
         self._running = False
         self.onboard.stop()
+        if self.module is not None:
+            self.module.close()
         if self.cfdp is not None:
             self.cfdp.close()
         self.transport.close()

@@ -253,6 +253,9 @@ class ReconfigSim:
         self.hub = None
         self.com = []  # controller-end fds of the COM ptys (the COM module's side)
         self.obc_uart = []
+        self.obc_uart_paths = []  # the OBC's ends of its UARTs, with an obc_command
+        self._cables = []
+        self.uart_dropped = 0
         self._tty = []
         self._decoders = [CaduDecoder(64), CaduDecoder(64)]
         self._demux = [TmDemultiplexer(scid), TmDemultiplexer(scid)]
@@ -311,11 +314,38 @@ class ReconfigSim:
             fd2, path2 = open_pty_pair()
             self.obc_uart.append(fd2)
             self._tty.append(path2)
+            if self.obc_command is not None:  # an OBC process that opens its UARTs by name
+                self._cable(fd2)
         for role in (0, 1):
             self._spawn(role, RESET_POWER)
         self._sup = threading.Thread(target=self._supervise, daemon=True)
         self._sup.start()
         return self
+
+    def _cable(self, controller_end):
+        """A null-modem cable from a controller's OBC UART to a pseudo-terminal of the OBC's
+        own (its device path in ``obc_uart_paths``), bytes carried by the supervisor; the
+        OBC's end stays open between its boots, as a UART's wires stay."""
+        import tty
+
+        mine, device = os.openpty()
+        tty.setraw(device)
+        os.set_blocking(mine, False)
+        os.set_blocking(controller_end, False)
+        self._cables.append((controller_end, mine, device))
+        self.obc_uart_paths.append(os.ttyname(device))
+
+    def _carry(self):
+        for a, b, _ in self._cables:
+            for src, dst in ((a, b), (b, a)):
+                try:
+                    data = os.read(src, 4096)
+                except (BlockingIOError, OSError):
+                    continue
+                try:
+                    os.write(dst, data)
+                except (BlockingIOError, OSError):
+                    self.uart_dropped += len(data)  # nobody reads that end: as a UART would
 
     def __enter__(self):
         return self.start()
@@ -332,7 +362,8 @@ class ReconfigSim:
                 p.kill()
         if self.hub is not None:
             self.hub.close()
-        for fd in self.com + self.obc_uart + [getattr(self, "_wire_fd", None)]:
+        cable_fds = [fd for _, mine, device in self._cables for fd in (mine, device)]
+        for fd in self.com + self.obc_uart + cable_fds + [getattr(self, "_wire_fd", None)]:
             if fd is not None:
                 try:
                     os.close(fd)
@@ -464,6 +495,7 @@ class ReconfigSim:
                     p = self.obcs.pop(line, None)
                     if p is not None:
                         p.kill()
+            self._carry()
             time.sleep(0.005)
 
     # -- faults -------------------------------------------------------------------------------

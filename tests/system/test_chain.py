@@ -220,29 +220,32 @@ def test_twelve_steps_and_faults(mission, tmp_path, capsys):
 
 
 def test_switch_over_to_the_redundant_obc(tmp_path, capsys):
-    """The OBC hangs, is power-cycled by the reconfiguration module, hangs again: with one
-    recovery already in the window the module switches to the redundant OBC (a second `obsw obc
-    serve` of the mission, its own state folder, another CPDU line), which answers the ground
-    through the same UARTs and runs procedures; no TC that was accepted is left without its
-    completion."""
+    """The OBC is killed and the reconfiguration module power-cycles it by itself; it comes
+    back with its context; then it hangs: with one recovery already in the window the module
+    switches to the redundant OBC (a second `obsw obc serve` of the mission, its own state
+    folder, another CPDU line), which carries on the context, answers the ground through the
+    same UARTs and runs procedures; no TC that was accepted is left without its completion."""
     figures = []
     recovery = {"deadline": 4.0, "max_failures": 1, "window": 300.0}
     with Chain(str(tmp_path), recovery=recovery) as chain:
         led = Ledger(chain)
         figures.append(("chain up (first ping through frames)", chain.wait_up(WAIT)))
         nominal = chain.obc_line
-        for fault, decision in (("hung", "power_cycle"), ("hung again", "switch_over")):
+        faults = (("killed", chain.sim.kill_obc, "power_cycle"),
+                  ("hung", chain.sim.hang_obc, "switch_over"))  # fmt: skip
+        for fault, inject, decision in faults:  # no ground TC: the module acts by itself
             led.ping_until_ok()
             time.sleep(1.0)  # heartbeats flowing, no TC frame outstanding
             boots = chain.sim.obc_boots
             t = time.monotonic()
-            chain.sim.hang_obc()
+            inject()
             seen = "recovery: %s line %d" % (decision, nominal)
             assert chain.sim.wait_for(lambda s=seen: chain.sim.seen(s), WAIT), seen
             assert chain.sim.wait_for(lambda b=boots: chain.sim.obc_boots == b + 1, WAIT)
             tries = led.ping_until_ok()
             figures.append(("OBC %s: %s, serving again (%d pings)" % (fault, decision, tries),
                             time.monotonic() - t))  # fmt: skip
+            assert restored_context(chain)[2], "the TM counts did not come back"
         assert chain.active_line == chain.REDUNDANT_LINE
         # the redundant OBC carries on the nominal's context: its boots, its TM counts
         boots, saves, counts = restored_context(chain)

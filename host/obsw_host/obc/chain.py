@@ -143,6 +143,7 @@ class Chain:
             "cfdp": self.cfdp_port,
             "tm": self.tm_port,
             "playback": self.playback_port,
+            "cfdp_ground": self.cfdp_ground_port,
         }
         doc.setdefault("spacecan", {}).update(
             interface="hub",
@@ -202,7 +203,9 @@ class Chain:
         from obsw_host.reconfig.sim import ReconfigSim
 
         os.makedirs(self.state, exist_ok=True)
-        self.pus_port, self.cfdp_port, self.tm_port, self.playback_port = _free_ports(4)
+        ports = _free_ports(5)
+        self.pus_port, self.cfdp_port, self.tm_port, self.playback_port = ports[:4]
+        self.cfdp_ground_port = ports[4]  # where the OBC's CFDP entity finds the ground's
         ends = [self._pty(), self._pty()]
         self.uart_paths = [path for _, path in ends]
         self.links = [FdLink(ends[0][0], "A"), FdLink(ends[1][0], "B")]

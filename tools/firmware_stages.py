@@ -53,6 +53,7 @@ CORTEX_M_SKIPS = {
     "test_pus_s21_by_reference.py": MEMORY,
     "test_pus_s06_objects.py::TestWriteProtection::test_every_load_honours_it": MEMORY,
     "test_pus_s15_storage.py::TestStores::test_housekeeping_and_event_control": HEAP,
+    "test_pus_s15_storage.py::TestPersistence::test_stores_survive_a_restart": HEAP,
     "test_reconfig_recovery.py::TestInTheApplication::test_context_kept_and_given_back": EEPROM,
     "test_reconfig_recovery.py::TestInTheApplication::test_heartbeats_keep_the_obc_on": EEPROM,
     "test_reconfig_recovery.py::TestInTheApplication::"

@@ -92,7 +92,7 @@ def free_base():
     raise RuntimeError("no free port base")
 
 
-READY = {"obsw obc serve": " up: "}  # a server's ready line (else: its first line)
+READY = {"obsw obc serve": "PUS application process"}  # a server's ready line (else: its first)
 
 
 class Server:

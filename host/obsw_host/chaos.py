@@ -177,6 +177,9 @@ class Campaign:
             try:
                 tx, end = c.switch(self.rng.choice((0x005, 0x003)), name="chaos", timeout=20.0)
                 fault["switched"] = bool(tx.ok and end == "obcp.finished")
+            except Exception as e:  # a timeout: the procedure did not complete
+                fault["switched"] = False
+                fault["error"] = str(e)
             finally:
                 c.sim.hub.revive(bus)
         elif kind == "uart_cut":
@@ -195,7 +198,22 @@ class Campaign:
             fault["took"] = self.serving()
         fault["until"] = time.monotonic()
         fault["recovered"] = fault["took"] is not None and fault.get("switched", True)
+        if not fault["recovered"]:
+            fault["state"] = self.diagnosis()
+            self.out("           not recovered: %s" % fault["state"])
         return fault
+
+    def diagnosis(self):
+        """What a fault not recovered from left: the ground station's FOP-1, its thread, the
+        simulation's last lines."""
+        c = self.chain
+        fop = c.station.ground.fop
+        return {
+            "fop_state": fop.state,
+            "fop_vs": fop.vs,
+            "station_alive": c._thread.is_alive() if c._thread else None,
+            "last": [text for _, text in c.sim.events[-6:]],
+        }
 
     def _lossy(self, seconds, loss, dup):
         """TC frames lost and duplicated on the way to the OBC for ``seconds``."""

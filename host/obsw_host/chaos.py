@@ -157,8 +157,10 @@ class Campaign:
             pid = c.pid_of(name)
             fault["process"] = name
             fault["kills"] = name == "core"  # the PUS process: TCs in it are gone
-            if pid is not None:
+            try:
                 os.kill(pid, signal.SIGKILL if kind == "process_kill" else signal.SIGSTOP)
+            except (TypeError, ProcessLookupError):
+                fault["gone"] = True  # already restarting (or never up): nothing to do
         elif kind == "obc_kill":
             fault["kills"] = True
             c.sim.kill_obc()

@@ -20,6 +20,7 @@ import pytest
 from obsw_host.ids import MissionIds
 from obsw_host.yamcs import server
 from obsw_host.yamcs.instance import instance_name
+from test_yamcs_e2e import Watch
 
 MISSING = server.missing()
 pytestmark = pytest.mark.skipif(MISSING is not None, reason=str(MISSING))
@@ -74,27 +75,6 @@ class Lines:
             found = [x for x in self.lines if predicate(x)]
         assert found, "not seen within %ss:\n%s" % (timeout, "\n".join(self.lines[-30:]))
         return found[0]
-
-
-class Watch:
-    def __init__(self):
-        self.items = []
-        self.changed = threading.Condition()
-
-    def __call__(self, item):
-        with self.changed:
-            self.items.append(item)
-            self.changed.notify_all()
-
-    def wait(self, predicate, timeout=TIMEOUT):
-        def find():
-            return next((x for x in self.items if predicate(x)), None)
-
-        with self.changed:
-            self.changed.wait_for(lambda: find() is not None, timeout)
-            found = find()
-        assert found is not None, "nothing matching came within %ss" % timeout
-        return found
 
 
 def _start(argv, env, cwd):

@@ -148,32 +148,35 @@ def parameter_type(name, pair, unit=None, limits=None, calibration=None, labels=
     return t
 
 
-def octets_type(name, pair, length_ref=None):
-    """PTC 7 (octet string): PFC > 0 is that many octets; PFC 0 is variable, its length in
-    octets the parameter ``length_ref`` just before it (Yamcs' XTCE reader takes a fixed or a
-    dynamic size for binary data, not a leading size as for strings)."""
-    t = ET.Element("BinaryParameterType", name=name)
+def _octets(tag, name, pair, length):
+    """PTC 7 (octet string) as binary data: PFC > 0 is that many octets; PFC 0 is variable,
+    as many octets as ``length`` says, the (tag, attribute, reference) of the parameter or
+    argument just before it (Yamcs' XTCE reader takes a fixed or a dynamic size for binary
+    data, not a leading size as for strings)."""
+    t = ET.Element(tag, name=name)
     size = _sub(_sub(t, "BinaryDataEncoding"), "SizeInBits")
     if pair[1]:
         _sub(size, "FixedValue").text = str(8 * pair[1])
     else:
+        ref_tag, attr, ref = length
         dynamic = _sub(size, "DynamicValue")
-        _sub(dynamic, "ParameterInstanceRef", parameterRef=length_ref)
+        _sub(dynamic, ref_tag, **{attr: ref})
         _sub(dynamic, "LinearAdjustment", slope="8")
     return t
+
+
+def octets_type(name, pair, length_ref=None):
+    """A PTC 7 parameter; a variable one after parameter ``length_ref``."""
+    return _octets(
+        "BinaryParameterType", name, pair, ("ParameterInstanceRef", "parameterRef", length_ref)
+    )
 
 
 def octets_argument_type(name, pair, length_arg=None):
-    """PTC 7 as a command argument: PFC > 0 octets, or as many as argument ``length_arg``."""
-    t = ET.Element("BinaryArgumentType", name=name)
-    size = _sub(_sub(t, "BinaryDataEncoding"), "SizeInBits")
-    if pair[1]:
-        _sub(size, "FixedValue").text = str(8 * pair[1])
-    else:
-        dynamic = _sub(size, "DynamicValue")
-        _sub(dynamic, "ArgumentInstanceRef", argumentRef=length_arg)
-        _sub(dynamic, "LinearAdjustment", slope="8")
-    return t
+    """A PTC 7 command argument; a variable one after argument ``length_arg``."""
+    return _octets(
+        "BinaryArgumentType", name, pair, ("ArgumentInstanceRef", "argumentRef", length_arg)
+    )
 
 
 def argument_type(name, pair, unit=None, valid=None, labels=None, calibration=None):

@@ -99,13 +99,22 @@ def _naf(k):
     return digits
 
 
-def _decode(octets):
-    """The point of a canonical encoding (RFC 8032 section 5.1.3) as (x, y), or None."""
+def canonical_encoding(octets):
+    """False for the encodings RFC 8032 section 5.1.3 refuses whatever the curve: y not below p,
+    and x = 0 (y = 1 or p - 1) with the sign bit set."""
     y = int.from_bytes(octets, "little")
     sign = y >> 255
     y &= (1 << 255) - 1
-    if y >= _P:
+    return y < _P and not (sign and (y == 1 or y == _P - 1))
+
+
+def _decode(octets):
+    """The point of a canonical encoding (RFC 8032 section 5.1.3) as (x, y), or None."""
+    if not canonical_encoding(octets):
         return None
+    y = int.from_bytes(octets, "little")
+    sign = y >> 255
+    y &= (1 << 255) - 1
     yy = y * y % _P
     u = (yy - 1) % _P
     v = (_D * yy + 1) % _P
@@ -116,14 +125,12 @@ def _decode(octets):
         if vxx != _P - u:
             return None  # no square root: not on the curve
         x = x * _SQRT_M1 % _P
-    if x == 0 and sign:
-        return None
     if x & 1 != sign:
         x = _P - x
     return x, y
 
 
-def _check(public_key, signature):
+def check_lengths(public_key, signature):
     if len(public_key) != 32:
         raise ValueError("an Ed25519 public key is 32 octets, not %d" % len(public_key))
     if len(signature) != 64:
@@ -134,7 +141,7 @@ def verify(public_key, signature, message):
     """True when ``signature`` (64 octets) is ``public_key``'s (32 octets) over ``message``.
 
     Any octets of the right lengths give True or False; wrong lengths raise ValueError."""
-    _check(public_key, signature)
+    check_lengths(public_key, signature)
     public_key = bytes(public_key)
     signature = bytes(signature)
     s = int.from_bytes(signature[32:], "little")

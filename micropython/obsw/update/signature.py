@@ -23,7 +23,9 @@ def _accelerated():
         return None
 
     def verify(public_key, signature, message):
-        ed25519._check(public_key, signature)
+        ed25519.check_lengths(public_key, signature)
+        if not ed25519.canonical_encoding(public_key):
+            return False  # OpenSSL takes these keys; RFC 8032 and obsw.update.ed25519 do not
         try:
             key = Ed25519PublicKey.from_public_bytes(bytes(public_key))
             key.verify(bytes(signature), bytes(message))

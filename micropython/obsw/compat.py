@@ -212,3 +212,25 @@ def gcm_accelerator(key):
     except ImportError:
         return None
     return AESGCM(bytes(key))
+
+
+def ed25519_accelerator():
+    """``cryptography``'s (OpenSSL's) Ed25519 verification as ``f(public_key, signature,
+    message) -> bool``, or None: on MicroPython, under OBSW_PURE, or without the package.
+    ``obsw.update.signature`` wraps it with the checks OpenSSL leaves out."""
+    if pure():
+        return None
+    try:
+        from cryptography.exceptions import InvalidSignature
+        from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PublicKey
+    except ImportError:
+        return None
+
+    def verify(public_key, signature, message):
+        try:
+            Ed25519PublicKey.from_public_bytes(public_key).verify(signature, message)
+        except (InvalidSignature, ValueError):
+            return False
+        return True
+
+    return verify

@@ -417,6 +417,7 @@ def main(argv=None):
     p.add_argument("--json", help="also write the figures to this file")
     p.add_argument("--markdown", help="also write them as a documentation page to this file")
     args = p.parse_args(argv)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # a stopped campaign cleans up
     with tempfile.TemporaryDirectory(prefix="obsw-chaos-") as work:
         r = Campaign(work, args.seed).run(args.minutes)
     ok = print_result(r)

@@ -176,14 +176,19 @@ class Campaign:
         elif kind == "can_cut":
             bus = self.rng.choice((0, 1))
             c.sim.hub.kill(bus)
+            name = "chaos%d" % len(self.faults)  # its own: an earlier one may still be loaded
             try:
-                tx, end = c.switch(self.rng.choice((0x005, 0x003)), name="chaos", timeout=20.0)
+                tx, end = c.switch(self.rng.choice((0x005, 0x003)), name=name, timeout=20.0)
                 fault["switched"] = bool(tx.ok and end == "obcp.finished")
             except Exception as e:  # a timeout: the procedure did not complete
                 fault["switched"] = False
                 fault["error"] = str(e)
             finally:
                 c.sim.hub.revive(bus)
+            try:
+                c.obcp.stop_and_unload(name, timeout=5.0)
+            except Exception:
+                pass  # best effort: the OBC may be restarting
         elif kind == "uart_cut":
             link = self.rng.choice(c.links)
             link.enabled = False

@@ -212,3 +212,26 @@ def gcm_accelerator(key):
     except ImportError:
         return None
     return AESGCM(bytes(key))
+
+
+def ed25519_accelerator():
+    """``cryptography``'s Ed25519 verification as ``verify(public_key, signature, message) ->
+    bool``, or None: on MicroPython, under OBSW_PURE, or without the package.
+    ``obsw.update.ed25519`` stays the definition."""
+    if pure():
+        return None
+    try:
+        from cryptography.exceptions import InvalidSignature
+        from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PublicKey
+    except ImportError:
+        return None
+
+    def verify(public_key, signature, message):
+        try:
+            key = Ed25519PublicKey.from_public_bytes(bytes(public_key))
+            key.verify(bytes(signature), bytes(message))
+        except (InvalidSignature, ValueError):
+            return False
+        return True
+
+    return verify

@@ -13,6 +13,7 @@ from obsw.update.package import (
     HashMismatch,
     WrongMission,
 )
+from obsw.update.signature import verify
 from obsw_host.update import build as b
 from obsw_host.update.slots import FACTORY, Software, UpdateRefused
 
@@ -58,7 +59,7 @@ def software(tmp):
 
 
 def stage(sw, path, public):
-    return sw.stage(path, b.verify, public, MISSION)
+    return sw.stage(path, verify, public, MISSION)
 
 
 def slot_files(sw, slot):

@@ -43,6 +43,14 @@ def add_parser(sub):
     b.add_argument("-o", "--out", required=True, help="the package file to write")
     b.add_argument("--key", required=True, help="the private key (obsw update keygen)")
     b.add_argument("--base", help="an earlier package of the mission: make a delta to it")
+    b.add_argument("--target", choices=("obc", "reconfig"), default="obc",
+                   help="the OBC's software (default), or the reconfiguration module's "
+                   "application (compiled, for obsw board update)")  # fmt: skip
+    b.add_argument("--module", action="append", default=[],
+                   help="reconfig: a changed module of the image, e.g. obsw/reconfig/app.py "
+                   "(repeatable: a module after those it imports)")  # fmt: skip
+    b.add_argument("--march", default="armv7emsp",
+                   help="reconfig: mpy-cross -march (default %(default)s: Pyboard)")  # fmt: skip
     mission_ids.add_arguments(b)
     b.set_defaults(func=build)
     w = s.add_parser("show", help="a package's manifest, its signature checked")
@@ -95,12 +103,16 @@ def keygen(args):
 
 
 def _open(path, key, ids):
-    from obsw.update.package import Reader
+    """The manifest of package ``path``, its signature checked (either target)."""
+    from obsw.update.package import Reader, WrongTarget
+    from obsw.update.signature import verify
 
-    from obsw_host.update.build import verify
-
-    with open(path, "rb") as f:
-        return Reader(f, verify, key, ids.config.name, "obc").manifest
+    try:
+        with open(path, "rb") as f:
+            return Reader(f, verify, key, ids.config.name, "obc").manifest
+    except WrongTarget:
+        with open(path, "rb") as f:
+            return Reader(f, verify, key, ids.config.name, "reconfig").manifest
 
 
 def build(args):
@@ -110,10 +122,34 @@ def build(args):
     key = b.load_private(args.key)
     if public is not None and b.public_hex(key) != public.hex():
         raise UserError("%s is not the key of the mission's update.public_key" % args.key)
+    if args.target == "reconfig":
+        if args.base:
+            raise UserError("--base: the reconfiguration module takes full packages only")
+        return _build_reconfig(args, ids, key)
     base = _open(args.base, public or bytes.fromhex(b.public_hex(key)), ids) if args.base else None
     manifest = b.build(args.out, b.sources(folder), mission=ids.config.name,
                        version=args.version, key=key, base=base)  # fmt: skip
     print("%s: %s, %d bytes" % (args.out, b.describe(manifest), os.path.getsize(args.out)))
+    return 0
+
+
+def _build_reconfig(args, ids, key):
+    import tempfile
+
+    from obsw_host import board
+    from obsw_host.update import build as b
+
+    if not args.module:
+        raise UserError("--target reconfig needs the modules that changed", "--module PATH")
+    with tempfile.TemporaryDirectory(prefix="obsw-update-") as tmp:
+        try:
+            files = board.compile_modules(tmp, args.march, args.module)
+        except board.BoardError as e:
+            raise UserError(str(e)) from None
+        manifest = b.build(args.out, files, mission=ids.config.name, version=args.version,
+                           key=key, target="reconfig")  # fmt: skip
+    print("%s: %s, %d bytes (%s)" % (args.out, b.describe(manifest), os.path.getsize(args.out),
+                                     args.march))  # fmt: skip
     return 0
 
 

@@ -20,6 +20,7 @@ import json
 import os
 
 from obsw.update.package import TARGETS, Reader, canonical, header
+from obsw.update.signature import verify
 
 from obsw_host.errors import UserError
 from obsw_host.frames.keys import inside_git_tree
@@ -93,18 +94,6 @@ def load_public(path):
     return raw
 
 
-def verify(public, signature, message):
-    """Ed25519 through ``cryptography`` (the verifier the OBC passes to ``Reader``)."""
-    from cryptography.exceptions import InvalidSignature
-    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PublicKey
-
-    try:
-        Ed25519PublicKey.from_public_bytes(bytes(public)).verify(bytes(signature), message)
-    except (InvalidSignature, ValueError):
-        return False
-    return True
-
-
 def sources(mission_dir):
     """{package path: file path} of the OBC software: lib/obsw, lib/obsw_host, mission/."""
     import obsw
@@ -112,7 +101,7 @@ def sources(mission_dir):
     import obsw_host
 
     out = {}
-    for prefix, root in (
+    for prefix, root in (  # in the order of the walk: sorted
         ("lib/obsw", os.path.dirname(obsw.__file__)),
         ("lib/obsw_host", os.path.dirname(obsw_host.__file__)),
         ("mission", mission_dir),
@@ -152,13 +141,14 @@ def base_manifest(path, public, mission, target):
 
 
 def build(out, files, *, mission, version, key, target="obc", base=None):
-    """Write the package ``out`` of ``files`` ({package path: file path}), signed with
+    """Write the package ``out`` of ``files`` ({package path: file path}, in the order they
+    are carried), signed with
     ``key`` (an Ed25519 private key); ``base``: the manifest of the package it is a delta
     to. Returns the manifest. The package is written whole or not at all."""
     if target not in TARGETS:
         raise UserError("target %r" % target, "one of %s" % ", ".join(TARGETS))
-    tree = {p: _sha256_file(src) for p, src in sorted(files.items())}
-    carried = sorted(tree)
+    tree = {p: _sha256_file(src) for p, src in files.items()}
+    carried = list(files)  # in the caller's order (the module's load order)
     if base is not None:
         carried = [p for p in carried if base["tree"].get(p) != tree[p]]
     manifest = {

@@ -187,7 +187,9 @@ def software_of(config):
 
 def build(config, update):
     """The ``SoftwareComponent`` of the OBC of ``config``; ``update``: its update section."""
-    from obsw_host.update.build import load_public, verify
+    from obsw.update.signature import verify
+
+    from obsw_host.update.build import load_public
 
     key = update["public_key"]
     if key is not None:

@@ -138,6 +138,10 @@ class ReconfigApp:
         self.last_error = None
         self.log = None  # optional callable(text) for notable events
         self._started = None
+        # called once when the application has run healthy for healthy_after seconds: the
+        # board's boot selector keeps an updated application then (obsw.reconfig.appslot)
+        self.on_healthy = None
+        self.healthy_after = 30.0
         self._alive = 0
         self._other_level = None
         self._other_seen = 0
@@ -229,6 +233,8 @@ class ReconfigApp:
 
     def _error(self, e, now):
         self.counters["loop_errors"] += 1
+        if repr(e) != self.last_error:  # said once while it repeats
+            self._note("loop error: %r" % (e,))
         self.last_error = repr(e)
         self._bad_until = now + 2.0
 
@@ -311,6 +317,10 @@ class ReconfigApp:
             self._other_level = level
             self._other_seen = now_us
         self.watchdog.poll(now_us // 1000, self.healthy(now))
+        if self.on_healthy is not None and now - self._started >= self.healthy_after:
+            if self.healthy(now):  # once, after running healthy that long (appslot.confirm)
+                fn, self.on_healthy = self.on_healthy, None
+                fn()
         return self._idle_ms(now)
 
     @micropython.native

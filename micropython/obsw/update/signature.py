@@ -1,0 +1,16 @@
+"""The Ed25519 verifier of update packages: ``cryptography``'s through ``compat`` where it is
+installed (the OBC, the ground), else the Python one (``obsw.update.ed25519``, the boards).
+Both answer alike (``tests/host/test_update_ed25519_interop.py``)."""
+
+from obsw.compat import ed25519_accelerator
+from obsw.update import ed25519
+
+_fast = ed25519_accelerator()
+
+
+def verify(public_key, signature, message):
+    """True if ``signature`` is ``public_key``'s Ed25519 signature of ``message``; wrong
+    lengths raise ValueError."""
+    if _fast is None or len(public_key) != 32 or len(signature) != 64:
+        return ed25519.verify(public_key, signature, message)
+    return _fast(public_key, signature, message)

@@ -167,6 +167,8 @@ def test_a_good_version_runs_and_a_crashing_one_is_rolled_back(tmp_path, mission
     assert wait_for(lambda: obc.runs("1.1", "a"), 60), obc.text()
     assert wait_for(lambda: obc.record()["active"] == "a", 30), obc.text()
     assert wait_for(lambda: obc.events("Software.confirmed"), 10)
+    hk = obc.ground.housekeeping(5).reply["values"]  # the sample's software structure
+    assert (hk["Software.version"], hk["Software.slot"]) == ("1.1", "a"), hk
     # 1.2 crashes as soon as a process starts
     broken = {"lib/obsw_host/obc/assembly.py": "raise RuntimeError('1.2 is broken')\n"}
     bad = package(tmp_path, folder, key, "1.2", replace=broken)
@@ -237,3 +239,15 @@ def test_a_power_cut_during_the_trial(tmp_path, mission, obc):
     obc.power_cut()
     obc.start()
     assert obc.runs("1.1", "a") and obc.record()["trial"] is None
+
+
+def test_the_functions_events_and_parameters_are_in_yamcs_database(tmp_path):
+    """An operator of Yamcs has the update's commands, events and parameters by name (the
+    generated XTCE of the sample)."""
+    from obsw_host.yamcs import database
+    from obsw_host.yamcs.xtce import generate
+
+    xml = generate(database.load(sample.SDB_PATH))
+    for name in ("stage", "activate", "rollback", "staged", "refused", "rolled_back",
+                 "version", "slot", "pending", "trial_starts"):  # fmt: skip
+        assert 'name="%s' % name in xml, name

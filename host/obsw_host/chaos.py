@@ -220,6 +220,7 @@ class Campaign:
             "fop_vs": fop.vs,
             "station_alive": c._thread.is_alive() if c._thread else None,
             "last": [text for _, text in c.sim.events[-6:]],
+            "loop_errors": sorted({t for _, t in c.sim.events if "loop error" in t})[:4],
         }
 
     def _lossy(self, seconds, loss, dup):

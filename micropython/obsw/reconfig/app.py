@@ -66,6 +66,20 @@ def _sdls_record(security):
     return b"".join(struct.pack(">HI", e[0], e[2]) for e in security.context())
 
 
+def _where(e):
+    """`` at FILE, line N`` of the innermost frame of ``e`` on MicroPython, else ""."""
+    try:
+        import io
+        import sys
+
+        buf = io.StringIO()
+        sys.print_exception(e, buf)
+    except (AttributeError, ImportError):
+        return ""
+    lines = [x.strip() for x in buf.getvalue().splitlines() if x.strip().startswith("File")]
+    return " at " + lines[-1] if lines else ""
+
+
 class ReconfigApp:
     """One controller's application. Times: seconds (float) and the hal's microseconds."""
 
@@ -233,8 +247,8 @@ class ReconfigApp:
 
     def _error(self, e, now):
         self.counters["loop_errors"] += 1
-        if repr(e) != self.last_error:  # said once while it repeats
-            self._note("loop error: %r" % (e,))
+        if repr(e) != self.last_error:  # said once while it repeats, with where it happened
+            self._note("loop error: %r%s" % (e, _where(e)))
         self.last_error = repr(e)
         self._bad_until = now + 2.0
 

@@ -16,6 +16,8 @@
 ``obsw obc serve`` then starts a new platform manager from what ``Software.choose`` says.
 """
 
+import os
+
 from obsw.il.errors import ComponentError, InteractionError
 
 from obsw_host.update.component import SOFTWARE
@@ -40,8 +42,6 @@ class SoftwareWatch:
         self._mtime = self._stamp()
 
     def _stamp(self):
-        import os
-
         try:
             return os.stat(self.software.path).st_mtime_ns
         except OSError:

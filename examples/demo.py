@@ -19,7 +19,7 @@ SECTIONS = (
     ("The whole OBC: the 12-step chain and its faults", "obsw_host.obc.chain", "demo"),
     (
         "In-flight update: a new version confirmed, a broken one rolled back",
-        "obsw_host.update.demo",
+        "obsw_host.update.rig",
         "demo",
     ),
     ("Mission control: Yamcs operates the sample spacecraft", "yamcs_demo", "run"),

@@ -167,7 +167,7 @@ def test_a_good_version_runs_and_a_crashing_one_is_rolled_back(tmp_path, mission
     assert wait_for(lambda: obc.runs("1.1", "a"), 60), obc.text()
     assert wait_for(lambda: obc.record()["active"] == "a", 30), obc.text()
     assert wait_for(lambda: obc.events("Software.confirmed"), 10)
-    hk = obc.ground.housekeeping(5).reply["values"]  # the sample's software structure
+    hk = obc.ground.housekeeping(20).reply["values"]  # the sample's software structure
     assert (hk["Software.version"], hk["Software.slot"]) == ("1.1", "a"), hk
     # 1.2 crashes as soon as a process starts
     broken = {"lib/obsw_host/obc/assembly.py": "raise RuntimeError('1.2 is broken')\n"}

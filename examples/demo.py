@@ -17,6 +17,11 @@ SECTIONS = (
     ("Reconfiguration module: two MicroPython controllers", "obsw_host.reconfig_sim", "demo"),
     ("Firmware: the reconfiguration image on a QEMU Cortex-M board", "obsw_host.board", "demo"),
     ("The whole OBC: the 12-step chain and its faults", "obsw_host.obc.chain", "demo"),
+    (
+        "In-flight update: a new version confirmed, a broken one rolled back",
+        "obsw_host.update.rig",
+        "demo",
+    ),
     ("Mission control: Yamcs operates the sample spacecraft", "yamcs_demo", "run"),
 )
 

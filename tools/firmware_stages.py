@@ -5,7 +5,7 @@ firmware_stages.py upy-frozen   core tests on the unix port with the core frozen
 firmware_stages.py cortex-m     core tests on the QEMU Cortex-M board through mpremote
 firmware_stages.py heap         reconfiguration session and a PLUTO procedure on the QEMU board
                                 with the Pyboard's heap: heap figures
-firmware_stages.py board        obsw board deploy / test against the QEMU board's pty
+firmware_stages.py board        obsw board deploy / test / update against the QEMU board's pty
 """
 
 import os
@@ -257,6 +257,8 @@ def stage_cortex_m():
             print("  %3d  %s" % (n, reason))
         p, f = board_tools(q.pty)
         passed, failed = passed + p, failed + f
+        p, f = board_update(q.pty)
+        passed, failed = passed + p, failed + f
     finally:
         q.close()
     return _close("cortex-m", t0, passed, failed, skipped)
@@ -279,6 +281,135 @@ def board_tools(pty):
     if r.returncode or c[1]:
         print(r.stdout[-2000:] + r.stderr[-1000:])
     return c[0] + deployed, c[1] + (not deployed)
+
+
+# on the board: the boot selector, with an application start that says which application
+# module it got and does not run it (the QEMU board has no reconfiguration hardware)
+_BOOT = (
+    "from obsw.reconfig import appslot\n"
+    "def start():\n"
+    "    import obsw.reconfig.app as a\n"
+    "    print('app', getattr(a, 'UPDATE', 'frozen'))\n"
+    "appslot.boot('', start)\n"
+    "print('record', appslot.running(''))\n"
+)
+# what `obsw board deploy` put on the board's filesystem: an updated board runs frozen modules
+_UNDEPLOY = (
+    "import os\n"
+    "from obsw.reconfig import appslot\n"
+    "for n in os.listdir():\n"
+    "    if n == 'obsw' or n.endswith('.mpy') or n in ('app', 'app.json'):\n"
+    "        appslot.remove_tree(n)\n"
+)
+
+
+def board_update(pty):
+    """The reconfiguration module's application update on the QEMU board, as on a Pyboard:
+    `obsw update build --target reconfig` and `obsw board update` stage a signed package of
+    the changed application module, which the boot selector loads on trial and keeps once
+    confirmed; a package with one changed byte and one signed with another key are refused
+    and change nothing; a module that raises at import gives way to the frozen one; one that
+    never confirms (hung, reset by the watchdog) is left after its starts.
+    Returns (passed, failed)."""
+    import json
+    import tempfile
+
+    obsw = shutil.which("obsw") or str(ROOT / ".venv" / "bin" / "obsw")
+    sys.path[:0] = [str(ROOT / "host"), str(ROOT / "micropython")]
+    from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
+    from obsw_host import board
+    from obsw_host.ids import MissionIds
+    from obsw_host.reconfig import board_file
+    from obsw_host.update import build as b
+
+    checks = []
+
+    def check(what, ok, detail=""):
+        checks.append(ok)
+        print("%s %s%s" % ("ok  " if ok else "FAIL", what, "" if ok else ": " + detail[-800:]))
+
+    def on_board(code):  # a fresh start of the board, then code
+        return firmware.mpremote(pty, "soft-reset", "+", "exec", code, timeout=120)[1]
+
+    t0 = time.monotonic()
+    march = board.board_arch(pty) or "armv7m"
+    with tempfile.TemporaryDirectory(prefix="obsw-board-update-") as tmp:
+        mission = os.path.join(tmp, "sat")
+        shutil.copytree(ROOT / "examples" / "sample", mission)
+        key_file = os.path.join(tmp, "update.key")
+        b.keygen(key_file, allow_git=True)
+        shutil.copy(key_file + ".pub", os.path.join(mission, "update.pub"))
+        path = os.path.join(mission, "mission.json")
+        with open(path) as f:
+            doc = json.load(f)
+        doc["update"] = {"public_key": "update.pub"}
+        with open(path, "w") as f:
+            json.dump(doc, f)
+        ids = MissionIds.locate(mission)
+        on_board(_UNDEPLOY)
+        firmware.mpremote(pty, "cp", board_file(ids, tmp), ":mission.json", "+",
+                          "cp", key_file + ".pub", ":update.pub")  # fmt: skip
+        key = b.load_private(key_file)
+        app_source = (ROOT / "micropython" / "obsw" / "reconfig" / "app.py").read_text()
+
+        def package(version, text=None, signer=key):
+            """The application module of ``version``: the image's with a mark, or ``text``."""
+            src = os.path.join(tmp, "app-%s.py" % version)
+            with open(src, "w") as f:
+                f.write(text or app_source + "\nUPDATE = %r\n" % version)
+            files = board._compile(os.path.join(tmp, version), march, src,
+                                   "obsw/reconfig/app.py", subprocess.call)  # fmt: skip
+            out = os.path.join(tmp, "v%s.obsw" % version)
+            b.build(out, files, mission=ids.config.name, version=version, key=signer,
+                    target="reconfig")  # fmt: skip
+            return out
+
+        def update(path):
+            r = subprocess.run([obsw, "board", "update", path, "--port", pty],
+                               capture_output=True, text=True, timeout=900)  # fmt: skip
+            return r.returncode, (r.stdout + r.stderr).strip()
+
+        good = package("1.1")
+        t = time.monotonic()
+        rc, said = update(good)
+        check("obsw board update stages 1.1 (%d bytes, %.1f s)" % (
+            os.path.getsize(good), time.monotonic() - t),
+            rc == 0 and said.endswith("staged 1.1"), said)  # fmt: skip
+        out = on_board(_BOOT)
+        check("the boot selector loads 1.1's module, on trial",
+              "app 1.1" in out and "record ('1.1', 'trial')" in out, out)  # fmt: skip
+        out = on_board("from obsw.reconfig import appslot; print(appslot.confirm(''))")
+        check("confirmed once healthy", out.strip().endswith("True"), out)
+        spoilt = os.path.join(tmp, "spoilt.obsw")
+        data = bytearray(open(package("1.2"), "rb").read())
+        data[-5] ^= 1
+        with open(spoilt, "wb") as f:
+            f.write(data)
+        forged = package("1.3", signer=Ed25519PrivateKey.generate())
+        for name, path, code in (("one changed byte", spoilt, "hash_mismatch"),
+                                 ("another key", forged, "bad_signature")):  # fmt: skip
+            rc, said = update(path)
+            out = on_board(_BOOT)
+            check("%s: refused (%s), 1.1 keeps running" % (name, code),
+                  rc == 1 and ("refused %s" % code) in said and "app 1.1" in out
+                  and "record ('1.1', 'good')" in out, said + out)  # fmt: skip
+        rc, said = update(package("1.4", text="raise RuntimeError('1.4 is broken')\n"))
+        out = on_board(_BOOT)
+        check("a module that raises at import: the frozen application runs",
+              said.endswith("staged 1.4") and "the frozen one starts" in out
+              and "app frozen" in out and "'failed'" in out, said + out)  # fmt: skip
+        rc, said = update(package("1.5"))
+        outs = [on_board(_BOOT) for _ in range(3)]  # never confirmed: the watchdog resets it
+        check("an application that never confirms is left after 2 starts",
+              "app 1.5" in outs[0] and "app 1.5" in outs[1] and "app frozen" in outs[2]
+              and "did not confirm in 2 starts" in on_board(
+                  "from obsw.reconfig import appslot; print(appslot.read(''))"),
+              "\n".join(outs))  # fmt: skip
+        on_board(_UNDEPLOY)
+    passed = sum(checks)
+    print("board update: %d passed, %d failed (%.1f s)" % (
+        passed, len(checks) - passed, time.monotonic() - t0))  # fmt: skip
+    return passed, len(checks) - passed
 
 
 def _figures(out, prefix):
@@ -341,7 +472,8 @@ def stage_board():
     t0 = time.monotonic()
     with firmware.Qemu(firmware.build_qemu()) as q:
         passed, failed = board_tools(q.pty)
-    return _close("board", t0, passed, failed)
+        p, f = board_update(q.pty)
+    return _close("board", t0, passed + p, failed + f)
 
 
 def main(argv):

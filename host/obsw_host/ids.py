@@ -396,6 +396,8 @@ class MissionIds:
             "essential_map": self.maps["essential"],
             "hptm_vc": self.tm_vcs["essential"],
         }
+        if self.config is not None:  # the name update packages for the module must carry
+            doc["name"] = self.config.name
         recovery = self.config.doc.get("recovery") if self.config else None
         if recovery is not None:  # the autonomous recovery's thresholds, as the mission says
             doc["recovery"] = dict(recovery)

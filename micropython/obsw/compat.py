@@ -215,9 +215,9 @@ def gcm_accelerator(key):
 
 
 def ed25519_accelerator():
-    """``cryptography``'s (OpenSSL's) Ed25519 verification as ``f(public_key, signature,
-    message) -> bool``, or None: on MicroPython, under OBSW_PURE, or without the package.
-    ``obsw.update.signature`` wraps it with the checks OpenSSL leaves out."""
+    """``cryptography``'s Ed25519 verification as ``verify(public_key, signature, message) ->
+    bool``, or None: on MicroPython, under OBSW_PURE, or without the package.
+    ``obsw.update.ed25519`` stays the definition."""
     if pure():
         return None
     try:
@@ -228,7 +228,8 @@ def ed25519_accelerator():
 
     def verify(public_key, signature, message):
         try:
-            Ed25519PublicKey.from_public_bytes(public_key).verify(signature, message)
+            key = Ed25519PublicKey.from_public_bytes(bytes(public_key))
+            key.verify(bytes(signature), bytes(message))
         except (InvalidSignature, ValueError):
             return False
         return True

@@ -102,11 +102,11 @@ class TestRunningValues(unittest.TestCase):
 
     def test_crc16_long_input(self):
         # longer than the bit planes cover at once (4 KiB): taken in chunks
-        data = bytes((i * 31 + 5) & 0xFF for i in range(9001))
+        data = bytes((i * 31 + 5) & 0xFF for i in range(5001))
         want = _bitwise_msb(data, 16, 0x1021, 0xFFFF)
         self.assertEqual(crc.crc16_ccitt_update(data, 0xFFFF), want)
         self.assertEqual(crc.crc16_ccitt(data), want)
-        self.assertEqual(crc.crc16_ccitt(data[5000:], crc.crc16_ccitt(data[:5000])), want)
+        self.assertEqual(crc.crc16_ccitt(data[4200:], crc.crc16_ccitt(data[:4200])), want)
 
 
 class TestCfdpChecksums(unittest.TestCase):

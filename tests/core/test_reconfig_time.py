@@ -26,6 +26,48 @@ def rtc_rig(seconds=0):
     return clock, model, D.DS3231(i2c)
 
 
+def _temp_file(name):
+    import os
+
+    base = (os.getenv("TMPDIR") if hasattr(os, "getenv") else None) or "/tmp"
+    try:
+        os.stat(base)
+    except OSError:
+        base = ""  # a board: its filesystem's top
+    return (base.rstrip("/") + "/" if base else "") + name
+
+
+class TestModelAcrossRestarts(unittest.TestCase):
+    def test_the_clock_runs_on_in_whole_seconds_across_a_restart(self):
+        import os
+
+        path = _temp_file(
+            "obsw-ds3231-model-%d.json" % (os.getpid() if hasattr(os, "getpid") else 0)
+        )
+        clock = Clock()
+        clock.t = 1000.25
+        try:
+            first = DS3231Model(clock, path, seconds=2_000_000_000)
+            first.write(0, first.read(0, 7))  # a set: the model keeps its state in the file
+            clock.t += 7.5  # the controller restarts 7.5 s later, on the same wall clock
+            again = DS3231Model(clock, path)
+            self.assertEqual(again.seconds(), first.seconds())
+            self.assertTrue(isinstance(again.seconds(), int))
+            day, ms = D.DS3231(_one(again)).day_ms()  # readable: whole BCD fields
+            self.assertEqual(day * 86400 + ms // 1000, again.seconds())
+        finally:
+            try:
+                os.remove(path)
+            except OSError:
+                pass
+
+
+def _one(model):
+    i2c = SimI2C()
+    i2c.devices[0x68] = model
+    return i2c
+
+
 class TestBcd(unittest.TestCase):
     def test_every_value_round_trips(self):
         for v in range(100):

@@ -249,7 +249,7 @@ def folder(tmp_path):
 def test_the_sample_passes():
     m, problems = check(locate(sample.MISSION_DIR))
     assert problems == []
-    assert sorted(m.interfaces) == ["CpduN", "CpduR", "OnboardTime", "SolarPanel"]
+    assert sorted(m.interfaces) == ["CpduN", "CpduR", "OnboardTime", "Software", "SolarPanel"]
     assert m.sdb.apid("pus") == 10
 
 

@@ -140,7 +140,7 @@ def test_mission_new_passes_the_check_and_runs(tmp_path):
         assert r.returncode == 0, r.stderr
     finally:
         out = obc.stop()
-    assert "pico-1: processes obc" in out
+    assert "pico-1: version " in out and ", processes obc, " in out
     assert "Traceback" not in out
 
 

@@ -85,7 +85,7 @@ def test_structures_periodic_reports_and_context(system):
     assert ground.disable_hk([9]).ok
     assert ground.delete_hk([9]).ok
     saved = onboard.app.store.load("s03")  # both structure sets and functional reporting
-    assert [s[0] for s in saved["hk"]] == [1, 2, 3, 4]  # the sample's structures, 9 deleted
+    assert [s[0] for s in saved["hk"]] == [1, 2, 3, 4, 20]  # the sample's structures, 9 deleted
     assert saved["diag"] == saved["functional"] == []
 
 

@@ -7,6 +7,7 @@ component's event, and a CFDP upload into the OBC's filestore. Skipped with the 
 Java or the Yamcs jars."""
 
 import hashlib
+import json
 import os
 import shutil
 import signal
@@ -18,6 +19,7 @@ import time
 
 import pytest
 from obsw_host.ids import MissionIds
+from obsw_host.update import build as update_build
 from obsw_host.yamcs import server
 from obsw_host.yamcs.instance import instance_name
 from test_yamcs_e2e import Watch
@@ -105,7 +107,17 @@ class Aurora:
         from yamcs.client import YamcsClient
 
         self.work = work
-        shutil.copytree(os.path.join(ROOT, "examples", "aurora"), os.path.join(work, "aurora"))
+        folder = os.path.join(work, "aurora")
+        shutil.copytree(os.path.join(ROOT, "examples", "aurora"), folder)
+        # the ground's update key, its public half in the mission (test_update_through_yamcs)
+        self.update_key = os.path.join(work, "update.key")
+        update_build.keygen(self.update_key, allow_git=True)
+        shutil.copy(self.update_key + ".pub", os.path.join(folder, "update.pub"))
+        with open(os.path.join(folder, "mission.json")) as f:
+            doc = json.load(f)
+        doc["update"] = {"public_key": "update.pub", "healthy_after": 1.0}
+        with open(os.path.join(folder, "mission.json"), "w") as f:
+            json.dump(doc, f, indent=2)
         self.env = dict(
             os.environ,
             OBSW_PORT_BASE=str(free_base()),
@@ -223,3 +235,35 @@ def test_cfdp_upload_into_the_obcs_filestore(aurora):
     assert tx.state == "COMPLETED", tx.error
     with open(os.path.join(aurora.filestore, name), "rb") as f:
         assert f.read() == data
+
+
+def test_an_update_through_yamcs(aurora):
+    """A package goes up with Yamcs' CFDP service into the OBC's update folder; Yamcs commands
+    from the generated database stage and activate it; the platform manager confirms it."""
+    name = "aurora-1.1.obsw"
+    up = os.path.join(aurora.work, "y", "files", aurora.instance, "up")
+    os.makedirs(up, exist_ok=True)
+    folder = os.path.join(aurora.work, "aurora")
+    update_build.build(os.path.join(up, name), update_build.sources(folder),
+                       mission=aurora.ids.name, version="1.1",
+                       key=update_build.load_private(aurora.update_key))  # fmt: skip
+    aurora.cfdp.upload(aurora.instance + "_up", name, "update/" + name, options={"reliable": True})
+    tx = aurora.transfers.wait(
+        lambda t: t.remote_path.endswith(name) and t.state in ("COMPLETED", "FAILED")
+    )
+    assert tx.state == "COMPLETED", tx.error
+    cmd = aurora.issue("Software/stage", {"file": "update/" + name})
+    assert cmd.is_success(), cmd.error
+    record = os.path.join(aurora.work, "state", aurora.ids.name, "software", "boot.json")
+    with open(record) as f:
+        assert json.load(f)["staged"] == "a"
+    assert aurora.issue("Software/activate").is_success()
+    deadline = time.monotonic() + 90
+    while time.monotonic() < deadline:
+        with open(record) as f:
+            if json.load(f)["active"] == "a":
+                break
+        time.sleep(0.2)
+    with open(record) as f:
+        done = json.load(f)
+    assert done["active"] == "a" and done["log"][-1]["event"] == "confirmed", done

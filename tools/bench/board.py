@@ -86,6 +86,7 @@ CASES = (
     ("pus_tc_decode", "PUS TC decode (TC[17,1])", 8),
     ("pus_tm_encode", "PUS TM encode (TM[3,25], 16 bytes)", 8),
     ("pluto_statement", "PLUTO statement (`i := i + 1;` in a while loop)", 8),
+    ("update_verify", "update package: its manifest's Ed25519 signature (collections in)", 1),
 )
 # the bench's own rig (a SpaceCAN controller playing the OBC, the modelled EEPROMs and DS3231)
 # shares the board's heap with the application: it gets this much on top of the Pyboard's

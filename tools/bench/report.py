@@ -48,6 +48,7 @@ RUNS = {
     "supervision": ("supervision.py", {}, "OBC recovery of a killed and a hung unit"),
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
     "recovery": ("recovery.py", {}, "Autonomous recovery of a hung OBC"),
+    "update": ("update.py", {}, "In-flight update of the OBC"),
 }
 # benchmarks whose figures do not depend on the host's load (instructions counted under QEMU)
 EXACT = ("board",)

@@ -36,6 +36,7 @@ def add_parser(sub):
         ("flash", _flash, "bootloader via mpremote, then DFU"),
         ("repl", _repl, "open the board's REPL"),
         ("test", _test, "run board test files on the board"),
+        ("update", _update, "stage a signed package of the application (obsw update build)"),
     ):
         q = s.add_parser(name, help=text)
         q.add_argument(
@@ -55,6 +56,8 @@ def add_parser(sub):
                 action="store_true",
                 help="no keys: let the board take essential TCs unauthenticated (logged)",
             )
+        if name == "update":
+            q.add_argument("package", help="from obsw update build --target reconfig")
         if name == "test":
             q.add_argument(
                 "files", nargs="*", help="test files (default: the reconfiguration core tests)"
@@ -142,6 +145,11 @@ def _deploy(args):
         print("%d modules deployed" % len(names))
         if ids is not None:
             print("mission.json of %s installed on the board" % ids.name)
+            if board._update_key(ids) is not None:
+                print("update.pub installed: the board takes packages signed for %s" % ids.name)
+            else:
+                print("update.pub NOT installed (the mission names no update.public_key): "
+                      "the board refuses every update package")  # fmt: skip
         else:
             print(
                 "mission.json NOT installed (no mission: --mission DIR, ./mission.json or "
@@ -181,6 +189,17 @@ def _repl(args):
     from obsw_host import board
 
     return _guard(lambda: board.repl(args.port))
+
+
+def _update(args):
+    from obsw_host import board
+
+    def go():
+        line = board.update(args.package, args.port)
+        print(line)
+        return 0 if line.startswith("staged") else 1
+
+    return _guard(go)
 
 
 def _test(args):

@@ -122,22 +122,64 @@ def serve(args):
         topology.check()  # component modules import, before anything starts
     except (ConfigError, UserError) as e:
         return _refuse(e)
-    from obsw_host.obc.platform import PlatformManager
-
     try:
         lock = StateLock(config.state).acquire()
     except StateLocked as e:
         return _refuse(e)
     try:
-        out("%s: processes %s, state in %s (Ctrl-C stops)" % (
-            config.name, ", ".join(config.processes), config.state))  # fmt: skip
-        if not PlatformManager(topology, out=out).serve():
-            return _refuse("every process stopped: the OBC cannot run this mission")
+        return _boot(args, config, topology, out)
     except KeyboardInterrupt:
-        pass
+        return 0
     finally:
         lock.release()
+
+
+def _boot(args, config, topology, out):
+    """The boot selector: run the platform manager on the software the boot record names
+    (``obsw_host.update.slots``), and again after every update step that changes it."""
+    from obsw_host.obc.platform import PlatformManager, stop_on_signals
+    from obsw_host.update.component import software_of
+    from obsw_host.update.slots import FACTORY
+
+    done = stop_on_signals()  # between two runs too
+    software = software_of(config)
+    max_starts = int(topology.section("update")["max_starts"])
+    while not done.is_set():
+        slot, trial = software.choose(max_starts)
+        code, mission = software.code(slot)
+        run = topology
+        if mission is not None:
+            try:
+                run = _slot_topology(config, mission)
+            except (ConfigError, UserError) as e:
+                software.fall_back("its mission is refused: %s" % e)
+                continue
+        out("%s: version %s (slot %s%s), processes %s, state in %s (Ctrl-C stops)" % (
+            run.config.name, software.version(slot), slot, ", on trial" if trial else "",
+            ", ".join(run.config.processes), config.state))  # fmt: skip
+        outcome = PlatformManager(run, out=out, software=software, slot=slot, code=code,
+                                  trial=trial).serve(done)  # fmt: skip
+        if outcome is True:
+            return 0
+        if outcome is False:
+            if slot == FACTORY:
+                return _refuse("every process stopped: the OBC cannot run this mission")
+            software.fall_back("every process of version %s stopped" % software.version(slot))
     return 0
+
+
+def _slot_topology(config, mission):
+    """The topology of a slot's mission folder, in the OBC's own state folder."""
+    problems = check_mission(mission)
+    if problems:
+        raise UserError(problems[0])
+    slot = load_config(mission)
+    slot.state, slot.il_directory = config.state, config.il_directory
+    if slot.runs("frames"):
+        from obsw_host.frames import policy
+
+        policy.check(slot)
+    return Topology(slot).check()
 
 
 def _serve_process(topology, args, out):

@@ -24,6 +24,7 @@ from obsw_host.obc.config import ConfigError, MissionConfig
 from obsw_host.obc.onboard_time import ONBOARD_TIME
 from obsw_host.obc.plugins import Component, PluginError
 from obsw_host.obc.registry import KINDS, WITH_PUS
+from obsw_host.update.component import SOFTWARE
 
 _INT_BOUNDS = {
     "uint8": (0, 0xFF),
@@ -82,7 +83,7 @@ class _Checker:
         self.folder = os.path.dirname(os.path.abspath(mission_file))
         self.problems = []
         # component name -> Interface (the OBC's built-in ones, plug-ins and nodes)
-        self.interfaces = {ONBOARD_TIME.name: ONBOARD_TIME}
+        self.interfaces = {ONBOARD_TIME.name: ONBOARD_TIME, SOFTWARE.name: SOFTWARE}
         self.unresolved = set()  # components whose module is at fault (said once, there)
         self.where = {}  # kind or component -> the process that runs it
         self.nodes = {}  # SpaceCAN node name -> node id, of the definitions that load

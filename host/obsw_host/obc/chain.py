@@ -45,9 +45,11 @@ def _station_class():
     from obsw_host.frames.station import GroundStation
 
     class OperatorStation(GroundStation):
-        """A ground station whose operator, when FOP-1 has given up (a restarted frame
-        processor's FARM-1 starts again at V(R) = 0), initiates the AD service with Set V(R),
-        so frame numbering restarts on both sides."""
+        """A ground station whose operator, when FOP-1 has given up, initiates the AD service
+        again: with Unlock when the last CLCW says FARM-1 is in lockout (frames lost or
+        duplicated beyond its window: FARM-1 ignores Set V(R) then), else with Set V(R) (a
+        restarted frame processor's FARM-1 starts again at V(R) = 0), so frame numbering
+        restarts on both sides."""
 
         started = False
 
@@ -57,7 +59,11 @@ def _station_class():
             select.select([self.sock] + self.ground.links, [], [], timeout)
             fop = self.ground.fop
             if self.started and fop.state == F.INITIAL:
-                self.ground.initiate(self.now(), F.INITIATE_AD_WITH_SET_VR, fop.vs)
+                clcw = self.ground.demux.clcw
+                if clcw is not None and clcw.lockout:
+                    self.ground.initiate(self.now(), F.INITIATE_AD_WITH_UNLOCK)
+                else:
+                    self.ground.initiate(self.now(), F.INITIATE_AD_WITH_SET_VR, fop.vs)
                 self._initiated = True
             self.started = True
             super().step(0)

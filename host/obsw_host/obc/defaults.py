@@ -54,6 +54,14 @@ PLATFORM = {
     "module_uarts": None,  # the serial devices to its two controllers; None: no link
     "context_period": 1.0,  # seconds between context saves
 }
+# in-flight software updates (obsw_host.update): signed packages, two slots, a trial and rollback
+UPDATE = {
+    "public_key": None,  # the ground's Ed25519 public key file (hex); None: updates refused
+    "deadline": 60.0,  # seconds a version on trial has to report healthy, else rolled back
+    "healthy_after": 3.0,  # seconds every process must answer heartbeats before the self-test
+    "max_starts": 3,  # starts of a version on trial (power cycles) before the boot falls back
+    "self_test": None,  # the mission's own test of a new version: "module:function"
+}
 # the reconfiguration module's autonomous recovery of the OBC (delivered to the boards in their
 # mission.json, obsw.reconfig.mission); the module's own fallback is the same table, in the core
 RECOVERY = dict(_recovery.DEFAULTS, lines=list(_recovery.DEFAULTS["lines"]))
@@ -65,6 +73,7 @@ SECTIONS = {
     "frames": FRAMES,
     "platform": PLATFORM,
     "recovery": RECOVERY,
+    "update": UPDATE,
 }
 
 

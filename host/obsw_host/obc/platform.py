@@ -13,6 +13,10 @@ configuration, a component module that does not import): one that refuses its co
 (exit status 2) is stopped at once, one that dies ``crash_loop`` times in a row before its
 first heartbeat is stopped then; either way one line says so and ``platform.stopped`` is
 raised, and nothing is power-cycled. When every process is stopped, ``serve`` returns.
+The processes run the software of the boot record's slot (``obsw_host.update``): with
+``software``, the manager starts them from ``code`` (their ``sys.path``'s first folder) and
+``obsw_host.update.trial.SoftwareWatch`` judges a version on trial and ends the run when the
+boot record names another slot.
 Failures of processes that ran healthy count towards the power cycle: after
 ``max_failures`` of them within ``window`` seconds the manager asks the reconfiguration
 module to power-cycle the OBC: ``power_cycle(line, off_ms)`` of the CPDU node's equipment
@@ -36,6 +40,18 @@ from obsw_host.obc.topology import PLATFORM, Topology
 
 EXIT_REFUSED = 2  # a process's exit status when it refuses its configuration
 _STARTING_BEAT = 0.05  # seconds between heartbeats until a process's first answer
+
+
+def stop_on_signals():
+    """An Event that SIGTERM and SIGINT set from now on."""
+    done = threading.Event()
+
+    def stop(signum, frame):
+        done.set()
+
+    signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGINT, stop)
+    return done
 
 
 class Child:
@@ -62,7 +78,17 @@ class PlatformManager:
     """Supervises the processes of ``config`` (see the module text)."""
 
     def __init__(
-        self, config, *, out=print, python=sys.executable, clock=time.monotonic, notifier=None
+        self,
+        config,
+        *,
+        out=print,
+        python=sys.executable,
+        clock=time.monotonic,
+        notifier=None,
+        software=None,
+        slot="factory",
+        code=None,
+        trial=False,
     ):
         topology = config if isinstance(config, Topology) else Topology(config)
         config = topology.config
@@ -91,6 +117,12 @@ class PlatformManager:
         self._thread = None
         self.supervision = Supervision(self, notifier)  # watchdog and systemd
         self._next_status = 0.0
+        self.code = code  # the slot's lib folder, first on the processes' sys.path
+        self.software = None
+        if software is not None:
+            from obsw_host.update.trial import SoftwareWatch
+
+            self.software = SoftwareWatch(self, software, slot, trial)
 
     def _say(self, text):
         self.log.append((self.clock(), text))
@@ -102,7 +134,13 @@ class PlatformManager:
         cmd = [self.python, "-m", "obsw_host.obc", self.config.path, "--process", child.name]
         cmd += ["--state", self.config.state, "--il-dir", self.config.il_directory]
         cmd += ["--parent", str(os.getpid())]
-        child.popen = subprocess.Popen(cmd)
+        env = None
+        if self.code is not None:
+            path = os.environ.get("PYTHONPATH")
+            env = dict(
+                os.environ, PYTHONPATH=os.pathsep.join([self.code] + ([path] if path else []))
+            )
+        child.popen = subprocess.Popen(cmd, env=env)
         child.started = self.clock()
         child.last_beat = None
         child.next_beat = child.started
@@ -223,6 +261,8 @@ class PlatformManager:
         self._flush_events()
         now = self.clock()
         self.supervision.step(now)
+        if self.software is not None:
+            self.software.step(now)
         if now >= self._next_status:
             self._next_status = now + float(self.settings["health_period"])
             self._send_status()
@@ -280,20 +320,19 @@ class PlatformManager:
                     p.wait(5.0)
         self.transport.close()
 
-    def serve(self):
-        """Run until SIGTERM or SIGINT, or until every process is stopped; True if so."""
-        done = threading.Event()
-
-        def stop(signum, frame):
-            done.set()
-
-        signal.signal(signal.SIGTERM, stop)
-        signal.signal(signal.SIGINT, stop)
+    def serve(self, done=None):
+        """Run until SIGTERM or SIGINT (True), until every process is stopped (False), or
+        until the software watch ends the run (its outcome: ``restart``, ``rolled back: ..``).
+        ``done``: an Event the caller's signal handlers set (``stop_on_signals``)."""
+        done = done or stop_on_signals()
+        watch = self.software
         self.start()
         try:
             while not done.wait(0.1):
-                if self.finished.is_set():
-                    return False
+                if self.finished.is_set() or (watch is not None and watch.outcome):
+                    break
+            else:
+                return True
         finally:
-            self.stop()
-        return True
+            self.stop()  # the round in progress ends first: a trial's verdict is in
+        return (watch.outcome if watch is not None else None) or False

@@ -30,6 +30,8 @@ from obsw_host.obc.module_link import ModuleLink
 from obsw_host.obc.onboard_time import ONBOARD_TIME, OnboardTime
 from obsw_host.obc.topology import OBC_HEALTH, PLATFORM, PLATFORM_EVENTS
 from obsw_host.pus.onboard import Onboard, tai_now
+from obsw_host.update.component import SOFTWARE
+from obsw_host.update.component import build as software_component
 
 
 class PlatformEvents:
@@ -110,6 +112,8 @@ class PusUnit:
         self.components.append((OBC_HEALTH, self.health))
         self.onboard_time = OnboardTime(os.path.join(config.state, "onboard_time.json"), tai_now)
         self.components.append((ONBOARD_TIME, self.onboard_time))
+        self.software = software_component(config, topology.section("update"))
+        self.components.append((SOFTWARE, self.software))
         self.interfaces = topology.interfaces()
         self.ids = ids = topology.ids
         playback_to = None
@@ -152,6 +156,7 @@ class PusUnit:
         self.app = self.onboard.app
         self.obcp = self.app.services.get(18)
         self.node.provide(PLATFORM, PlatformEvents(self.app, sdb, self.health))
+        self.software.refresh()  # update steps taken while this process was down: events
         self.module = None
         platform = topology.section("platform")
         if platform.get("module_uarts"):  # the UART link to the reconfiguration module

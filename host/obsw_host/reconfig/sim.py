@@ -10,6 +10,7 @@ controllers recover the OBC by themselves (`obsw.reconfig.recovery`); the sample
 to them over the OBC UARTs too (heartbeats, context, DS3231 time).
 """
 
+import collections
 import os
 import platform
 import shutil
@@ -38,6 +39,10 @@ from obsw_host.reconfig import simhal as W
 from obsw_host.reconfig.canhub import CanHub
 
 ROLES = ("nominal", "redundant")
+# a controller reset more often than this within a minute is in a crash loop: the supervisor
+# leaves it off (its peer carries on), as a board's reset supervisor that gives up would
+CRASH_LOOP = 20
+BOOT_LIMIT = 30.0  # seconds from a controller's power on to its first watchdog kick
 
 
 def micropython_binary():
@@ -140,15 +145,26 @@ def _power_on(cmd, env, fds=()):
     """A simulated controller's or OBC's process, its output read by the simulation, with the
     signal dispositions of a machine that powers on: SIGINT not ignored, whatever the shell
     that ran the simulation left (a background job inherits SIGINT ignored, and the OBC's
-    recovery then stalled)."""
+    recovery then stalled); and its power goes with the simulation's: killed when the thread
+    that started it ends, however the simulation ends (no orphan keeps running)."""
     return subprocess.Popen(
         cmd,
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         pass_fds=fds,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        preexec_fn=_powered_by_parent,
     )
+
+
+def _powered_by_parent():
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    try:  # Linux: SIGKILL when the parent's thread that started it ends
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
 
 
 class _Proc:
@@ -250,6 +266,7 @@ class ReconfigSim:
         self.obc = None
         self.obc_boots = 0
         self.resets = [[], []]  # reasons per controller
+        self._reset_times = [[], []]  # when, for the crash-loop rule
         self.hub = None
         self.com = []  # controller-end fds of the COM ptys (the COM module's side)
         self.obc_uart = []
@@ -259,7 +276,10 @@ class ReconfigSim:
         self._tty = []
         self._decoders = [CaduDecoder(64), CaduDecoder(64)]
         self._demux = [TmDemultiplexer(scid), TmDemultiplexer(scid)]
-        self.reports = [[], []]
+        # HPTM decoded from each controller's COM UART, the newest kept (the supervisor reads
+        # the UARTs all along, as a COM module takes whatever comes: a controller never blocks)
+        self.reports = [collections.deque((), 2000), collections.deque((), 2000)]
+        self._com_lock = threading.Lock()
         self._seq = 0
         self._lock = threading.Lock()
         self._stop = threading.Event()
@@ -269,6 +289,7 @@ class ReconfigSim:
         self._kicks = [0, 0]
         self._req_since = [None, None]
         self._restart_at = [None, None]
+        self._spawned_at = [0.0, 0.0]
         self._powered = {}
 
     # -- log ----------------------------------------------------------------------------------
@@ -394,8 +415,11 @@ class ReconfigSim:
             self.key_file,
         ]
         self.ctrl[role] = _Proc(ROLES[role], _power_on(cmd, env), self)
-        self._wdog[role] = Tps3813Model(self.wd[0], self.wd[1], time.monotonic() * 1000)
-        self._kicks[role] = None
+        # the watchdog starts with the controller's first kick: a simulated controller's
+        # "reset release" is its interpreter up, which takes a loaded machine seconds
+        self._wdog[role] = None
+        self._kicks[role] = self.wire()[16 * role + W.W_KICKS]
+        self._spawned_at[role] = time.monotonic()
         self._req_since[role] = None
 
     def _spawn_obc(self, which):
@@ -433,8 +457,12 @@ class ReconfigSim:
 
     def _reset(self, role, cause, why):
         self.resets[role].append(RESET_NAMES[cause])
-        if len(self.resets[role]) > 20:
-            self.log("supervisor: %s controller keeps failing; left off" % ROLES[role])
+        now = time.monotonic()
+        recent = self._reset_times[role] = [t for t in self._reset_times[role] if now - t < 60]
+        recent.append(now)
+        if len(recent) > CRASH_LOOP:  # resets spread over a long run are faults recovered from
+            self.log("supervisor: %s controller reset %d times within 60 s; left off" % (
+                ROLES[role], len(recent)))  # fmt: skip
             self.ctrl[role].kill()
             self._restart_at[role] = (float("inf"), cause)
             return
@@ -446,6 +474,7 @@ class ReconfigSim:
         self._restart_at[role] = (time.monotonic() + self.reset_s, cause)
 
     def _supervise(self):
+        next_com = 0.0
         while not self._stop.is_set():
             now = time.monotonic()
             w = self.wire()
@@ -472,12 +501,17 @@ class ReconfigSim:
                 dog = self._wdog[role]
                 k = w[base + W.W_KICKS]
                 why = None
-                if self._kicks[role] is None:
-                    self._kicks[role] = k
-                elif k != self._kicks[role]:
-                    self._kicks[role] = k
-                    why = dog.kick(now * 1000)
-                why = why or dog.poll(now * 1000)
+                if dog is None:
+                    if k != self._kicks[role]:
+                        self._kicks[role] = k
+                        self._wdog[role] = Tps3813Model(self.wd[0], self.wd[1], now * 1000)
+                    elif now - self._spawned_at[role] > BOOT_LIMIT:
+                        why = "never came (%g s since power on)" % BOOT_LIMIT
+                else:
+                    if k != self._kicks[role]:
+                        self._kicks[role] = k
+                        why = dog.kick(now * 1000)
+                    why = why or dog.poll(now * 1000)
                 if why is not None:
                     self._reset(role, RESET_WATCHDOG, "watchdog: kick %s" % why)
             q = self.lines()
@@ -496,6 +530,9 @@ class ReconfigSim:
                     if p is not None:
                         p.kill()
             self._carry()
+            if now >= next_com:
+                next_com = now + 0.05
+                self.poll_tm()
             time.sleep(0.005)
 
     # -- faults -------------------------------------------------------------------------------
@@ -531,16 +568,17 @@ class ReconfigSim:
             os.write(fd, data)
 
     def poll_tm(self):
-        """Read HPTM from both COM UARTs into ``reports`` (lists of Report per controller)."""
-        for role, fd in enumerate(self.com):
-            try:
-                data = os.read(fd, 65536)
-            except (BlockingIOError, OSError):
-                continue
-            for f in self._decoders[role].feed(data):
+        """Read HPTM from both COM UARTs into ``reports`` (Reports per controller)."""
+        with self._com_lock:
+            for role, fd in enumerate(self.com):
                 try:
-                    for p in self._demux[role].feed(f):
-                        self.reports[role].append(Report.unpack(p[6:]))
-                except (FrameError, ValueError):
-                    pass
+                    data = os.read(fd, 65536)
+                except (BlockingIOError, OSError):
+                    continue
+                for f in self._decoders[role].feed(data):
+                    try:
+                        for p in self._demux[role].feed(f):
+                            self.reports[role].append(Report.unpack(p[6:]))
+                    except (FrameError, ValueError):
+                        pass
         return self.reports

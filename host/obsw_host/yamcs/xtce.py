@@ -72,6 +72,9 @@ class SpaceSystem:
 
     def parameter(self, name, ptype, description=None):
         """Add a parameter of type element ``ptype``; returns its absolute reference."""
+        if any(p.get("name") == name for p in self.params):
+            raise ValueError("%s: two parameters named %s (an attribute, and an event's field "
+                             "or a generated one): rename one" % (self.path, name))  # fmt: skip
         ptype.set("name", name + "_t")
         self.ptypes.append(ptype)
         p = ET.Element("Parameter", name=name, parameterTypeRef=name + "_t")

@@ -6,12 +6,14 @@ metadata(
 require("obsw-base", library="obsw")
 require("obsw-frames", library="obsw")
 require("obsw-spacecan-node", library="obsw")
+require("obsw-update", library="obsw")
 
 package(
     "obsw/reconfig",
     files=[
         "__init__.py",
         "app.py",
+        "appslot.py",
         "cpdu.py",
         "ds3231.py",
         "ecc.py",

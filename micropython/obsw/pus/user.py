@@ -184,14 +184,19 @@ class UserProcess:
         return tx
 
     def _answered(self, tm, decoded):
+        """The open request a response TM answers (a response carries no request ID): the
+        oldest one of its type that the process accepted, else the oldest of its type (a
+        request whose TC was lost, e.g. to a restart, never takes another's response)."""
         key = (tm.service, tm.subtype)
-        for tx in self.open:
-            if tx.expect == key and tx.tc.apid == tm.apid:
-                tx.replies.append(decoded)
-                if not tx.tc.ack & ACK_COMPLETION:
-                    self._close(tx)
-                return tx
-        return None
+        waiting = [tx for tx in self.open if tx.expect == key and tx.tc.apid == tm.apid]
+        if not waiting:
+            return None
+        accepted = [tx for tx in waiting if tx.accepted]
+        tx = accepted[0] if accepted else waiting[0]
+        tx.replies.append(decoded)
+        if not tx.tc.ack & ACK_COMPLETION:
+            self._close(tx)
+        return tx
 
     def _close(self, tx):
         tx.done = True

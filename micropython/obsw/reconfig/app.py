@@ -66,6 +66,20 @@ def _sdls_record(security):
     return b"".join(struct.pack(">HI", e[0], e[2]) for e in security.context())
 
 
+def _where(e):
+    """`` at FILE, line N`` of the innermost frame of ``e`` on MicroPython, else ""."""
+    try:
+        import io
+        import sys
+
+        buf = io.StringIO()
+        sys.print_exception(e, buf)
+    except (AttributeError, ImportError):
+        return ""
+    lines = [x.strip() for x in buf.getvalue().splitlines() if x.strip().startswith("File")]
+    return " at " + lines[-1] if lines else ""
+
+
 class ReconfigApp:
     """One controller's application. Times: seconds (float) and the hal's microseconds."""
 
@@ -138,6 +152,10 @@ class ReconfigApp:
         self.last_error = None
         self.log = None  # optional callable(text) for notable events
         self._started = None
+        # called once when the application has run healthy for healthy_after seconds: the
+        # board's boot selector keeps an updated application then (obsw.reconfig.appslot)
+        self.on_healthy = None
+        self.healthy_after = 30.0
         self._alive = 0
         self._other_level = None
         self._other_seen = 0
@@ -229,6 +247,8 @@ class ReconfigApp:
 
     def _error(self, e, now):
         self.counters["loop_errors"] += 1
+        if repr(e) != self.last_error:  # said once while it repeats, with where it happened
+            self._note("loop error: %r%s" % (e, _where(e)))
         self.last_error = repr(e)
         self._bad_until = now + 2.0
 
@@ -311,6 +331,10 @@ class ReconfigApp:
             self._other_level = level
             self._other_seen = now_us
         self.watchdog.poll(now_us // 1000, self.healthy(now))
+        if self.on_healthy is not None and now - self._started >= self.healthy_after:
+            if self.healthy(now):  # once, after running healthy that long (appslot.confirm)
+                fn, self.on_healthy = self.on_healthy, None
+                fn()
         return self._idle_ms(now)
 
     @micropython.native

@@ -7,7 +7,8 @@ to each board's flash beside ``tc.keys``; ``load`` turns it into ``ReconfigApp``
 
 ``nodes`` are the SpaceCAN node ids of the nominal and the redundant controller; an optional
 ``recovery`` object holds the autonomous recovery's thresholds (``obsw.reconfig.recovery``:
-the keys of its ``DEFAULTS``, each optional). A board
+the keys of its ``DEFAULTS``, each optional), and ``name`` the mission's name, which the
+packages that update the module's application must carry (``obsw.reconfig.appslot``). A board
 without the file runs with the application's built-in ids and says so once (``load`` returns
 None); a file that is there but wrong raises ``MissionFileError`` naming the key.
 """
@@ -18,7 +19,7 @@ from obsw.reconfig.recovery import DEFAULTS as RECOVERY_DEFAULTS
 
 FILE = "mission.json"
 KEYS = ("scid", "nodes", "essential_map", "hptm_vc")
-OPTIONAL = ("recovery",)
+OPTIONAL = ("recovery", "name")  # name: the mission's, which update packages must name
 
 
 class MissionFileError(ValueError):
@@ -67,6 +68,8 @@ def parse(doc):
     }
     if "recovery" in doc:
         out["recovery"] = _recovery(doc["recovery"])
+    if not isinstance(doc.get("name", ""), str):
+        raise MissionFileError("name", "expected the mission's name")
     return out
 
 

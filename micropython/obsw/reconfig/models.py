@@ -191,8 +191,10 @@ class DS3231Model:
             try:
                 with open(path) as f:
                     d = json.load(f)
-                self._base = d["base"] + (clock() - d["at"] if d["running"] else 0)
-                self._at = clock()
+                # the clock is the host's wall clock: the time runs on across a restart of
+                # the controller as a DS3231 on its battery does (whole seconds, as it counts)
+                self._base = int(d["base"])
+                self._at = float(d["at"]) if d["running"] else clock()
                 self.regs[0x07:0x13] = bytes(d["regs"])
                 self.running = d["running"]
             except (OSError, ValueError, KeyError):

@@ -1,0 +1,1 @@
+"""Software update packages, read and checked on the OBC and on the reconfiguration module."""

@@ -14,7 +14,7 @@ non-adjacent form over one shared chain of doublings, and one inversion at the e
 """
 
 from obsw.compat import const, micropython
-from obsw.update.sha512 import digest
+from obsw.update.sha512 import sha512
 
 _P = const(2**255 - 19)
 _L = const(2**252 + 27742317777372353535851937790883648493)
@@ -24,8 +24,6 @@ _SQRT_M1 = const(196811613767075059568070793049885420154460665159238901627440210
 _BX = const(15112221349535400772501151409588531511454012693041857206046113283949847762202)
 _BY = const(46316835694926478169428394003475163141307993866256225615783033603165251855960)
 _W = const(5)  # the NAF width: 8 odd multiples of each base, one addition every 6 doublings
-
-_sha512 = digest()
 
 
 @micropython.native
@@ -150,7 +148,7 @@ def verify(public_key, signature, message):
     a = _decode(public_key)
     if a is None:
         return False
-    k = int.from_bytes(_sha512(signature[:32] + public_key + bytes(message)), "little") % _L
+    k = int.from_bytes(sha512(signature[:32] + public_key + bytes(message)), "little") % _L
     ax = _P - a[0]  # -A: k is added with A negated
     a_table = _odd_multiples(ax, a[1], 1, ax * a[1] % _P)
     b_table = _odd_multiples(_BX, _BY, 1, _BX * _BY % _P)

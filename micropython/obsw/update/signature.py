@@ -1,27 +1,21 @@
-"""Ed25519 verification with the fastest implementation at hand.
-
-    from obsw.update.signature import verify
-    verify(public_key, signature, message)   # True or False
-
-``cryptography``'s (OpenSSL's C, ``obsw.compat.ed25519_accelerator``) where it is importable and
-the core may use accelerators; the pure-Python ``obsw.update.ed25519`` everywhere else (the
-boards). Both refuse the same signatures: S not below L, a public key or an R that is no
-canonical encoding of a curve point.
-"""
+"""The Ed25519 verifier of update packages: ``cryptography``'s through ``compat`` where it is
+installed (the OBC, the ground), else the Python one (``obsw.update.ed25519``, the boards).
+Both answer alike (``tests/host/test_update_ed25519_interop.py``): OpenSSL takes a public key
+that is a non-canonical encoding, which RFC 8032 and the Python verifier refuse, so such a key
+is refused here before OpenSSL sees it."""
 
 from obsw.compat import ed25519_accelerator
 from obsw.update import ed25519
 
-
-def _strict(accelerated):
-    def verify(public_key, signature, message):
-        ed25519.check_lengths(public_key, signature)
-        if not ed25519.canonical_encoding(public_key):
-            return False  # OpenSSL takes these keys; RFC 8032 and obsw.update.ed25519 do not
-        return accelerated(bytes(public_key), bytes(signature), bytes(message))
-
-    return verify
+_fast = ed25519_accelerator()
 
 
-_accelerated = ed25519_accelerator()
-verify = _strict(_accelerated) if _accelerated else ed25519.verify
+def verify(public_key, signature, message):
+    """True if ``signature`` is ``public_key``'s Ed25519 signature of ``message``; wrong
+    lengths raise ValueError."""
+    if _fast is None:
+        return ed25519.verify(public_key, signature, message)
+    ed25519.check_lengths(public_key, signature)
+    if not ed25519.canonical_encoding(public_key):
+        return False
+    return _fast(public_key, signature, message)

@@ -1,0 +1,1 @@
+"""Signed software updates (``obsw.update.package``): packages, the OBC's software slots."""

@@ -49,6 +49,7 @@ RUNS = {
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
     "recovery": ("recovery.py", {}, "Autonomous recovery of a hung OBC"),
     "update": ("update.py", {}, "In-flight update of the OBC"),
+    "ed25519": ("ed25519.py", {}, "Ed25519 verify of an update's signature"),
 }
 # benchmarks whose figures do not depend on the host's load (instructions counted under QEMU)
 EXACT = ("board",)

@@ -42,6 +42,7 @@ RECOVERY = {"deadline": 4.0, "boot_grace": 20.0, "off_ms": 300, "max_failures": 
 MEMORY_GROWTH = 1.25  # the spacecraft's RSS at the end may exceed the start's by a quarter
 MEMORY_SLACK_KB = 1024  # and a megabyte (a unit restarting at the very end)
 WAIT = 60.0  # s any fault may take to be recovered from before it counts as not recovered
+PING_WAIT = 0.5  # s a recovery ping waits for its completion
 HK_SID = 1  # the sample's periodic housekeeping: every 10 cycles of 0.1 s
 HK_PERIOD = 1.0
 HK_MISSING = 2.5  # a silence this many periods long means reports are missing
@@ -113,10 +114,12 @@ class Campaign:
         self._seen = len(g.received)
 
     def serving(self, timeout=WAIT):
-        """Ping until one completes; the seconds it took, or None."""
+        """Ping until one completes; the seconds it took, or None. Each ping waits
+        ``PING_WAIT`` for its completion: a ping lost to the fault costs no more than that
+        (the resolution of the recovery times)."""
         t0 = time.monotonic()
         while time.monotonic() - t0 < timeout:
-            if self.ping():
+            if self.ping(PING_WAIT):
                 return time.monotonic() - t0
         return None
 

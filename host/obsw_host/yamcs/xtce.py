@@ -880,8 +880,9 @@ class Generator:
 
     # ------------------------------------------------------------------ services 2, 3, 9, 14
     def services_2_3_9_14(self):
-        """Reports and commands of device access, diagnostics, functional reporting, time and
-        diagnostic forwarding: one item per command (N = 1), the first item of a report."""
+        """Commands of device access, diagnostics, functional reporting, time and diagnostic
+        forwarding, one item per command (N = 1); the time reports (their other reports come
+        from their layouts: ``reports``)."""
         r = self.root
         exponent = self.header_param("time_rate_exponent", 8)
         status = self.header_param("time_reference_status", 8)

@@ -241,13 +241,15 @@ def test_parameter_set_completes_and_reaches_the_panel(ground, mode):
 
 def test_out_of_range_and_refused_commands(ground):
     # Yamcs checks the database's range before sending; the panel's own refusal comes back
-    # as a service 1 completion failure with its failure code
+    # as a service 1 completion failure with its failure code and data
     with pytest.raises(Exception, match="range|Range|bound"):
         issue(ground, "packets", MISSION + "/SolarPanel/set_speed", {"value": 50.0})
     cmd = issue(ground, "packets", MISSION + "/SolarPanel/set_angle", {"angle": 1000.0})
     assert cmd.is_failure()
     assert cmd.acknowledgments["Verifier_Accepted"].status == "OK"
     assert "component_error" in cmd.error
+    # with the failure's data: the component's error, NOT_DEPLOYED, among it
+    assert b"NOT_DEPLOYED".hex().upper() in cmd.error
 
 
 @pytest.mark.parametrize("mode", MODES)

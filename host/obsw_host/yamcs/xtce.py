@@ -242,13 +242,30 @@ class Generator:
                 ],
             )
         )
+        # a failure's data (what failed: a parameter ID, a path...): the rest of the packet
+        # after the request ID, the code (and a progress report's step), before the PEC
+        data = {}
+        for step in (0, 1):
+            octets = 1 - self.cfg.tm_header_size - 4 - 1 - step - self.cfg.pec_size
+            ptype = ET.Element("BinaryParameterType")
+            size = _sub(_sub(ptype, "BinaryDataEncoding"), "SizeInBits")
+            dyn = _sub(size, "DynamicValue")
+            _sub(dyn, "ParameterInstanceRef", parameterRef=self.h["packet_length"])
+            _sub(dyn, "LinearAdjustment", slope="8", intercept=str(8 * octets))
+            name = "failure_data" + ("_after_step" if step else "")
+            data[step] = r.parameter(name, ptype, "the failure's data, as the OBC sent it")
+        self.v_data = data[0]
         for sub, name, entries in (
-            (M.TM_VERIFY_ACCEPTANCE_FAILURE, "acceptance_failure", [self.v_code]),
-            (M.TM_VERIFY_START_FAILURE, "start_failure", [self.v_code]),
+            (M.TM_VERIFY_ACCEPTANCE_FAILURE, "acceptance_failure", [self.v_code, data[0]]),
+            (M.TM_VERIFY_START_FAILURE, "start_failure", [self.v_code, data[0]]),
             (M.TM_VERIFY_PROGRESS_SUCCESS, "progress_success", [self.v_step]),
-            (M.TM_VERIFY_PROGRESS_FAILURE, "progress_failure", [self.v_step, self.v_code]),
-            (M.TM_VERIFY_COMPLETION_FAILURE, "completion_failure", [self.v_code]),
-            (M.TM_VERIFY_ROUTING_FAILURE, "routing_failure", [self.v_code]),
+            (
+                M.TM_VERIFY_PROGRESS_FAILURE,
+                "progress_failure",
+                [self.v_step, self.v_code, data[1]],
+            ),
+            (M.TM_VERIFY_COMPLETION_FAILURE, "completion_failure", [self.v_code, data[0]]),
+            (M.TM_VERIFY_ROUTING_FAILURE, "routing_failure", [self.v_code, data[0]]),
         ):
             r.containers.append(
                 _container(name, "verification", [(self.subtype, sub[1])], entries)
@@ -392,7 +409,8 @@ class Generator:
             v = _sub(vs, tag, name=name)
             alg = _sub(v, "CustomAlgorithm", name="verify_" + name.lower())
             _sub(alg, "AlgorithmText", language="Java").text = (
-                'org.yamcs.pus.Pus1Verifier({stage: %d, template: "failure code {code}"})' % stage
+                'org.yamcs.pus.Pus1Verifier({stage: %d, template: "{code} (data {data})"})'
+                % stage
             )
             inputs = _sub(alg, "InputSet")
             for ref, n in (
@@ -402,6 +420,7 @@ class Generator:
                 (self.v_seq, "rcvdSeq"),
                 (self.v_subtype, "reportSubType"),
                 (self.v_code, "code"),
+                (self.v_data, "data"),
             ):
                 _sub(inputs, "InputParameterInstanceRef", parameterRef=ref, inputName=n)
             _sub(

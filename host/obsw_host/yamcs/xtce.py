@@ -409,8 +409,7 @@ class Generator:
             v = _sub(vs, tag, name=name)
             alg = _sub(v, "CustomAlgorithm", name="verify_" + name.lower())
             _sub(alg, "AlgorithmText", language="Java").text = (
-                'org.yamcs.pus.Pus1Verifier({stage: %d, template: "{code} (data {data})"})'
-                % stage
+                'org.yamcs.pus.Pus1Verifier({stage: %d, template: "{code} (data {data})"})' % stage
             )
             inputs = _sub(alg, "InputSet")
             for ref, n in (

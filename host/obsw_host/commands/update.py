@@ -127,7 +127,7 @@ def build(args):
             raise UserError("--base: the reconfiguration module takes full packages only")
         return _build_reconfig(args, ids, key)
     base = _open(args.base, public or bytes.fromhex(b.public_hex(key)), ids) if args.base else None
-    manifest = b.build(args.out, b.sources(folder), mission=ids.config.name,
+    manifest = b.build(args.out, b.sources(folder, ids.config.state), mission=ids.config.name,
                        version=args.version, key=key, base=base)  # fmt: skip
     print("%s: %s, %d bytes" % (args.out, b.describe(manifest), os.path.getsize(args.out)))
     return 0

@@ -94,33 +94,44 @@ def load_public(path):
     return raw
 
 
-def sources(mission_dir):
-    """{package path: file path} of the OBC software: lib/obsw, lib/obsw_host, mission/."""
+def sources(mission_dir, state=None):
+    """{package path: file path} of the OBC software: lib/obsw, lib/obsw_host, mission/, the
+    mission's ``state`` folder left out (default ``mission_dir/state``: what a running OBC
+    keeps there, its sockets, stores and software slots, is not software)."""
     import obsw
 
     import obsw_host
 
+    state = state if state is not None else os.path.join(mission_dir, "state")
     out = {}
     for prefix, root in (  # in the order of the walk: sorted
         ("lib/obsw", os.path.dirname(obsw.__file__)),
         ("lib/obsw_host", os.path.dirname(obsw_host.__file__)),
         ("mission", mission_dir),
     ):
-        out.update(tree_files(root, prefix))
+        out.update(tree_files(root, prefix, skip=(state,)))
     return out
 
 
-def tree_files(root, prefix):
-    """{prefix/relative path: path} of every file under ``root`` a package carries."""
+def tree_files(root, prefix, skip=()):
+    """{prefix/relative path: path} of every regular file under ``root`` a package carries,
+    but those under the folders ``skip``."""
     if not os.path.isdir(root):
         raise UserError("%s is not a folder" % root)
+    skip = {os.path.realpath(x) for x in skip}
     out = {}
     for d, dirs, names in os.walk(root):
-        dirs[:] = sorted(x for x in dirs if x not in _SKIP_DIRS)
+        dirs[:] = sorted(
+            x
+            for x in dirs
+            if x not in _SKIP_DIRS and os.path.realpath(os.path.join(d, x)) not in skip
+        )
         for name in sorted(names):
             if name.endswith(_SKIP_SUFFIXES):
                 continue
             path = os.path.join(d, name)
+            if not os.path.isfile(path):
+                continue  # a socket or a pipe of a running process: not a file to carry
             rel = os.path.relpath(path, root).replace(os.sep, "/")
             out[prefix + "/" + rel] = path
     return out

@@ -55,6 +55,13 @@ def add_parser(sub):
         help="operate a running `obsw obc serve` (its PUS process) instead of starting one "
         "(packets mode); once per --mission, in the same order",
     )
+    x.add_argument(
+        "--listen",
+        metavar="ADDRESS",
+        default="127.0.0.1",
+        help="with --obc: the address where the OBCs' TM and CFDP PDUs arrive, this machine's "
+        "on their network when they run elsewhere (default 127.0.0.1)",
+    )
     x.add_argument("--files", help="the on-board CFDP filestore (default: DIR/sat)")
     x.add_argument("--seconds", type=float, help="stop after this many seconds")
     x.set_defaults(func=run_in_temp)
@@ -84,6 +91,12 @@ def _instance_options(x):
         help="PUS packets over TCP, or TC/TM frames with CLTUs and COP-1 over UDP",
     )
     x.add_argument("--http-port", type=int, help="web and API port (default: the mission's)")
+    x.add_argument(
+        "--http-address",
+        default="127.0.0.1",
+        help="where the web interface and API listen (default 127.0.0.1; 0.0.0.0: every "
+        "interface, for operators on other machines)",
+    )
     x.add_argument(
         "--keys",
         help="SDLS key file (frames mode): TC and TM protected with Yamcs' AES-256-GCM SDLS",
@@ -160,6 +173,7 @@ def _write(folder, ids, args, ports=None):
             ids=ids,
             name=name,
             keys=getattr(args, "keys", None),
+            http_address=args.http_address,
         )
     except KeyFileError as e:
         raise UserError(str(e)) from None
@@ -178,7 +192,7 @@ def _write_fleet(folder, missions, args):
         Member(instance_name(ids.name), database.from_ids(ids), args.mode, None, ids)
         for ids in missions
     ]
-    write_fleet(folder, members, http)
+    write_fleet(folder, members, http, args.http_address)
     return [m.name for m in members]
 
 
@@ -252,7 +266,7 @@ def _spacecraft(args, ids, folder, ports, obc, several):
             address = parse_address(obc)
         except ValueError as e:
             raise UserError(str(e)) from None
-        return ObcLink(ids, address, ports), "the OBC at %s:%d" % address
+        return ObcLink(ids, address, ports, args.listen), "the OBC at %s:%d" % address
     from obsw_host.yamcs.spacecraft import SampleSpacecraft
 
     files = args.files or os.path.join(folder, "sat")

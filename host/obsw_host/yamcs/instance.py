@@ -319,12 +319,14 @@ def write_instance(
     ids=None,
     name=INSTANCE,
     keys=None,
+    http_address="127.0.0.1",
 ):
     """Write a Yamcs server for ``spacecraft`` into ``folder``: one instance named ``name`` with
     ``mode`` links on ``ports``, or the ``instances`` given as {name: (mode, ports)} (one
     server, several instances). ``ids``: the mission's ids (default: the database's alone).
     With ``keys`` (an SDLS key file), the ``frames`` instances protect TC and TM with Yamcs'
-    SDLS (``obsw_host.yamcs.sdls``). Returns the MDB path."""
+    SDLS (``obsw_host.yamcs.sdls``). ``http_address``: where the web interface and API listen.
+    Returns the MDB path."""
     ids = ids or spacecraft.ids
     instances = instances or {name: (mode, ports)}
     defaults = ids.ports.yamcs()
@@ -344,7 +346,7 @@ def write_instance(
             spacecraft, mode_, dict(defaults, **(ports_ or {})), "mdb/" + mdb_name, ids
         )
         files["yamcs.%s.yaml" % name] = _instance_yaml(folder, name, config, mode_, keys, buckets)
-    files.update(_server_files(http_port, list(instances), buckets))
+    files.update(_server_files(http_port, list(instances), buckets, http_address))
     files["extra_streams.sql"] = cfdp_sql(ids.apid("cfdp"))
     _write_etc(etc, files)
     return os.path.join(mdb, mdb_name)
@@ -400,11 +402,12 @@ class Member:
         self.ids = ids
 
 
-def write_fleet(folder, members, http_port=HTTP_PORT):
+def write_fleet(folder, members, http_port=HTTP_PORT, http_address="127.0.0.1"):
     """Write one Yamcs server operating several spacecraft into ``folder``: an instance per
     ``Member``, each with its own mission database (``mdb/NAME.xml``), event templates
     (``etc/events.NAME.json``), CFDP streams (``etc/extra_streams.NAME.sql``), buckets and
-    links. Returns {instance name: MDB path}."""
+    links. ``http_address``: where the web interface and API listen (loopback unless the
+    operators reach Yamcs from other machines). Returns {instance name: MDB path}."""
     etc = os.path.join(folder, "etc")
     mdb = os.path.join(folder, "mdb")
     os.makedirs(etc, exist_ok=True)
@@ -426,6 +429,6 @@ def write_fleet(folder, members, http_port=HTTP_PORT):
                                                           buckets)  # fmt: skip
         files[os.path.basename(sql_file)] = cfdp_sql(m.ids.apid("cfdp"))
         paths[m.name] = os.path.join(folder, mdb_file)
-    files.update(_server_files(http_port, [m.name for m in members], buckets))
+    files.update(_server_files(http_port, [m.name for m in members], buckets, http_address))
     _write_etc(etc, files)
     return paths

@@ -94,8 +94,8 @@ def _instance_options(x):
     x.add_argument(
         "--http-address",
         default="127.0.0.1",
-        help="where the web interface and API listen (default 127.0.0.1; 0.0.0.0: every "
-        "interface, for operators on other machines)",
+        help="this machine's address where the web interface and API listen, for operators on "
+        "other machines (default 127.0.0.1)",
     )
     x.add_argument(
         "--keys",
@@ -354,7 +354,9 @@ def run(args):
             names = [_write(folder, missions[0], args, all_ports[0])[0]]
         for sat in sats:
             sat.start()
-        yamcs = server.Yamcs(folder, _http_port(args, missions[0]), instance=names[0])
+        yamcs = server.Yamcs(
+            folder, _http_port(args, missions[0]), instance=names[0], address=args.http_address
+        )
         yamcs.start(timeout=120)
         try:
             _wait_running(yamcs, names[1:])

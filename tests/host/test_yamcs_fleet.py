@@ -138,6 +138,17 @@ def test_config_writes_one_instance_per_mission(three, tmp_path):
         assert (out / "files" / name / "up").is_dir()
 
 
+@needs_yamcs
+def test_yamcs_accepts_the_fleets_configuration(three, tmp_path):
+    out = str(tmp_path / "y")
+    argv = ["yamcs", "config", out]
+    for f in three:
+        argv += ["--mission", f]
+    assert _obsw(*argv).returncode == 0
+    r = _obsw("yamcs", "check", out)
+    assert r.returncode == 0, r.stdout + r.stderr
+
+
 def _refused(argv, folder):
     r = _obsw(*argv)
     assert r.returncode == 2, (r.stdout, r.stderr)

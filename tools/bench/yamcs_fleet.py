@@ -138,7 +138,6 @@ class Setup:
         from obsw_host.mission import new
         from obsw_host.yamcs import database, fleet, server
         from obsw_host.yamcs.instance import Member, write_fleet
-        from yamcs.client import YamcsClient
 
         os.environ.pop("OBSW_PORT_BASE", None)  # each mission its own base
         base = free_base(count, new.FLEET_STEP)
@@ -154,6 +153,15 @@ class Setup:
         write_fleet(yfolder, members, http)
         self.yamcs = server.Yamcs(yfolder, http, instance=self.names[0])
         self.children = []
+        try:
+            self._start(folders, http)
+        except BaseException:
+            self.close()
+            raise
+
+    def _start(self, folders, http):
+        from yamcs.client import YamcsClient
+
         t0 = time.monotonic()
         self.yamcs.start(timeout=300)
         for name in self.names[1:]:

@@ -49,7 +49,7 @@ def child(args):
     from obsw_host.pus.onboard import tai_now
     from obsw_host.yamcs.gateway import PacketGateway
 
-    ids = MissionIds.locate(args.mission)
+    ids = MissionIds.locate(args.child)
     ports = ids.ports.yamcs()
     cfdp = ids.apid("cfdp")
     gateway = PacketGateway(

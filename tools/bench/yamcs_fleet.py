@@ -63,10 +63,13 @@ def child(args):
     target = gateway.tm_address
     apid = ids.pus_apid
     data = bytes(13)  # a SID and three values, as large as the sample's report
+    last = 0
     for line in sys.stdin:
         rate, seconds = float(line.split()[0]), float(line.split()[1])
-        # distinct time stamps: Yamcs keys its archive on generation time and sequence count
-        t0 = int(tai_now()) << 16
+        # distinct time stamps, never one of an earlier run's (a rate's packets may span more
+        # time than it took to send them): Yamcs keys its archive on time and sequence count
+        t0 = max(int(tai_now()) << 16, last)
+        last = t0 + 16 * (int(rate * seconds) + 2)
         packets = [
             PusTm(
                 apid, 3, 25, data, seq_count=i & 0x3FFF, time=divmod(t0 + 16 * i, 1 << 16)

@@ -137,7 +137,7 @@ def test_a_command_to_each_instance_completes_on_its_own_spacecraft_only(ground)
         cmd = ground.issue(name, "SolarPanel/set_speed", {"value": speeds[name]})
         assert cmd.is_success(), cmd.error
         acks = cmd.acknowledgments
-        for stage in ("Verifier_Accepted", "Verifier_Started", "Verifier_Completed"):
+        for stage in ("Verifier_Accepted", "Verifier_Started", "Verifier_Complete"):
             assert acks[stage].status == "OK", (name, stage)
         now[name] = speeds[name]
         after = {n: ground.values[n].mark() for n in ground.names}
@@ -156,4 +156,4 @@ def test_a_ping_to_each_instance_completes_through_service_1(ground):
     for name in ground.names:
         cmd = ground.issue(name, "PUS/ping")
         assert cmd.is_success(), (name, cmd.error)
-        assert cmd.acknowledgments["Verifier_Completed"].status == "OK"
+        assert cmd.acknowledgments["Verifier_Complete"].status == "OK"

@@ -21,6 +21,7 @@ from obsw_host.yamcs.spacecraft import SampleSpacecraft
 MISSING = server.missing()
 pytestmark = pytest.mark.skipif(MISSING is not None, reason=str(MISSING))
 MISSION = "/obsw-demo"
+XTCE = {"x": "http://www.omg.org/spec/XTCE/20180204"}
 TIMEOUT = 30.0
 
 
@@ -240,13 +241,15 @@ def test_parameter_set_completes_and_reaches_the_panel(ground, mode):
 
 def test_out_of_range_and_refused_commands(ground):
     # Yamcs checks the database's range before sending; the panel's own refusal comes back
-    # as a service 1 completion failure with its failure code
+    # as a service 1 completion failure with its failure code and data
     with pytest.raises(Exception, match="range|Range|bound"):
         issue(ground, "packets", MISSION + "/SolarPanel/set_speed", {"value": 50.0})
     cmd = issue(ground, "packets", MISSION + "/SolarPanel/set_angle", {"angle": 1000.0})
     assert cmd.is_failure()
     assert cmd.acknowledgments["Verifier_Accepted"].status == "OK"
     assert "component_error" in cmd.error
+    # with the failure's data: the component's error, NOT_DEPLOYED, among it
+    assert b"NOT_DEPLOYED".hex().upper() in cmd.error
 
 
 @pytest.mark.parametrize("mode", MODES)
@@ -388,3 +391,89 @@ def test_yamcs_listens_on_loopback_only(ground):
                     listening.append((table, cols[1]))
     assert listening, "found none of Yamcs' sockets"
     assert [x for x in listening if x[1].split(":")[0] not in loopback] == []
+
+
+def _expected_parameters(root, name, keys):
+    """The parameters a report of ``name`` fills: its own (those without an alias), and for
+    each alias name space its containers select in, the parameter of the sample's selector."""
+    systems, aliases = {}, {}
+
+    def walk(ss, path):
+        path = path + "/" + ss.get("name")
+        systems[path] = ss
+        for p in ss.findall("x:TelemetryMetaData/x:ParameterSet/x:Parameter", XTCE):
+            for a in p.findall("x:AliasSet/x:Alias", XTCE):
+                aliases[(a.get("nameSpace"), a.get("alias"))] = path + "/" + p.get("name")
+        for child in ss.findall("x:SpaceSystem", XTCE):
+            walk(child, path)
+
+    walk(root, "")
+    report = systems[MISSION + "/TM/" + name]
+    own = [
+        MISSION + "/TM/" + name + "/" + p.get("name")
+        for p in report.findall("x:TelemetryMetaData/x:ParameterSet/x:Parameter", XTCE)
+        if p.find("x:AliasSet", XTCE) is None
+    ]
+    for entry in report.iter("{%s}IndirectParameterRefEntry" % XTCE["x"]):
+        space = entry.get("aliasNameSpace")
+        own.append(aliases[(space, str(keys["type" if "obcp" in name else "pid"]))])
+    refs = report.iter("{%s}ContainerRefEntry" % XTCE["x"])
+    if any(e.get("containerRef").endswith("/embedded_tc") for e in refs):
+        tc = systems[MISSION + "/TM/embedded_tc"]
+        own += [
+            MISSION + "/TM/embedded_tc/" + p.get("name")
+            for p in tc.findall("x:TelemetryMetaData/x:ParameterSet/x:Parameter", XTCE)
+        ]
+    return sorted(set(own))
+
+
+def test_every_report_is_decoded(ground):
+    """Each report of every layout the OBC packs (obsw_host.yamcs.report_layouts), with every
+    repeated group twice and every service 12 check type once, sent to Yamcs: every parameter
+    of the report gets its value (test_yamcs_reports checks the list covers the service
+    tables)."""
+    import sys
+    import xml.etree.ElementTree as ET
+
+    from obsw.pus.config import from_sdb
+    from obsw.pus.fields import field
+    from obsw.pus.sdb import load as load_sdb
+    from obsw.pus.services import s18_layouts
+    from obsw.pus.tm import PusTm
+    from obsw_host.yamcs import xtce
+    from obsw_host.yamcs.report_layouts import report_layouts
+
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from report_samples import Sampler
+
+    sc = database.load(SDB_PATH)
+    config = from_sdb(load_sdb(SDB_PATH))
+    apid = load_sdb(SDB_PATH).apid("pus")
+    root = ET.fromstring(xtce.generate(sc))
+    sampler = Sampler(1, config, apid)
+    keys = {"pid": 1, "type": s18_layouts.ARG_INT}
+    sat = ground.sats["packets"]
+    proc = ground.processor("packets")
+    out = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    undecoded = {}
+    try:
+        for n, (msg_type, (name, layout)) in enumerate(
+            sorted(report_layouts(lambda pid: field(*sc.params[pid].pair)).items())
+        ):
+            data = layout.pack(sampler.layout(layout))
+            tm = PusTm(apid, msg_type[0], msg_type[1], data, seq_count=n, time=(1000, 0),
+                       config=config)  # fmt: skip
+            out.sendto(tm.pack(), sat.gateway.tm_address)
+            names = _expected_parameters(root, name, keys)
+            deadline = time.monotonic() + 10.0
+            while True:
+                values = proc.get_parameter_values(names)
+                missing = [nm for nm, v in zip(names, values) if v is None]
+                if not missing or time.monotonic() > deadline:
+                    break
+                time.sleep(0.2)
+            if missing:
+                undecoded["%s %s" % (msg_type, name)] = missing
+    finally:
+        out.close()
+    assert not undecoded

@@ -145,8 +145,10 @@ def _power_on(cmd, env, fds=()):
     """A simulated controller's or OBC's process, its output read by the simulation, with the
     signal dispositions of a machine that powers on: SIGINT not ignored, whatever the shell
     that ran the simulation left (a background job inherits SIGINT ignored, and the OBC's
-    recovery then stalled); and its power goes with the simulation's: killed when the thread
-    that started it ends, however the simulation ends (no orphan keeps running)."""
+    recovery then stalled); a process group of its own, the machine every process it starts
+    runs on (a power cut reaches them all, even one its parent no longer knows); and its
+    power goes with the simulation's: killed when the thread that started it ends, however
+    the simulation ends (no orphan keeps running)."""
     return subprocess.Popen(
         cmd,
         env=env,
@@ -159,6 +161,7 @@ def _power_on(cmd, env, fds=()):
 
 def _powered_by_parent():
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+    os.setpgid(0, 0)
     try:  # Linux: SIGKILL when the parent's thread that started it ends
         import ctypes
 
@@ -188,12 +191,23 @@ class _Proc:
         return self.popen.poll() is None
 
     def signal_tree(self, sig):
-        """``sig`` to the process and all it started (a hang or a power cut stops them all)."""
-        _signal_all([self.popen.pid] + descendants(self.popen.pid), sig)
+        """``sig`` to the process and all it started (a hang or a power cut stops them all):
+        its process group, and the descendants that left it."""
+        pids = [self.popen.pid] + descendants(self.popen.pid)
+        try:
+            os.killpg(self.popen.pid, sig)
+        except OSError:
+            pass
+        _signal_all(pids, sig)
 
     def kill(self):
         if self.popen.poll() is None:
             self.signal_tree(signal.SIGKILL)
+        else:  # it ended by itself: what it started may run on
+            try:
+                os.killpg(self.popen.pid, signal.SIGKILL)
+            except OSError:
+                pass
         try:
             self.popen.wait(5.0)
         except subprocess.TimeoutExpired:

@@ -11,9 +11,11 @@ Two link modes, every socket on loopback:
   connection carries PUS TM and TC, one carries CFDP TM; TCs go out on the first.
 - ``frames``: Yamcs sends TC transfer frames in CLTUs by UDP to the frame processor (its FOP-1
   runs COP-1 against our FARM-1 on VC 0; no segment header, since Yamcs 5.12.8 fails on MAP
-  IDs for the commands of its own services, CFDP's among them) and receives TM transfer
-  frames by UDP (the mission's virtual channels: real time, playback, CFDP and essential, from
-  the spacecraft database's ``frames`` plan; idle frames and the CLCW in the OCF).
+  IDs for the commands of its own services, CFDP's among them: ``TcPacketHandler.getMapId``
+  reads the ancillary data of a MetaCommand they do not have; docs/yamcs.md) and receives TM
+  transfer frames by UDP (the mission's virtual channels: real time, playback, CFDP and
+  essential, from the spacecraft database's ``frames`` plan; idle frames and the CLCW in the
+  OCF).
 
 The spacecraft id, the virtual channels, the CFDP entities (the database's onboard filestore
 and the first other one, whatever their prefixes) and the CFDP APID come from the mission

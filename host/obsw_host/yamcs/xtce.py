@@ -23,9 +23,10 @@ from obsw.pus.config import PusConfig
 from obsw.pus.fields import field
 from obsw.pus.packets import ACK_ALL
 from obsw.pus.services.s01_verification import FAILURE_NAMES
-from obsw.pus.services.s12_layouts import FMON_STATUS_NAMES, STATUS_NAMES
-from obsw.pus.services.s20_parameters import DEFINITION_NAMES
+from obsw.pus.services.s12_layouts import STATUS_NAMES
 
+from obsw_host.yamcs.report_layouts import report_layouts
+from obsw_host.yamcs.xtce_reports import CHECK_ALARMS, PID, TRANSITION, ReportWriter
 from obsw_host.yamcs.xtce_types import (
     argument_type,
     linear,
@@ -70,8 +71,9 @@ class SpaceSystem:
             s = self.children[name] = SpaceSystem(name, self.path + "/" + name)
         return s
 
-    def parameter(self, name, ptype, description=None):
-        """Add a parameter of type element ``ptype``; returns its absolute reference."""
+    def parameter(self, name, ptype, description=None, aliases=None):
+        """Add a parameter of type element ``ptype`` (``aliases`` {name space: alias});
+        returns its absolute reference."""
         if any(p.get("name") == name for p in self.params):
             raise ValueError("%s: two parameters named %s (an attribute, and an event's field "
                              "or a generated one): rename one" % (self.path, name))  # fmt: skip
@@ -80,6 +82,10 @@ class SpaceSystem:
         p = ET.Element("Parameter", name=name, parameterTypeRef=name + "_t")
         if description:
             p.set("shortDescription", description)
+        if aliases:
+            alias_set = _sub(p, "AliasSet")
+            for space, alias in sorted(aliases.items()):
+                _sub(alias_set, "Alias", nameSpace=space, alias=alias)
         self.params.append(p)
         return self.path + "/" + name
 
@@ -112,6 +118,9 @@ def _container(name, base, conditions, entries=(), archive=False):
         ).text = "UseAsArchivingPartition"
     lst = _sub(c, "EntryList")
     for e in entries:
+        if isinstance(e, ET.Element):  # an entry made by the caller (xtce_reports)
+            lst.append(e)
+            continue
         ref, offset = e if isinstance(e, tuple) else (e, None)
         entry = _sub(lst, "ParameterRefEntry", parameterRef=ref)
         if offset is not None:
@@ -233,13 +242,30 @@ class Generator:
                 ],
             )
         )
+        # a failure's data (what failed: a parameter ID, a path...): the rest of the packet
+        # after the request ID, the code (and a progress report's step), before the PEC
+        data = {}
+        for step in (0, 1):
+            octets = 1 - self.cfg.tm_header_size - 4 - 1 - step - self.cfg.pec_size
+            ptype = ET.Element("BinaryParameterType")
+            size = _sub(_sub(ptype, "BinaryDataEncoding"), "SizeInBits")
+            dyn = _sub(size, "DynamicValue")
+            _sub(dyn, "ParameterInstanceRef", parameterRef=self.h["packet_length"])
+            _sub(dyn, "LinearAdjustment", slope="8", intercept=str(8 * octets))
+            name = "failure_data" + ("_after_step" if step else "")
+            data[step] = r.parameter(name, ptype, "the failure's data, as the OBC sent it")
+        self.v_data = data[0]
         for sub, name, entries in (
-            (M.TM_VERIFY_ACCEPTANCE_FAILURE, "acceptance_failure", [self.v_code]),
-            (M.TM_VERIFY_START_FAILURE, "start_failure", [self.v_code]),
+            (M.TM_VERIFY_ACCEPTANCE_FAILURE, "acceptance_failure", [self.v_code, data[0]]),
+            (M.TM_VERIFY_START_FAILURE, "start_failure", [self.v_code, data[0]]),
             (M.TM_VERIFY_PROGRESS_SUCCESS, "progress_success", [self.v_step]),
-            (M.TM_VERIFY_PROGRESS_FAILURE, "progress_failure", [self.v_step, self.v_code]),
-            (M.TM_VERIFY_COMPLETION_FAILURE, "completion_failure", [self.v_code]),
-            (M.TM_VERIFY_ROUTING_FAILURE, "routing_failure", [self.v_code]),
+            (
+                M.TM_VERIFY_PROGRESS_FAILURE,
+                "progress_failure",
+                [self.v_step, self.v_code, data[1]],
+            ),
+            (M.TM_VERIFY_COMPLETION_FAILURE, "completion_failure", [self.v_code, data[0]]),
+            (M.TM_VERIFY_ROUTING_FAILURE, "routing_failure", [self.v_code, data[0]]),
         ):
             r.containers.append(
                 _container(name, "verification", [(self.subtype, sub[1])], entries)
@@ -260,7 +286,10 @@ class Generator:
                 ptype = parameter_type(
                     "", p.pair, p.unit, limits=p.limits, calibration=p.calibration, labels=p.labels
                 )
-            self.refs[pid] = s.parameter(name, ptype, p.description)
+            # the alias a value report (TM[20,2]) finds it by; not a variable octet string,
+            # which needs its length parameter before it
+            aliases = None if entries else {PID: pid}
+            self.refs[pid] = s.parameter(name, ptype, p.description, aliases)
             self.entries[pid] = entries + [self.refs[pid]]
 
     def housekeeping(self):
@@ -301,52 +330,33 @@ class Generator:
             self.templates.append({"eventId": labels[e.id], "template": text})
 
     def monitoring(self):
-        """TM[12,12]: the first transition of each report, per monitored parameter."""
-        r = self.root
-        base_entries = [
-            self.header_param("transition_count", 16),
-            self.header_param("pmon_id", 16),
-            self.header_param("monitored_parameter_id", 16),
-            self.header_param("check_type", 8),
-        ]
-        self.report("check_transition", M.TM_MON_CHECK_TRANSITION_REPORT, base_entries)
+        """Service 12's per-parameter parameters: the limit a numeric parameter crossed and
+        its previous and current check states (an alarm when out of limits), which check
+        transition reports (TM[12,12], TM[12,11]) fill by alias."""
         states = {k: _label(v) for k, v in STATUS_NAMES.items()}
         for pid in sorted(self.sc.params):
             p = self.sc.params[pid]
-            if not p.limits or p.pair[0] not in (2, 3, 4, 5):
+            if p.pair[0] not in (2, 3, 4, 5):
                 continue
             s = self.system_of(p.path[:-1])
             name = _label(p.path[-1])
-            limit = s.parameter(name + "_limit_crossed", parameter_type("", p.pair, p.unit))
-            prev = s.parameter(name + "_previous_check", parameter_type("", E8, labels=states))
-            alarms = {"below_low": "critical", "above_high": "critical", "invalid": "warning"}
-            cur = s.parameter(
-                name + "_check_state", parameter_type("", E8, labels=states, alarms=alarms)
-            )
-            r.containers.append(
-                _container(
-                    "check_transition_" + _label(p.qualified),
-                    "check_transition",
-                    [(base_entries[2], pid), (base_entries[3], 1)],
-                    [self.refs[pid], limit, prev, cur],
-                )
-            )
+            for suffix, ptype, space in (
+                ("_limit_crossed", parameter_type("", p.pair, p.unit), TRANSITION["limit"]),
+                ("_previous_check", parameter_type("", E8, labels=states), TRANSITION["previous"]),
+                (
+                    "_check_state",
+                    parameter_type("", E8, labels=states, alarms=CHECK_ALARMS),
+                    TRANSITION["current"],
+                ),
+            ):
+                s.parameter(name + suffix, ptype, aliases={space: pid})
 
-    def parameter_reports(self):
-        n = self.header_param("parameter_count", 8)
-        pid_ref = self.header_param("reported_parameter_id", 16)
-        self.report("parameter_values", M.TM_PARAM_VALUE_REPORT, [n, pid_ref])
-        for pid in sorted(self.sc.params):
-            if self.sc.params[pid].pair[0] in (7, 8):
-                continue
-            self.root.containers.append(
-                _container(
-                    "parameter_value_%d" % pid,
-                    "parameter_values",
-                    [(n, 1), (pid_ref, pid)],
-                    [self.refs[pid]],
-                )
-            )
+    def reports(self):
+        """Every report of ``report_layouts``, whole (``xtce_reports``)."""
+        writer = ReportWriter(self)
+        types = lambda pid: field(*self.sc.params[pid].pair)  # noqa: E731
+        for msg_type, (name, layout) in sorted(report_layouts(types).items()):
+            writer.write(msg_type, name, layout)
 
     def test_reports(self):
         self.report("are_you_alive_report", M.TM_TEST_ARE_YOU_ALIVE_REPORT)
@@ -399,7 +409,7 @@ class Generator:
             v = _sub(vs, tag, name=name)
             alg = _sub(v, "CustomAlgorithm", name="verify_" + name.lower())
             _sub(alg, "AlgorithmText", language="Java").text = (
-                'org.yamcs.pus.Pus1Verifier({stage: %d, template: "failure code {code}"})' % stage
+                'org.yamcs.pus.Pus1Verifier({stage: %d, template: "{code} (data {data})"})' % stage
             )
             inputs = _sub(alg, "InputSet")
             for ref, n in (
@@ -409,6 +419,7 @@ class Generator:
                 (self.v_seq, "rcvdSeq"),
                 (self.v_subtype, "reportSubType"),
                 (self.v_code, "code"),
+                (self.v_data, "data"),
             ):
                 _sub(inputs, "InputParameterInstanceRef", parameterRef=ref, inputName=n)
             _sub(
@@ -640,15 +651,6 @@ class Generator:
             ),
         ):
             self.command(pus, name, mt, fields(), "TC[%d,%d]" % mt)
-        whole = [
-            self.header_param("memory_id", 16),
-            self.header_param("memory_object_id", 16),
-            self.header_param("memory_object_length", 32),
-            self.header_param("memory_object_checksum", 16),
-        ]
-        self.report("memory_whole_object_report", M.TM_MEM_CHECK_OBJECT_WHOLE_REPORT, whole)
-        self.report("memory_object_dump", M.TM_MEM_DUMP_OBJECT_REPORT, whole[:2])
-        self.report("memory_object_check", M.TM_MEM_CHECK_OBJECT_REPORT, whole[:2])
         # ST[15]: time tags as the CUC coarse (seconds) and fine (1/65536 s) parts
         windows = {0: "from_to", 1: "after", 2: "before"}
         self.command(
@@ -675,11 +677,6 @@ class Generator:
             self.command(pus, name, mt, fields, "TC[%d,%d]" % mt)
         self.command(
             pus, "store_diag_report", M.TC_STORE_REPORT_DIAG_STRUCTURES, [u("store", U16)]
-        )
-        self.report(
-            "store_diag_report",
-            M.TM_STORE_DIAG_STRUCTURES_REPORT,
-            [self.header_param("store_id", 16)],
         )
         # ST[21] sequences from files, ST[22] the orbit number
         for name, mt in (
@@ -774,37 +771,9 @@ class Generator:
 
     # ------------------------------------------------------------------ ST[12] 17-28, ST[20] 4-7
     def functional_monitoring(self):
-        """TM[12,26] and TM[12,28] (their first FMON), TC[12,17] to TC[12,27]."""
-        fmon_states = {k: _label(v) for k, v in FMON_STATUS_NAMES.items()}
-        yes_no = {0: "no", 1: "yes"}
-        count = self.header_param("fmon_count", 16)
-        fmon = self.header_param("fmon_id", 16)
-        protected = self.header_param("fmon_protected", 8, labels=yes_no)
-        enabled = self.header_param("fmon_enabled", 8, labels=yes_no)
-        checking = self.root.parameter(
-            "fmon_checking_status",
-            parameter_type("", E8, labels=fmon_states, alarms={"failed": "critical"}),
-        )
-        self.report(
-            "functional_status_report",
-            M.TM_MON_FUNCTIONAL_MONITORING_STATUS_REPORT,
-            [count, fmon, protected, enabled, checking],
-            archive=True,
-        )
-        validity = [
-            self.header_param("fmon_validity_parameter", 16),
-            self.header_param("fmon_validity_mask", 32),
-            self.header_param("fmon_validity_value", 32),
-        ]
+        """TC[12,17] to TC[12,27]."""
         ev_labels = {e.id: _label(e.qualified) for e in self.sc.events.values()}
         ev_labels[0] = "none"
-        event = self.root.parameter("fmon_event", parameter_type("", E16, labels=ev_labels))
-        tail = [event, self.header_param("fmon_failing", 16), self.header_param("fmon_pmons", 16)]
-        self.report(
-            "functional_definition_report",
-            M.TM_MON_FUNCTIONAL_MONITORING_REPORT,
-            [count, fmon] + validity + [protected, enabled] + tail,
-        )
         pus = self.root.child("PUS")
         one = ("fixed", "n", 1, 16)
 
@@ -846,18 +815,8 @@ class Generator:
             )
 
     def parameter_definitions(self):
-        """TM[20,7] (its first parameter), TC[20,4] to TC[20,6]."""
+        """TC[20,4] to TC[20,6]."""
         param_labels = {pid: _label(p.qualified) for pid, p in self.sc.params.items()}
-        kinds = {k: _label(v) for k, v in DEFINITION_NAMES.items()}
-        entries = [
-            self.header_param("definition_count", 8),
-            self.root.parameter("defined_parameter", parameter_type("", U16, labels=param_labels)),
-            self.header_param("definition_kind", 8, labels=kinds),
-            self.header_param("definition_memory", 16),
-            self.header_param("definition_object", 16),
-            self.header_param("definition_address", 32),
-        ]
-        self.report("parameter_definition_report", M.TM_PARAM_DEFINITION_REPORT, entries)
         pus = self.root.child("PUS")
         one = ("fixed", "n", 1, 8)
 
@@ -896,7 +855,7 @@ class Generator:
         self.housekeeping()
         self.events()
         self.monitoring()
-        self.parameter_reports()
+        self.reports()
         self.test_reports()
         self.tc_base()
         self.service_commands()
@@ -939,8 +898,9 @@ class Generator:
 
     # ------------------------------------------------------------------ services 2, 3, 9, 14
     def services_2_3_9_14(self):
-        """Reports and commands of device access, diagnostics, functional reporting, time and
-        diagnostic forwarding: one item per command (N = 1), the first item of a report."""
+        """Commands of device access, diagnostics, functional reporting, time and diagnostic
+        forwarding, one item per command (N = 1); the time reports (their other reports come
+        from their layouts: ``reports``)."""
         r = self.root
         exponent = self.header_param("time_rate_exponent", 8)
         status = self.header_param("time_reference_status", 8)
@@ -950,17 +910,6 @@ class Generator:
         self.report("cds_time_report", M.TM_TIME_CDS_REPORT, [exponent] + cds + [status])
         diag_sid = self.header_param("diag_structure_id", 16)
         self.report("diag_report", M.TM_HK_DIAG_REPORT, [diag_sid])
-        n = self.header_param("register_count", 8)
-        address = self.header_param("register_address", 32)
-        value = self.header_param("register_value", 32)
-        self.report("register_dump", M.TM_DEVICE_REGISTER_DUMP_REPORT, [n, address, value])
-        for name, msg_type in (
-            ("diag_structure_report", M.TM_HK_DIAG_STRUCTURE_REPORT),
-            ("diag_properties_report", M.TM_HK_DIAG_PERIODIC_PROPERTIES_REPORT),
-            ("functional_reporting_report", M.TM_HK_FUNCTIONAL_REPORTING_REPORT),
-            ("forward_diag_report", M.TM_FWD_DIAG_STRUCTURES_REPORT),
-        ):
-            self.report(name, msg_type)
 
         pus = r.child("PUS")
         one8, one16 = ("fixed", "n", 1, 8), ("fixed", "n", 1, 16)

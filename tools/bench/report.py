@@ -47,6 +47,7 @@ RUNS = {
     "obc_start": ("obc_start.py", {}, "OBC cold start"),
     "supervision": ("supervision.py", {}, "OBC recovery of a killed and a hung unit"),
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
+    "yamcs_fleet": ("yamcs_fleet.py", {}, "Several spacecraft on one Yamcs"),
     "recovery": ("recovery.py", {}, "Autonomous recovery of a hung OBC"),
     "update": ("update.py", {}, "In-flight update of the OBC"),
     "ed25519": ("ed25519.py", {}, "Ed25519 verify of an update's signature"),

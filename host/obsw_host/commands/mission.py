@@ -25,7 +25,16 @@ def add_parser(sub):
     c.set_defaults(func=check_cmd)
     n = s.add_parser("new", help="write a new mission folder from the shipped template")
     n.add_argument("name", help="the spacecraft's name (letters, digits, '_', '.', '-')")
-    n.add_argument("--dir", help="the folder to write (default: ./NAME)")
+    n.add_argument("--dir", help="the folder to write (default: ./NAME; with --count, the "
+                   "folder of the missions, default: .)")  # fmt: skip
+    n.add_argument("--from", dest="template", metavar="DIR",
+                   help="copy this mission folder instead of the shipped template")  # fmt: skip
+    n.add_argument("--scid", type=int, help="the spacecraft id (with --count, the first one's; "
+                   "default: the template's, + 1 per mission)")  # fmt: skip
+    n.add_argument("--port-base", type=int, help="the mission's port base (with --count, the "
+                   "first one's, default 20000; each next one 200 above)")  # fmt: skip
+    n.add_argument("--count", type=int, help="write N missions NAME-1 .. NAME-N, each with "
+                   "its own spacecraft id and ports (a fleet for one Yamcs)")  # fmt: skip
     n.set_defaults(func=new_cmd)
     u = s.add_parser("upgrade", help="convert a format-1 mission file to format 2")
     u.add_argument("file", help="the mission file (rewritten in place unless --output)")
@@ -55,12 +64,31 @@ def check_cmd(args):
 
 
 def new_cmd(args):
-    from obsw_host.mission.new import write
+    from obsw_host.mission import new
 
-    folder = write(args.name, args.dir or args.name)
+    if args.count is not None:
+        base = new.FLEET_BASE if args.port_base is None else args.port_base
+        template = args.template or new.TEMPLATE_DIR
+        folders = new.fleet(template, args.name, args.dir or ".", args.count, args.scid, base)
+        for folder in folders:
+            ids = _ids(folder)  # the mission file's base ($OBSW_PORT_BASE moves a run, not it)
+            print("%s: mission %s, spacecraft id %s, port base %d"
+                  % (folder, ids.name, ids.sdb.scid, ids.config.doc["ports"]["base"]))  # fmt: skip
+        return 0
+    if args.template or args.scid is not None or args.port_base is not None:
+        folder = new.copy(args.template or new.TEMPLATE_DIR, args.name, args.dir or args.name,
+                          args.scid, args.port_base)  # fmt: skip
+    else:
+        folder = new.write(args.name, args.dir or args.name)
     print("%s: mission %s written; next: obsw mission check %s && obsw obc serve %s"
           % (folder, args.name, folder, folder))  # fmt: skip
     return 0
+
+
+def _ids(folder):
+    from obsw_host.ids import MissionIds
+
+    return MissionIds.locate(folder)
 
 
 def upgrade_cmd(args):

@@ -54,3 +54,85 @@ def write(name, folder):
     _rewrite(os.path.join(folder, "sdb.json"),
              {"$schema": _schema_ref(folder, SDB_SCHEMA), "mission": name})  # fmt: skip
     return folder
+
+
+# the mission file's keys that fix a port by itself (older files): (section, key)
+_FIXED_PORTS = (("pus", "port"), ("cfdp", "port"), ("frames", "tm_port"))
+FLEET_BASE = 20000  # the port base of a fleet's first mission
+FLEET_STEP = 200  # between two missions' bases: each mission's ports stay apart (ids-and-ports)
+
+
+def _shift_address(text, delta):
+    host, sep, port = str(text).rpartition(":")
+    return "%s:%d" % (host, int(port) + delta) if sep and port.isdigit() else text
+
+
+def copy(template, name, folder, scid=None, port_base=None):
+    """Write mission ``name`` into ``folder`` as a copy of mission folder ``template`` with its
+    name (mission file and database), and with ``scid`` and ``port_base`` when given: the ports
+    the mission file fixes by themselves move with the base. Returns the folder."""
+    from obsw_host.mission import locate
+
+    if not NAME.match(name):
+        raise UserError("mission name %r is not usable" % name,
+                        expected="letters, digits, '_', '.' and '-' (up to 64)")  # fmt: skip
+    source = os.path.dirname(os.path.abspath(locate(template)))
+    folder = os.path.abspath(folder)
+    if os.path.exists(folder) and (not os.path.isdir(folder) or os.listdir(folder)):
+        raise UserError("%s already exists" % folder, expected="a new or empty folder")
+    shutil.copytree(source, folder, dirs_exist_ok=True,
+                    ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
+    mission_path = os.path.join(folder, MISSION_FILE)
+    with open(mission_path, encoding="utf-8") as f:
+        doc = json.load(f)
+    sdb_path = os.path.join(folder, doc.get("sdb", "sdb.json"))
+    with open(sdb_path, encoding="utf-8") as f:
+        sdb = json.load(f)
+    doc["name"] = sdb["mission"] = name
+    for d, path, schema in ((doc, mission_path, MISSION_SCHEMA), (sdb, sdb_path, SDB_SCHEMA)):
+        if "$schema" in d:
+            d["$schema"] = _schema_ref(os.path.dirname(path), schema)
+    if scid is not None:
+        sdb.setdefault("frames", {})["scid"] = scid
+        if "scid" in doc.get("frames", {}):  # a mission file that repeats it
+            doc["frames"]["scid"] = scid
+    if port_base is not None:
+        ports = doc.setdefault("ports", {})
+        delta = port_base - ports.get("base", 5000)
+        ports["base"] = port_base
+        for name_ in [k for k in ports if k != "base"]:
+            ports[name_] += delta
+        for section, key in _FIXED_PORTS:
+            if isinstance(doc.get(section, {}).get(key), int):
+                doc[section][key] += delta
+        peers = doc.get("cfdp", {}).get("peers") or {}
+        for eid in peers:
+            peers[eid] = _shift_address(peers[eid], delta)
+    for d, path in ((doc, mission_path), (sdb, sdb_path)):
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(d, f, indent=2)
+            f.write("\n")
+    return folder
+
+
+def fleet(template, prefix, folder, count, scid=None, port_base=FLEET_BASE, step=FLEET_STEP):
+    """Write ``count`` missions ``PREFIX-1`` .. ``PREFIX-N`` into ``folder`` from mission folder
+    ``template``, each with its own spacecraft id (``scid`` + k, default the template's + k)
+    and port base (``port_base`` + k * ``step``). Returns their folders."""
+    from obsw_host.ids import MissionIds
+
+    if count < 1:
+        raise UserError("--count %d" % count, expected="one mission or more")
+    first = MissionIds.locate(template).sdb.scid if scid is None else scid
+    first = 0 if first is None else first
+    if first + count > 1024:
+        raise UserError("spacecraft ids %d to %d" % (first, first + count - 1),
+                        expected="ids up to 1023")  # fmt: skip
+    if port_base + (count - 1) * step + 5018 > 65535:
+        raise UserError("port bases %d to %d" % (port_base, port_base + (count - 1) * step),
+                        expected="every port below 65536 (a lower --port-base)")  # fmt: skip
+    return [
+        copy(template, "%s-%d" % (prefix, k + 1), os.path.join(folder, "%s-%d" % (prefix, k + 1)),
+             scid=first + k + (1 if scid is None else 0), port_base=port_base + k * step)
+        for k in range(count)
+    ]  # fmt: skip

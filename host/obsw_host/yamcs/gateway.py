@@ -6,7 +6,8 @@ conventions: telecommand packets from Yamcs go to UDP ``port_base + APID`` (or t
 the sender reaches the TM input; every packet arriving on ``tm_port`` goes to Yamcs over TCP,
 on the connection of its stream (``apids``: stream name -> APIDs, the rest on ``pus``).
 Yamcs connects to the gateway (``TcpTcTmDataLink``, ``TcpTmDataLink``); every socket is bound
-to 127.0.0.1 unless told otherwise. Packets for a stream with no connection are dropped and
+to 127.0.0.1 unless told otherwise (``host``; ``udp_host`` for the UDP socket alone, the one
+that faces OBCs on other machines). Packets for a stream with no connection are dropped and
 counted, as a radio link without a ground station would lose them.
 """
 
@@ -30,6 +31,7 @@ class PacketGateway:
         tm_port=None,
         port_base=None,
         routes=None,
+        udp_host=None,
     ):
         self.host = host
         ports = Ports()  # the defaults of this run (obsw_host.ports)
@@ -54,7 +56,7 @@ class PacketGateway:
                 self.ports[name] = s.getsockname()[1]
             self.udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
             self.udp.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
-            self.udp.bind((host, tm_port))
+            self.udp.bind((host if udp_host is None else udp_host, tm_port))
             self.udp.setblocking(False)
             self.tm_address = self.udp.getsockname()
         except OSError:

@@ -182,7 +182,15 @@ def links(mode, ports, ids):
     ]
 
 
-def instance_config(spacecraft, mode, ports, mdb_file, ids):
+def instance_config(
+    spacecraft,
+    mode,
+    ports,
+    mdb_file,
+    ids,
+    events_file="etc/events.json",
+    sql_file="etc/extra_streams.sql",
+):
     ground_prefix, sat_prefix = ids.ground_prefix, ids.local_prefix
     sat_entity, ground_entity = ids.cfdp_entities
     return {
@@ -203,7 +211,7 @@ def instance_config(spacecraft, mode, ports, mdb_file, ids):
                 "class": "org.yamcs.pus.PusEventDecoder",
                 "args": {
                     "eventIdParameter": "/%s/event_id" % spacecraft.mission,
-                    "eventTemplateFile": "etc/events.json",
+                    "eventTemplateFile": events_file,
                     "realtimeStreams": ["tm_realtime"],
                 },
             },
@@ -243,7 +251,7 @@ def instance_config(spacecraft, mode, ports, mdb_file, ids):
             "parameterAlarm": ["alarms_realtime"],
             "eventAlarm": ["event_alarms_realtime"],
             "tc": [{"name": "tc_realtime", "processor": "realtime"}],
-            "sqlFile": "etc/extra_streams.sql",
+            "sqlFile": sql_file,
         },
     }
 
@@ -313,12 +321,14 @@ def write_instance(
     ids=None,
     name=INSTANCE,
     keys=None,
+    http_address="127.0.0.1",
 ):
     """Write a Yamcs server for ``spacecraft`` into ``folder``: one instance named ``name`` with
     ``mode`` links on ``ports``, or the ``instances`` given as {name: (mode, ports)} (one
     server, several instances). ``ids``: the mission's ids (default: the database's alone).
     With ``keys`` (an SDLS key file), the ``frames`` instances protect TC and TM with Yamcs'
-    SDLS (``obsw_host.yamcs.sdls``). Returns the MDB path."""
+    SDLS (``obsw_host.yamcs.sdls``). ``http_address``: where the web interface and API listen.
+    Returns the MDB path."""
     ids = ids or spacecraft.ids
     instances = instances or {name: (mode, ports)}
     defaults = ids.ports.yamcs()
@@ -334,37 +344,93 @@ def write_instance(
     buckets = []
     files = {}
     for name, (mode_, ports_) in instances.items():
-        for way in ("up", "down"):
-            path = os.path.join("files", name, way)
-            os.makedirs(os.path.join(folder, path), exist_ok=True)
-            buckets.append({"name": "%s_%s" % (name, way), "path": path})
         config = instance_config(
             spacecraft, mode_, dict(defaults, **(ports_ or {})), "mdb/" + mdb_name, ids
         )
-        if keys is not None and mode_ == "frames":
-            from obsw_host.yamcs.sdls import secure_links
+        files["yamcs.%s.yaml" % name] = _instance_yaml(folder, name, config, mode_, keys, buckets)
+    files.update(_server_files(http_port, list(instances), buckets, http_address))
+    files["extra_streams.sql"] = cfdp_sql(ids.apid("cfdp"))
+    _write_etc(etc, files)
+    return os.path.join(mdb, mdb_name)
 
-            secure_links(config["dataLinks"], keys, etc)
-        cfdp = config["services"][-1]["args"]
-        cfdp["incomingBucket"] = name + "_down"
-        cfdp["localEntities"][0]["bucket"] = name + "_down"  # where files to it land
-        files["yamcs.%s.yaml" % name] = _yaml(config)
+
+def _instance_yaml(folder, name, config, mode, keys, buckets):
+    """Instance ``name``'s yaml text, its CFDP buckets made and added to ``buckets``."""
+    for way in ("up", "down"):
+        path = os.path.join("files", name, way)
+        os.makedirs(os.path.join(folder, path), exist_ok=True)
+        buckets.append({"name": "%s_%s" % (name, way), "path": path})
+    if keys is not None and mode == "frames":
+        from obsw_host.yamcs.sdls import secure_links
+
+        secure_links(config["dataLinks"], keys, os.path.join(folder, "etc"))
+    cfdp = config["services"][-1]["args"]
+    cfdp["incomingBucket"] = name + "_down"
+    cfdp["localEntities"][0]["bucket"] = name + "_down"  # where files to it land
+    return _yaml(config)
+
+
+def _server_files(http_port, instances, buckets, address="127.0.0.1"):
     server = {
         "services": [
             {
                 "class": "org.yamcs.http.HttpServer",
-                "args": {"address": "127.0.0.1", "port": http_port},
+                "args": {"address": address, "port": http_port},
             }
         ],
         "dataDir": "data",
-        "instances": list(instances),
+        "instances": instances,
         "secretKey": "obsw-local-only",
         "buckets": buckets,
     }
-    files["yamcs.yaml"] = _yaml(server)
-    files["processor.yaml"] = _yaml(PROCESSOR)
-    files["extra_streams.sql"] = cfdp_sql(ids.apid("cfdp"))
+    return {"yamcs.yaml": _yaml(server), "processor.yaml": _yaml(PROCESSOR)}
+
+
+def _write_etc(etc, files):
     for name, text in files.items():
         with open(os.path.join(etc, name), "w") as f:
             f.write(text + "\n")
-    return os.path.join(mdb, mdb_name)
+
+
+class Member:
+    """One spacecraft of a fleet: its instance ``name``, database ``spacecraft``, link ``mode``,
+    Yamcs' link ``ports`` and mission ``ids``."""
+
+    def __init__(self, name, spacecraft, mode, ports, ids):
+        self.name = name
+        self.spacecraft = spacecraft
+        self.mode = mode
+        self.ports = ports
+        self.ids = ids
+
+
+def write_fleet(folder, members, http_port=HTTP_PORT, http_address="127.0.0.1"):
+    """Write one Yamcs server operating several spacecraft into ``folder``: an instance per
+    ``Member``, each with its own mission database (``mdb/NAME.xml``), event templates
+    (``etc/events.NAME.json``), CFDP streams (``etc/extra_streams.NAME.sql``), buckets and
+    links. ``http_address``: where the web interface and API listen (loopback unless the
+    operators reach Yamcs from other machines). Returns {instance name: MDB path}."""
+    etc = os.path.join(folder, "etc")
+    mdb = os.path.join(folder, "mdb")
+    os.makedirs(etc, exist_ok=True)
+    os.makedirs(mdb, exist_ok=True)
+    buckets, files, paths = [], {}, {}
+    for m in members:
+        mdb_file = "mdb/%s.xml" % m.name
+        events_file = "etc/events.%s.json" % m.name
+        sql_file = "etc/extra_streams.%s.sql" % m.name
+        with open(os.path.join(folder, mdb_file), "w") as f:
+            f.write(generate(m.spacecraft))
+        with open(os.path.join(folder, events_file), "w") as f:
+            json.dump(event_templates(m.spacecraft), f, indent=1)
+        ports = dict(m.ids.ports.yamcs(), **(m.ports or {}))
+        config = instance_config(
+            m.spacecraft, m.mode, ports, mdb_file, m.ids, events_file, sql_file
+        )
+        files["yamcs.%s.yaml" % m.name] = _instance_yaml(folder, m.name, config, m.mode, None,
+                                                          buckets)  # fmt: skip
+        files[os.path.basename(sql_file)] = cfdp_sql(m.ids.apid("cfdp"))
+        paths[m.name] = os.path.join(folder, mdb_file)
+    files.update(_server_files(http_port, [m.name for m in members], buckets, http_address))
+    _write_etc(etc, files)
+    return paths

@@ -30,9 +30,11 @@ def parse_address(text):
 
 class ObcLink:
     """The gateway between Yamcs and a running OBC of mission ``ids`` (see the module text).
-    ``obc``: (host, port) of its PUS process; ``ports``: Yamcs' link ports (``pus``, ``cfdp``)."""
+    ``obc``: (host, port) of its PUS process; ``ports``: Yamcs' link ports (``pus``, ``cfdp``);
+    ``listen``: the address of its UDP socket (loopback; this machine's address on the OBC's
+    network when the OBC runs elsewhere)."""
 
-    def __init__(self, ids, obc, ports):
+    def __init__(self, ids, obc, ports, listen="127.0.0.1"):
         host, port = obc
         self.obc = (host, port)
         pus_apid = ids.pus_apid
@@ -42,6 +44,7 @@ class ObcLink:
             apids={"cfdp": [cfdp_apid]},
             tm_port=ids.ports.cfdp_ground,
             routes={pus_apid: (host, port), cfdp_apid: (host, ids.ports.cfdp)},
+            udp_host=listen,
         )
         self._stop = threading.Event()
         self._thread = None

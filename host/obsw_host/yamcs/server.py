@@ -131,10 +131,13 @@ class Yamcs:
     """A Yamcs server process on an instance folder, with its log in ``folder/yamcs.log``.
 
     Start it from a thread that lives as long as it should run (the main thread): on Linux it
-    ends with the thread that started it."""
+    ends with the thread that started it. ``address``: the address its web interface and API
+    listen on, as its ``yamcs.yaml`` says (loopback unless operators reach it from elsewhere;
+    an "any" address is kept on loopback, see ``loopback_guard``)."""
 
-    def __init__(self, folder, http_port, instance="obsw", env=None):
+    def __init__(self, folder, http_port, instance="obsw", env=None, address="127.0.0.1"):
         self.folder = folder
+        self.address = address  # where its web interface and API listen
         self.http_port = http_port
         self.instance = instance
         self.env = env
@@ -143,7 +146,7 @@ class Yamcs:
 
     @property
     def url(self):
-        return "http://127.0.0.1:%d" % self.http_port
+        return "http://%s:%d" % (self.address, self.http_port)
 
     def start(self, timeout=60.0):
         """Start Yamcs and return once the instance runs (TimeoutError, with the log's tail,

@@ -7,7 +7,6 @@ spacecraft only. Skipped with the reason without Java or the Yamcs jars.
 """
 
 import os
-import socket
 
 import pytest
 from obsw_host.ids import MissionIds
@@ -22,36 +21,13 @@ pytestmark = pytest.mark.skipif(MISSING is not None, reason=str(MISSING))
 TIMEOUT = 30.0
 
 
-def free_fleet_base(count, step=new.FLEET_STEP):
-    """A port base for ``count`` missions ``step`` apart with every port of theirs free."""
-    for base in range(30000, 60000 - count * step - 5100, 997):
-        ports = set()
-        for k in range(count):
-            b = base + k * step
-            ports |= {b - 1, b, b + 10, b + 100, b + 101, b + 3090} | set(
-                range(b + 5015, b + 5019)
-            )
-        try:
-            for port in ports:
-                for kind in (socket.SOCK_DGRAM, socket.SOCK_STREAM):
-                    s = socket.socket(socket.AF_INET, kind)
-                    try:
-                        s.bind(("127.0.0.1", port))
-                    finally:
-                        s.close()
-        except OSError:
-            continue
-        return base
-    raise RuntimeError("no free port base for %d missions" % count)
-
-
 class Fleet:
     """Three `obsw obc serve` and one `obsw yamcs run` operating them, with Yamcs' client."""
 
     def __init__(self, work):
         from yamcs.client import YamcsClient
 
-        base = free_fleet_base(COUNT)
+        base = new.free_fleet_base(COUNT)
         self.folders = new.fleet(SAMPLE, "fleet", work, COUNT, port_base=base)
         self.missions = [MissionIds.locate(f) for f in self.folders]
         self.names = [ids.name for ids in self.missions]

@@ -96,29 +96,6 @@ def child(args):
 # ------------------------------------------------------------------------------ parent
 
 
-def free_base(count, step):
-    """A port base for ``count`` missions ``step`` apart with every port of theirs free."""
-    for base in range(30000, 60000 - count * step - 5100, 997):
-        ports = set()
-        for k in range(count):
-            b = base + k * step
-            ports |= {b - 1, b, b + 10, b + 100, b + 101, b + 3090} | set(
-                range(b + 5015, b + 5019)
-            )
-        try:
-            for port in ports:
-                for kind in (socket.SOCK_DGRAM, socket.SOCK_STREAM):
-                    s = socket.socket(socket.AF_INET, kind)
-                    try:
-                        s.bind(("127.0.0.1", port))
-                    finally:
-                        s.close()
-        except OSError:
-            continue
-        return base
-    raise RuntimeError("no free port base for %d missions" % count)
-
-
 def proc_cpu(pid):
     """User + system CPU seconds of process ``pid`` (Linux /proc)."""
     with open("/proc/%d/stat" % pid) as f:
@@ -144,7 +121,7 @@ class Setup:
         from obsw_host.yamcs.instance import Member, write_fleet
 
         os.environ.pop("OBSW_PORT_BASE", None)  # each mission its own base
-        base = free_base(count, new.FLEET_STEP)
+        base = new.free_fleet_base(count)
         folders = new.fleet(SAMPLE, "sc", os.path.join(folder, "missions"), count, port_base=base)
         self.missions = [MissionIds.locate(f) for f in folders]
         self.names = [ids.name for ids in self.missions]

@@ -136,3 +136,30 @@ def fleet(template, prefix, folder, count, scid=None, port_base=FLEET_BASE, step
              scid=first + k + (1 if scid is None else 0), port_base=port_base + k * step)
         for k in range(count)
     ]  # fmt: skip
+
+
+def free_fleet_base(count, step=FLEET_STEP, host="127.0.0.1"):
+    """A port base for ``count`` missions ``step`` apart with every port of theirs (the OBC's,
+    the gateway's and Yamcs') free on ``host`` now: for tests and benchmarks that run a fleet
+    beside other jobs."""
+    import socket
+
+    for base in range(30000, 60000 - count * step - 5100, 997):
+        ports = set()
+        for k in range(count):
+            b = base + k * step
+            ports |= {b - 1, b, b + 10, b + 100, b + 101, b + 3090} | set(
+                range(b + 5015, b + 5019)
+            )
+        try:
+            for port in ports:
+                for kind in (socket.SOCK_DGRAM, socket.SOCK_STREAM):
+                    s = socket.socket(socket.AF_INET, kind)
+                    try:
+                        s.bind((host, port))
+                    finally:
+                        s.close()
+        except OSError:
+            continue
+        return base
+    raise RuntimeError("no free port base for %d missions" % count)

@@ -307,12 +307,15 @@ def _file(path, size, seed):
     return data[:size]
 
 
-def _bucket_file(path, timeout=TIMEOUT):
+def _bucket_file(path, size, timeout=TIMEOUT):
     """The file Yamcs stored in a bucket. Yamcs may announce a received transfer complete a
-    moment before the file is in the bucket and offers no notification for that, so this one
-    place polls the folder (at most ``timeout`` s)."""
+    moment before the file is in the bucket, or while it is still writing it, and offers no
+    notification for that, so this one place polls the folder until the file has ``size``
+    octets (at most ``timeout`` s)."""
     end = time.monotonic() + timeout
-    while not os.path.exists(path) and time.monotonic() < end:
+    while time.monotonic() < end:
+        if os.path.exists(path) and os.path.getsize(path) >= size:
+            break
         time.sleep(0.02)
     with open(path, "rb") as f:
         return f.read()
@@ -350,7 +353,8 @@ def test_cfdp_download_to_yamcs(ground, mode, reliable):
     assert sat.wait_finished(tid, "S", timeout=TIMEOUT) is not None
     tx = ground.transfers[mode].wait(_transfer_done(name), mark)
     assert tx.state == "COMPLETED", tx.error
-    assert _bucket_file(os.path.join(ground.folder, "files", mode, "down", name)) == data
+    path = os.path.join(ground.folder, "files", mode, "down", name)
+    assert _bucket_file(path, len(data)) == data
 
 
 def test_lost_frame_is_retransmitted_by_cop1(ground):

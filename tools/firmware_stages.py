@@ -16,9 +16,9 @@ import subprocess
 import sys
 import time
 
+from obsw_host import firmware
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tools"))
-import firmware  # noqa: E402
 
 CORE_TESTS = sorted((ROOT / "tests" / "core").glob("test_*.py"))
 # Core tests that cannot run on a board with the Pyboard's heap and float, and why (counted as

@@ -67,11 +67,8 @@ def frozen_modules():
 
 
 def firmware_tools():
-    """tools/firmware.py of this repository (the pinned-source builds and the QEMU board)."""
-    tools = os.path.join(repo_root(), "tools")
-    if tools not in sys.path:
-        sys.path.insert(0, tools)
-    import firmware
+    """``obsw_host.firmware``: the pinned-source builds and the QEMU board."""
+    from obsw_host import firmware
 
     return firmware
 

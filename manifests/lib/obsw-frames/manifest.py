@@ -20,6 +20,7 @@ package(
         "gcm.py",
         "processor.py",
         "randomizer.py",
+        "rs.py",
         "sdls.py",
         "sdls_ep.py",
         "sdls_gcm.py",

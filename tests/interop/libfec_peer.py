@@ -58,6 +58,10 @@ class LibFec:
             ctypes.c_uint,
         ]
         lib.delete_viterbi27.argtypes = [ctypes.c_void_p]
+        # CCSDS: G1 = 171, G2 = 133 octal, G2 inverted; libfec writes the taps current bit
+        # first (0x4F, 0x6D) and takes a negative polynomial for an inverted symbol. Its SIMD
+        # decoders have no branch table until this is called.
+        lib.set_viterbi27_polynomial((ctypes.c_int * 2)(0x4F, -0x6D))
         taltab = (ctypes.c_ubyte * 256).in_dll(lib, "Taltab")
         self.taltab = bytes(taltab)  # conventional -> dual basis
         inv = bytearray(256)
@@ -97,8 +101,8 @@ class LibFec:
         return conv.raw.translate(self.taltab), n
 
     def viterbi27(self, symbols, nbits):
-        """Decode ``nbits`` data bits (the last 6 of them the zero tail) from 2 * nbits soft
-        symbols (0 = strong zero, 255 = strong one; CCSDS G2 inverted back by the caller)."""
+        """Decode ``nbits`` bits (the last 6 of them the zero tail) from 2 * nbits soft
+        symbols (0 = strong zero, 255 = strong one) as CCSDS sends them, G2 inverted."""
         vp = self.lib.create_viterbi27(nbits)
         try:
             self.lib.init_viterbi27(vp, 0)

@@ -14,6 +14,7 @@ package(
         "bch.py",
         "clcw.py",
         "cltu.py",
+        "conv.py",
         "dedup.py",
         "errors.py",
         "farm.py",

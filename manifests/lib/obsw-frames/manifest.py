@@ -27,7 +27,6 @@ package(
         "sdls_gcm.py",
         "sdls_keys.py",
         "sdls_mac.py",
-        "sync.py",
         "tc.py",
         "tm.py",
         "tm_coding.py",

@@ -107,8 +107,11 @@ class ReedSolomon:
         self.k = N - 2 * e
         if length is None:
             length = self.k * depth
-        if length % depth or not depth <= length <= self.k * depth:
+        if not depth <= length <= self.k * depth:
             raise FrameLengthError("RS codeblock data", self.k * depth, length)
+        if length % depth:
+            what = "RS codeblock data (a multiple of the interleaving depth %d)" % depth
+            raise FrameLengthError(what, length - length % depth, length)
         self.length = length
         self.fill = self.k - length // depth  # virtual fill per codeword
         self.block_length = length + self.parity * depth

@@ -1,6 +1,6 @@
 """Frame error rate against Eb/N0 for uncoded, RS, convolutional and concatenated TM coding.
 
-coding_gain.py [--frames N] [--png docs/channel-coding.png] [--json FILE]
+coding_gain.py [--frames N] [--png docs/channel-coding.png] [--json FILE] [--replot FILE]
 BPSK over AWGN, soft symbols quantized to signed 8 bits for the Viterbi decoder, hard
 decisions for RS alone; TM frames of 1115 octets (8920 bits, the length of CCSDS 130.1-G's
 curves), RS(255,223) interleaved I=5, the pseudo-randomizer on, frame synchronization assumed
@@ -106,7 +106,13 @@ def main(argv=None):
     ap.add_argument("--png", default=str(ROOT / "docs" / "channel-coding.png"))
     ap.add_argument("--json", help="also write the points to this file")
     ap.add_argument("--only", choices=sorted(GRID), action="append", help="curves to run")
+    ap.add_argument("--replot", help="only plot the points of an earlier --json file")
     args = ap.parse_args(argv)
+    if args.replot:
+        results = json.loads(pathlib.Path(args.replot).read_text())
+        frames = max(n for pts in results.values() for _, _, n in pts)
+        plot(results, args.png, frames)
+        return 0
     rng = np.random.default_rng(2026)
     results = {}
     for name in args.only or GRID:

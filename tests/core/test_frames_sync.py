@@ -193,6 +193,19 @@ class TestChains(unittest.TestCase):
         self.assertEqual(dec.uncorrectable, 1)
         self.assertEqual([g.data for g in got[1:]], frames[1:])
 
+    def test_conv_stream_joined_mid_pair_realigns(self):
+        rnd = Lcg(11)
+        frames = [rnd.data(30) for _ in range(12)]
+        enc = tm_coding.TmEncoder(30, "conv")
+        bits = sync.unpack_bits(b"".join(enc.encode(f) for f in frames))[1:]  # one symbol lost
+        dec = tm_coding.TmDecoder(30, "conv", realign=2)
+        got = []
+        for i in range(0, len(bits), 500):
+            got += dec.feed_soft([1 if b else -1 for b in bits[i : i + 500]])
+        got += dec.flush()
+        datas = [g.data for g in got]
+        self.assertEqual(datas[-4:], frames[-4:])
+
     def test_bad_coding_name(self):
         with self.assertRaises(ValueError):
             tm_coding.TmEncoder(100, "turbo")

@@ -102,8 +102,7 @@ class TmDecoder:
             self._unlocked += len(bits)
             if self._unlocked > self._realign:
                 self._unlocked = 0
-                self.viterbi.reset(None)
-                self.viterbi._pending = self.viterbi._pending[1:] if self.viterbi._pending else [0]
+                self.viterbi.realign()
         else:
             self._unlocked = 0
         return out

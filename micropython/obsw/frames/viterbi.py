@@ -56,6 +56,15 @@ class Viterbi27:
         # C path: 8 octets of decisions per bit; Python: one int per bit
         self._decisions = bytearray() if self._c else []
         self._pending = []
+        self._skip = False
+
+    def realign(self):
+        """Start again one symbol later: the C1/C2 pairing of a stream joined in the middle
+        was wrong (the symbol held back, if any, is dropped, else the next one will be)."""
+        pending = self._pending[1:] if self._pending else None
+        self.reset(None)
+        self._skip = pending is None
+        self._pending = pending or []
 
     def metric_spread(self):
         """Best path metric minus the mean: grows with clean symbols, a symbol-pair slip or
@@ -69,6 +78,9 @@ class Viterbi27:
 
     def feed(self, soft):
         """Take soft symbols; return the bits now decided (one per octet, 0 or 1)."""
+        if self._skip and len(soft):
+            self._skip = False
+            soft = soft[1:]
         if self._pending:
             soft = self._pending + list(soft)
         n = len(soft) & ~1

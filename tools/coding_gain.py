@@ -166,7 +166,7 @@ def plot(results, png, frames):
     ax.set_ylabel("frame error rate")
     ax.set_title("CCSDS 131.0-B coding gain, BPSK on AWGN, %d frames per point" % frames)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, loc="lower left")
+    ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
     fig.savefig(png, dpi=110)
     print("wrote", png)

@@ -21,7 +21,7 @@ from obsw_host.frames import keys
 from obsw_host.frames.ground import Ground
 from obsw_host.frames.links import FdLink, SerialLink, open_pty_pair
 from obsw_host.frames.processor import FrameProcessorHost, sdb_events
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 from obsw_host.net import DEFAULT_HOST
 from obsw_host.sample import SDB_PATH
 

@@ -8,7 +8,7 @@ an action (service 19), and a time-tagged TC (service 11) runs at its release ti
 
 import sys
 
-from obsw_host.ports import app_port
+from obsw_host.mission.ports import app_port
 from obsw_host.sample import SDB_PATH, load_sdb
 
 

@@ -30,7 +30,7 @@ from obsw.spp import TYPE_TC, TYPE_TM
 from obsw.store import Store
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 
 HK_STORE = 1
 SCID = MissionIds.sample().scid  # the sample spacecraft's

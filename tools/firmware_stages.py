@@ -318,7 +318,7 @@ def board_update(pty):
     sys.path[:0] = [str(ROOT / "host"), str(ROOT / "micropython")]
     from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
     from obsw_host import board
-    from obsw_host.ids import MissionIds
+    from obsw_host.mission.ids import MissionIds
     from obsw_host.reconfig import board_file
     from obsw_host.update import build as b
 

@@ -304,7 +304,7 @@ def update(package, port=None):
 
 def _update_key(ids):
     """The mission's update public key file, or None."""
-    from obsw_host.obc import defaults
+    from obsw_host.mission import defaults
 
     if ids.config is None:
         return None

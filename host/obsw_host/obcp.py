@@ -117,8 +117,8 @@ def run_args(args):
 
 def _mission_sdb(mission):
     """The database file of the mission (``locate``: one-line error when there is none)."""
-    from obsw_host.mission import locate
-    from obsw_host.obc import config
+    from obsw_host.mission import config
+    from obsw_host.mission.folder import locate
 
     return config.load(locate(mission)).sdb_path
 

@@ -1,9 +1,9 @@
-"""The chaos campaign's verdict (``obsw_host.chaos``) on made-up runs: what counts as lost, as
+"""The chaos campaign's verdict (``obsw_sim.chaos``) on made-up runs: what counts as lost, as
 declared, as a gap; the page it writes. The campaign itself is the `chaos` stage."""
 
 import types
 
-from obsw_host.chaos import Campaign, markdown, print_result
+from obsw_sim.chaos import Campaign, markdown, print_result
 
 
 class Tx:

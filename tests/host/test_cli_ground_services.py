@@ -8,7 +8,7 @@ import subprocess
 import sys
 
 import pytest
-from obsw_host.obc import config as obc_config
+from obsw_host.mission import config as obc_config
 from obsw_host.obc.platform import PlatformManager
 from test_obc_assembly import free_port, sample, wait_for, write_config
 

@@ -13,7 +13,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
 
 import check_imports  # noqa: E402
-from obsw_host.obc.config import MissionConfig  # noqa: E402
+from obsw_host.mission.config import MissionConfig  # noqa: E402
 
 
 def _load(name, path):

@@ -9,7 +9,7 @@ import shutil
 import pytest
 from obsw_host.cli import main
 from obsw_host.frames import keys, policy
-from obsw_host.obc import config as obc_config
+from obsw_host.mission import config as obc_config
 from obsw_host.obc.frames_unit import FramesUnit
 from obsw_host.obc.topology import Topology
 from obsw_host.sample import MISSION_DIR, MISSION_PATH

@@ -77,7 +77,7 @@ def test_can_hub_binds_loopback():
 
 def test_commands_default_to_loopback():
     parser = build_parser()
-    from obsw_host.obc.config import load
+    from obsw_host.mission.config import load
 
     assert load(MISSION_DIR).host == DEFAULT_HOST  # the sample binds loopback: it names none
     args = parser.parse_args(["frames", "processor", "--uart-a", "a", "--uart-b", "b"])

@@ -12,8 +12,8 @@ import time
 
 import pytest
 from obsw_host import sample
-from obsw_host.mission import MissionError, load, locate
-from obsw_host.mission.check import check
+from obsw_host.mission import MissionError, locate
+from obsw_host.mission.check import check, load
 from obsw_host.mission.upgrade import upgrade
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))

@@ -55,12 +55,11 @@ def test_every_schema_key_is_in_the_page():
 
 
 def test_the_schema_defaults_are_the_obcs():
-    """The defaults an editor shows (the schema's) are the ones the OBC uses (obc.defaults)."""
+    """The defaults an editor shows (the schema's) are the ones the OBC uses."""
     from obsw_host.mission import defaults
-    from obsw_host.obc import defaults as obc_defaults
 
-    for name, values in obc_defaults.SECTIONS.items():
-        assert defaults.section(name) == values, name
+    for name, values in defaults.SECTIONS.items():
+        assert defaults.schema_section(name) == values, name
 
 
 @pytest.fixture

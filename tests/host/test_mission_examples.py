@@ -17,7 +17,7 @@ import time
 import pytest
 from obsw.reconfig.node import definition_dict
 from obsw_host import sample
-from obsw_host.mission import load
+from obsw_host.mission.check import load
 from obsw_host.mission.new import TEMPLATE_DIR
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))

@@ -30,8 +30,8 @@ from obsw.spp import SpacePacket
 from obsw.timecode import Cuc
 from obsw_host import sample
 from obsw_host.cli import main
-from obsw_host.ids import MissionError, MissionIds
-from obsw_host.obc import config as obc_config
+from obsw_host.mission import config as obc_config
+from obsw_host.mission.ids import MissionError, MissionIds
 from obsw_host.obc.frames_unit import FramesUnit
 from obsw_host.obc.topology import Topology
 from obsw_host.obc.units import PusUnit

@@ -9,8 +9,8 @@ import shutil
 
 from obsw.pus import sdb as sdb_module
 from obsw.pus.services.mission import MissionService
-from obsw_host.ids import MissionIds
 from obsw_host.mission.check import check
+from obsw_host.mission.ids import MissionIds
 from obsw_host.pus.catalog import catalog
 from obsw_host.pus.onboard import SERVICES, service_table
 from obsw_host.yamcs import database

@@ -12,7 +12,7 @@ import pytest
 from obsw.pus import sdb as sdb_module
 from obsw.pus.services.s02_device_access import DeviceUser
 from obsw.pus.tm import PusTm
-from obsw_host.obc import config as obc_config
+from obsw_host.mission import config as obc_config
 from obsw_host.obc.platform import PlatformManager
 from obsw_host.pus.ground import Ground
 from obsw_host.sample import MISSION_DIR, MISSION_PATH

@@ -10,7 +10,7 @@ import sys
 import pytest
 from obsw_host.commands import obc as obc_command
 from obsw_host.il.processes import python_path
-from obsw_host.obc import config as obc_config
+from obsw_host.mission import config as obc_config
 from obsw_host.obc.platform import PlatformManager
 from obsw_host.obc.state import StateLock, StateLocked, default_state, reset
 from obsw_host.pus.ground import Ground

@@ -9,7 +9,7 @@ import signal
 from obsw.il.node import Node
 from obsw_host.il.processes import spawn, stop
 from obsw_host.il.transport import SocketTransport
-from obsw_host.obc import config as obc_config
+from obsw_host.mission import config as obc_config
 from obsw_host.obc.platform import PlatformManager
 from obsw_host.pus.ground import Ground
 from obsw_host.sample import MISSION_PATH

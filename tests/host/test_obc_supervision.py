@@ -16,15 +16,15 @@ from obsw.il.clock import SimClock
 from obsw.pus.app import ApplicationProcess
 from obsw.pus.parameters import ParameterPool
 from obsw.pus.services.s12_monitoring import OnBoardMonitoring
+from obsw_host.mission.config import ConfigError
 from obsw_host.obc import monitoring
 from obsw_host.obc import watchdog as wd
-from obsw_host.obc.config import ConfigError
 from obsw_host.obc.health import HostHealth, ObcHealth
 from obsw_host.obc.sdnotify import Notifier
 from obsw_host.obc.service import DEFAULTS, unit_text
 from obsw_host.obc.supervision import Supervision
-from obsw_host.obc.watchdog_sim import SimulatedWatchdog
 from obsw_host.sample import load_sdb
+from obsw_sim.watchdog import SimulatedWatchdog
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 OBSW = os.path.join(os.path.dirname(sys.executable), "obsw")

@@ -9,12 +9,12 @@ import signal
 
 from obsw.il.node import Node
 from obsw_host.il.transport import SocketTransport
-from obsw_host.obc import config as obc_config
+from obsw_host.mission import config as obc_config
 from obsw_host.obc import watchdog as wd
 from obsw_host.obc.platform import PlatformManager
 from obsw_host.obc.sdnotify import Notifier
-from obsw_host.obc.watchdog_sim import SimulatedWatchdog
 from obsw_host.pus.ground import Ground
+from obsw_sim.watchdog import SimulatedWatchdog
 from test_obc_assembly import free_port, sample, wait_for, write_config
 from test_obc_supervision import FakeSystemd, fake_tree
 

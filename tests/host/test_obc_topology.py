@@ -5,7 +5,7 @@ import json
 import os
 
 import pytest
-from obsw_host.obc import config as obc_config
+from obsw_host.mission import config as obc_config
 from obsw_host.obc import registry
 from obsw_host.obc.plugins import Component, PluginError, component_for
 from obsw_host.obc.topology import Topology

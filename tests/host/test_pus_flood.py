@@ -105,7 +105,7 @@ def free_port():
 
 
 def test_flood_into_the_obc_core_process(tmp_path):
-    from obsw_host.obc import config as obc_config
+    from obsw_host.mission import config as obc_config
     from obsw_host.obc.assembly import ObcProcess
     from obsw_host.sample import MISSION_DIR, MISSION_PATH
 

@@ -8,7 +8,7 @@ from obsw.pus.messages import FAILURE_OUT_OF_RANGE
 from obsw.pus.services.s20_parameters import RangeError
 from obsw.store import Store
 from obsw_host.commands import ground as ground_command
-from obsw_host.ports import app_port
+from obsw_host.mission.ports import app_port
 from obsw_host.pus.ground import Ground, PusTimeout
 from obsw_host.pus.onboard import Onboard
 from obsw_host.sample import SDB_PATH, load_sdb

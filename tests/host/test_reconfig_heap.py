@@ -9,7 +9,7 @@ import os
 import subprocess
 
 import pytest
-from obsw_host.reconfig.sim import compile_controller, micropython_binary, mpy_cross_binary
+from obsw_sim.reconfig import compile_controller, micropython_binary, mpy_cross_binary
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 

@@ -9,9 +9,9 @@ from obsw.reconfig.essential import HPC_POWER_CYCLE, Hpc
 from obsw.reconfig.hal import NOMINAL, REDUNDANT
 from obsw.reconfig.node import definition_dict
 from obsw_host.mission.new import TEMPLATE_DIR
-from obsw_host.reconfig import simhal as W
-from obsw_host.reconfig.sim import ReconfigSim, micropython_binary
 from obsw_host.sample import CPDU_NODE_PATH
+from obsw_sim import reconfig_hal as W
+from obsw_sim.reconfig import ReconfigSim, micropython_binary
 
 pytestmark = pytest.mark.skipif(
     micropython_binary() is None or not hasattr(os, "openpty"),

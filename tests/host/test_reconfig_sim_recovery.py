@@ -7,8 +7,8 @@ import time
 
 import pytest
 from obsw.reconfig.recovery import DEFAULTS
-from obsw_host.obc.defaults import RECOVERY, section
-from obsw_host.reconfig.sim import ReconfigSim, micropython_binary
+from obsw_host.mission.defaults import RECOVERY, section
+from obsw_sim.reconfig import ReconfigSim, micropython_binary
 
 pytestmark = pytest.mark.skipif(
     micropython_binary() is None or not hasattr(os, "openpty"),

@@ -13,7 +13,7 @@ import sys
 
 import pytest
 from obsw_host import sample
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 from obsw_host.pus.ground import Ground, PusTimeout
 from obsw_host.update import build as b
 from test_obc_assembly import wait_for

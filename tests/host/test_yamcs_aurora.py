@@ -18,7 +18,7 @@ import threading
 import time
 
 import pytest
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 from obsw_host.update import build as update_build
 from obsw_host.yamcs import server
 from obsw_host.yamcs.instance import instance_name

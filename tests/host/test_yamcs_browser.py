@@ -24,7 +24,7 @@ try:  # an optional development dependency: without it the tests here skip, sayi
     from playwright.sync_api import expect, sync_playwright
 except ImportError:
     expect = sync_playwright = None
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 from obsw_host.solar_panel import SolarPanel
 from obsw_host.yamcs import server
 from obsw_host.yamcs.instance import instance_name

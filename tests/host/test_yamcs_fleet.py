@@ -9,8 +9,8 @@ spacecraft only. Skipped with the reason without Java or the Yamcs jars.
 import os
 
 import pytest
-from obsw_host.ids import MissionIds
 from obsw_host.mission import new
+from obsw_host.mission.ids import MissionIds
 from obsw_host.yamcs import server
 from test_yamcs_aurora import _start, _stop
 from test_yamcs_e2e import Watch

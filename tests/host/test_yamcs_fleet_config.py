@@ -10,9 +10,9 @@ import subprocess
 import sys
 
 import pytest
-from obsw_host.ids import MissionIds
 from obsw_host.mission import new
 from obsw_host.mission.check import check
+from obsw_host.mission.ids import MissionIds
 from obsw_host.yamcs import fleet, server
 
 MISSING = server.missing()

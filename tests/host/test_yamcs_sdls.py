@@ -16,7 +16,7 @@ from obsw.frames.cltu import encode
 from obsw.frames.sdls_gcm import GcmSecurityAssociation
 from obsw.frames.tc import TcFrame
 from obsw_host.frames import keys
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 from obsw_host.sample import SDB_PATH
 from obsw_host.yamcs import database, instance, server
 from obsw_host.yamcs.spacecraft import ASM, SampleSpacecraft

@@ -1,4 +1,4 @@
-"""The twelve-step chain end to end (``obsw_host.obc.chain``), then its faults: each OBC process
+"""The twelve-step chain end to end (``obsw_sim.chain``), then its faults: each OBC process
 killed in turn, bus A cut, UART A cut, the whole OBC killed and power-cycled by the
 reconfiguration module on an essential TC, the whole OBC hung and power-cycled by the module
 alone. It runs for the sample (in three processes) and for aurora (its own processes, its
@@ -13,8 +13,8 @@ import time
 import pytest
 from obsw.reconfig.essential import HPC_POWER_CYCLE, Hpc
 from obsw.spacecan.master import MASTER
-from obsw_host.obc.chain import Chain
-from obsw_host.reconfig.sim import micropython_binary
+from obsw_sim.chain import Chain
+from obsw_sim.reconfig import micropython_binary
 
 pytestmark = pytest.mark.skipif(
     micropython_binary() is None or not hasattr(os, "openpty"),

@@ -1,4 +1,4 @@
-"""Benchmark: TC-to-completion latency through the whole chain (``obsw_host.obc.chain``).
+"""Benchmark: TC-to-completion latency through the whole chain (``obsw_sim.chain``).
 
 One run starts the chain (ground station, pseudo-terminal UARTs, the OBC as three processes
 under its platform manager, the CAN hub and both MicroPython reconfiguration controllers) and
@@ -22,7 +22,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
-from obsw_host.obc.chain import SWITCH, Chain  # noqa: E402
+from obsw_sim.chain import SWITCH, Chain  # noqa: E402
 
 
 def percentiles(samples):

@@ -31,7 +31,7 @@ sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 from obsw.pus.tc import PusTc  # noqa: E402
 from obsw.pus.tm import PusTm  # noqa: E402
 from obsw_host.il.processes import python_path  # noqa: E402
-from obsw_host.obc.config import load as load_config  # noqa: E402
+from obsw_host.mission.config import load as load_config  # noqa: E402
 from obsw_host.obc.topology import Topology  # noqa: E402
 from obsw_host.sample import MISSION_DIR  # noqa: E402
 

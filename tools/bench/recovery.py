@@ -16,7 +16,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
-from obsw_host.reconfig.sim import ReconfigSim  # noqa: E402
+from obsw_sim.reconfig import ReconfigSim  # noqa: E402
 
 BOOT = 5.0  # s of simulated OBC boot (the OBC process sleeps this long before its first word)
 

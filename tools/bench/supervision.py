@@ -25,7 +25,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
-from obsw_host.obc import config as obc_config  # noqa: E402
+from obsw_host.mission import config as obc_config  # noqa: E402
 from obsw_host.obc.platform import PlatformManager  # noqa: E402
 from obsw_host.sample import MISSION_DIR, MISSION_PATH  # noqa: E402
 

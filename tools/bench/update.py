@@ -15,7 +15,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
 from obsw_host.update import build as b  # noqa: E402
-from obsw_host.update.rig import CRASH, DEADLINE, HEALTHY_AFTER, UpdateRig, wait  # noqa: E402
+from obsw_sim.update_rig import CRASH, DEADLINE, HEALTHY_AFTER, UpdateRig, wait  # noqa: E402
 
 
 def measure(quick):

@@ -46,7 +46,7 @@ def child(args):
     ``RATE SECONDS`` line of standard input that many HK packets per second sent through it;
     answers each with the count sent."""
     from obsw.pus.tm import PusTm
-    from obsw_host.ids import MissionIds
+    from obsw_host.mission.ids import MissionIds
     from obsw_host.pus.onboard import tai_now
     from obsw_host.yamcs.gateway import PacketGateway
 
@@ -115,8 +115,8 @@ class Setup:
     """N missions, one Yamcs with an instance each, and a link child per spacecraft."""
 
     def __init__(self, count, folder):
-        from obsw_host.ids import MissionIds
         from obsw_host.mission import new
+        from obsw_host.mission.ids import MissionIds
         from obsw_host.yamcs import database, fleet, server
         from obsw_host.yamcs.instance import Member, write_fleet
 

@@ -3,7 +3,7 @@
 import signal
 import sys
 
-from obsw_host import ids as mission_ids
+from obsw_host.mission import ids as mission_ids
 
 
 def add_parser(sub):
@@ -118,10 +118,11 @@ def _mission(args):
     """The ids of the mission deploy names or finds, or None when there is none to find (a
     mission found with a mistake stops the deploy before anything is copied)."""
     from obsw_host.errors import UserError
+    from obsw_host.mission.folder import locate
 
     if getattr(args, "mission", None) is None and getattr(args, "sdb", None) is None:
         try:
-            mission_ids.locate(None)
+            locate(None)
         except UserError:
             return None
     ids = mission_ids.from_args(args)

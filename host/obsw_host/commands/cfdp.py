@@ -1,8 +1,8 @@
 """`obsw cfdp`: put and get files over CFDP, ask a remote entity for status, run an entity.
 
 Entity ids, the CFDP APID and the ports come from the mission (``--mission DIR``, see
-``obsw_host.ids``): a ground client is the ground filestore's entity and talks to the onboard
-one on the mission's CFDP port; ``serve`` runs the onboard entity, its peer the ground's.
+``obsw_host.mission.ids``): a ground client is the ground filestore's entity and talks to the
+onboard one on the mission's CFDP port; ``serve`` runs the onboard entity, its peer the ground's.
 """
 
 import argparse
@@ -10,8 +10,8 @@ import os
 import sys
 import time
 
-from obsw_host import ids as mission_ids
 from obsw_host.cfdp.client import parse_transaction
+from obsw_host.mission import ids as mission_ids
 from obsw_host.net import DEFAULT_HOST
 
 

@@ -5,8 +5,8 @@ mission (``--mission DIR``) unless an option gives them."""
 import binascii
 import json
 
-from obsw_host import ids as mission_ids
 from obsw_host.errors import UserError, user_message
+from obsw_host.mission import ids as mission_ids
 from obsw_host.net import DEFAULT_HOST
 
 

@@ -56,9 +56,9 @@ import json
 import os
 import sys
 
-from obsw_host import ids as mission_ids
-from obsw_host.commands import arguments
+from obsw_host.commands import arguments, session
 from obsw_host.errors import UserError
+from obsw_host.mission import ids as mission_ids
 from obsw_host.net import DEFAULT_HOST
 
 
@@ -130,7 +130,7 @@ def add_parser(sub):
     x.set_defaults(func=_hk_interval)
     x = hk.add_parser("listen", help="print periodic reports")
     x.add_argument("--seconds", type=arguments.seconds, default=3.0)
-    x.set_defaults(func=_listen, listen=(3, 25))
+    x.set_defaults(func=session.listen, listen=(3, 25))
     ground_services.add_to_hk(hk)  # obsw ground hk append
 
     pa = s.add_parser("params", help="service 20 parameters").add_subparsers(dest="params")
@@ -152,7 +152,7 @@ def add_parser(sub):
         x.set_defaults(func=_events_switch, ev_action=name)
     x = ev.add_parser("listen", help="print event reports")
     x.add_argument("--seconds", type=arguments.seconds, default=3.0)
-    x.set_defaults(func=_listen, listen=(5, None))
+    x.set_defaults(func=session.listen, listen=(5, None))
 
     _add_automation(s)
 
@@ -163,7 +163,7 @@ def add_parser(sub):
     x.set_defaults(func=_time_rate)
     x = ti.add_parser("listen", help="print time reports (CUC TM[9,2] or CDS TM[9,3])")
     x.add_argument("--seconds", type=arguments.seconds, default=3.0)
-    x.set_defaults(func=_listen, listen=(9, None))
+    x.set_defaults(func=session.listen, listen=(9, None))
 
 
 def _add_automation(s):
@@ -289,35 +289,6 @@ def _raw():
     return argparse.RawDescriptionHelpFormatter
 
 
-def _ground(args):
-    from obsw_host.pus.ground import Ground
-    from obsw_host.pus.monitor import SessionLog
-
-    ids = mission_ids.from_args(args)
-    apid = args.apid if args.apid is not None else ids.pus_apid
-    target = (args.host, _port(args, ids, apid))
-    log = (lambda s: print(s, file=sys.stderr)) if args.verbose else None
-    session = SessionLog(args.log) if getattr(args, "log", None) else None
-    g = Ground(
-        ids.sdb,
-        apid=apid,
-        target=target,
-        timeout=args.timeout,
-        log=log,
-        session=session,
-        source_id=ids.source_id,
-        config=ids.pus_config,
-    )
-    return _fresh(g)
-
-
-def _port(args, ids, apid):
-    """The on-board UDP port: ``--port``, else the mission's port of process ``apid``."""
-    if args.port is not None:
-        return args.port
-    return ids.ports.pus if apid == ids.apid("pus") else ids.ports.app(apid)
-
-
 def _colour(args):
     return args.colour == "always" or (args.colour == "auto" and sys.stdout.isatty())
 
@@ -331,7 +302,7 @@ def _monitor_live(args):
     from obsw_host.pus.tm_fanout import LINGER
 
     seen = [0]
-    with _ground(args) as g:
+    with session.ground(args) as g:
         display = Display(g.sdb, _colour(args), getattr(args, "raw", False), g.proc.config)
 
         def show(tm, decoded, tx):
@@ -380,62 +351,23 @@ def _list(args):
     if args.kind == "obcps":
         from obsw_host.pus.obcp_ground import ObcpGround
 
-        return _run(args, lambda g: ObcpGround(g).report_status())
+        return session.run(args, lambda g: ObcpGround(g).report_status())
     from obsw_host.pus.storage_ground import StorageGround
 
     repository = args.repository or "%s:/" % mission_ids.from_args(args).local_prefix
-    return _run(args, lambda g: StorageGround(g).directory(repository))
-
-
-def _run(args, fn):
-    from obsw_host.pus import display, text
-    from obsw_host.pus.ground import PusTimeout
-
-    with _ground(args) as g:
-        try:
-            tx = fn(g)
-        except PusTimeout as e:
-            tx = e.transaction
-        sdb = g.sdb
-        target = g.target
-    result = text.transaction(tx)
-    detail = display.failure_detail(tx, sdb)  # the component's error by name
-    if args.json:
-        if detail:
-            result["failure_detail"] = detail
-        print(json.dumps(result))
-        return 0 if tx.ok else 1
-    for line in tx.verification():
-        if "failure" in line and detail:  # the data decoded replaces its hex
-            line = "%s (%s)" % (line.split(" data ")[0], detail)
-        print("  " + line)
-    for reply in tx.replies:
-        print(display.readable(reply, sdb, getattr(args, "raw", False)))  # names, tables
-    if not tx.done:
-        print(_no_answer(args, tx, target))
-    return 0 if tx.ok else 1
-
-
-def _no_answer(args, tx, target):
-    if not tx.verification():
-        return "no report from %s:%s within %ss: is `obsw obc serve` running there?" % (
-            target[0],
-            target[1],
-            args.timeout,
-        )
-    return "no completion report within %ss" % args.timeout
+    return session.run(args, lambda g: StorageGround(g).directory(repository))
 
 
 def _ping(args):
-    return _run(args, lambda g: g.ping())
+    return session.run(args, lambda g: g.ping())
 
 
 def _connection(args):
-    return _run(args, lambda g: g.connection_test(args.target))
+    return session.run(args, lambda g: g.connection_test(args.target))
 
 
 def _hk_report(args):
-    return _run(args, lambda g: g.housekeeping(args.sid))
+    return session.run(args, lambda g: g.housekeeping(args.sid))
 
 
 def _hk_sids(args):
@@ -446,31 +378,20 @@ def _hk_sids(args):
         "disable": "disable_hk",
         "delete": "delete_hk",
     }[args.hk_action]
-    return _run(args, lambda g: getattr(g, method)(args.sids))
-
-
-def _key(text):
-    return int(text) if text.isdigit() else text
+    return session.run(args, lambda g: getattr(g, method)(args.sids))
 
 
 def _hk_create(args):
-    params = [_key(p) for p in args.parameters]
-    return _run(args, lambda g: g.create_hk(args.sid, args.interval, params))
+    params = [session.key(p) for p in args.parameters]
+    return session.run(args, lambda g: g.create_hk(args.sid, args.interval, params))
 
 
 def _hk_interval(args):
-    return _run(args, lambda g: g.set_hk_interval(args.sid, args.interval))
+    return session.run(args, lambda g: g.set_hk_interval(args.sid, args.interval))
 
 
 def _params_get(args):
-    return _run(args, lambda g: g.get_parameters(*[_key(n) for n in args.names]))
-
-
-def _value(text):
-    try:
-        return json.loads(text)
-    except ValueError:
-        return text
+    return session.run(args, lambda g: g.get_parameters(*[session.key(n) for n in args.names]))
 
 
 def _params_set(args):
@@ -479,112 +400,26 @@ def _params_set(args):
         name, sep, value = a.partition("=")
         if not sep:
             raise UserError("parameter assignment %r" % a, expected="NAME=VALUE")
-        values[_key(name)] = _value(value)
-    return _run(args, lambda g: g.set_parameters(values, raw=args.raw))
+        values[session.key(name)] = session.value(value)
+    return session.run(args, lambda g: g.set_parameters(values, raw=args.raw))
 
 
 def _events_disabled(args):
-    return _run(args, lambda g: g.disabled_events())
+    return session.run(args, lambda g: g.disabled_events())
 
 
 def _events_switch(args):
-    keys = [_key(n) for n in args.names]
+    keys = [session.key(n) for n in args.names]
     if args.ev_action == "enable":
-        return _run(args, lambda g: g.enable_events(keys))
-    return _run(args, lambda g: g.disable_events(keys))
+        return session.run(args, lambda g: g.enable_events(keys))
+    return session.run(args, lambda g: g.disable_events(keys))
 
 
 def _time_rate(args):
-    return _run(args, lambda g: g.set_time_rate(args.exponent))
-
-
-def _listen(args):
-    """Print TM of one type for a while (subscribed: TM caused by any client comes too)."""
-    import time
-
-    from obsw_host.pus import text
-    from obsw_host.pus.monitor import Display
-
-    service, subtype = args.listen
-    n = 0
-    with _ground(args) as g:
-        display = Display(g.sdb, raw=getattr(args, "raw", False), config=g.proc.config)
-        g.subscribe()
-        print(
-            "listening for TM[%s,%s] from %s:%d for %gs"
-            % (service, subtype or "*", g.target[0], g.target[1], args.seconds),
-            file=sys.stderr,
-            flush=True,
-        )
-        end = time.monotonic() + args.seconds
-        seen = len(g.received)
-        while time.monotonic() < end:
-            g.poll(min(0.1, max(0.0, end - time.monotonic())))
-            for tm, decoded in g.received[seen:]:
-                if service == 3 and decoded and "raw" in decoded:
-                    decoded = _learn(g, tm, decoded)
-                if tm.service == service and (subtype is None or tm.subtype == subtype):
-                    n += 1
-                    if args.json:
-                        value = {"type": [tm.service, tm.subtype], "value": text.plain(decoded)}
-                        print(json.dumps(value), flush=True)
-                    else:
-                        print(display.tm(tm, decoded), flush=True)
-            seen = len(g.received)
-    if not n:
-        print("no TM[%s,%s] within %ss" % (service, subtype or "*", args.seconds), file=sys.stderr)
-    return 0
-
-
-def _learn(g, tm, decoded):
-    """A report of a structure this ground has not seen: ask for its layout, decode again."""
-    try:
-        g.learn_structure(decoded["sid"], kind=g.hk.kind_of(tm))
-        return g.hk.decode_report(tm)
-    except Exception:
-        return decoded
+    return session.run(args, lambda g: g.set_time_rate(args.exponent))
 
 
 # ------------------------------------------------------------------------------ automation
-
-
-def _fresh(g):
-    """Sequence counts that differ from an earlier run's, so request IDs stay unique."""
-    import time
-
-    from obsw.spp import SequenceCounter
-
-    g.proc.sequence = SequenceCounter(int(time.time() * 16) & 0x3FFF)
-    return g
-
-
-def _assignments(words):
-    out = {}
-    for w in words:
-        name, sep, value = w.partition("=")
-        if not sep:
-            raise UserError("assignment %r" % w, expected="NAME=VALUE")
-        out[_key(name)] = _value(value)
-    return out
-
-
-def _request(g, words):
-    """The on-board request a command line names (a Transaction, not sent)."""
-    kind = words[0] if words else ""
-    if kind == "ping" and len(words) == 1:
-        return g.request(17, 1)
-    if kind == "function" and len(words) >= 2:
-        args = {str(k): v for k, v in _assignments(words[2:]).items()}
-        return g.function_request(_key(words[1]), **args)
-    if kind == "set" and len(words) >= 2:
-        return g.parameter_request(_assignments(words[1:]))
-    if kind == "service" and len(words) >= 3:
-        return _mission_call(g.service_request, words[1], words[2], words[3:])
-    raise UserError(
-        "request %r" % " ".join(words),
-        expected="ping | function NAME [ARG=VALUE..] | service NAME REQUEST [ARG=VALUE..] | "
-        "set NAME=VALUE..",
-    )
 
 
 def _rid(text):
@@ -597,35 +432,22 @@ def _rid(text):
 
 def _function(args):
     def go(g):
-        values = {str(k): v for k, v in _assignments(args.arguments).items()}
-        return g.perform(_key(args.name), **values)
+        values = {str(k): v for k, v in session.assignments(args.arguments).items()}
+        return g.perform(session.key(args.name), **values)
 
-    return _run(args, go)
-
-
-def _mission_call(method, service, request, words):
-    """``method(service, request, **arguments)`` with mistakes in the names, types or ranges
-    of the arguments said as the user's."""
-    from obsw.pus.services.mission import MissionArgumentError
-
-    values = {str(k): v for k, v in _assignments(words).items()}
-    try:
-        return method(_key(service), _key(request), **values)
-    except KeyError as e:
-        raise UserError(str(e.args[0]) if e.args else str(e)) from None
-    except MissionArgumentError as e:
-        raise UserError(str(e)) from None
+    return session.run(args, go)
 
 
 def _service(args):
-    return _run(
-        args, lambda g: _mission_call(g.call_service, args.service, args.request, args.arguments)
+    return session.run(
+        args,
+        lambda g: session.mission_call(g.call_service, args.service, args.request, args.arguments),
     )
 
 
 def _sched_insert(args):
     def go(g):
-        request = _request(_fresh(g), args.request)
+        request = session.request(session.fresh(g), args.request)
         if args.service == "position":
             user = g.position
             item = (args.position, request, args.subschedule, args.group)
@@ -639,7 +461,7 @@ def _sched_insert(args):
             item = (at, request, args.subschedule, args.group)
         return g._issue(user.insert(g.apid, [item]))
 
-    return _run(args, go)
+    return session.run(args, go)
 
 
 def _sched_user(g, args):
@@ -658,7 +480,7 @@ def _sched_simple(args):
         }[args.what]
         return g._issue(fn(g.apid))
 
-    return _run(args, go)
+    return session.run(args, go)
 
 
 def _sched_shift(args):
@@ -669,11 +491,11 @@ def _sched_shift(args):
             return g._issue(user.shift(g.apid, offset, [_rid(i) for i in args.ids]))
         return g._issue(user.shift_all(g.apid, offset))
 
-    return _run(args, go)
+    return session.run(args, go)
 
 
 def _sched_delete(args):
-    return _run(
+    return session.run(
         args, lambda g: g._issue(_sched_user(g, args).delete(g.apid, [_rid(i) for i in args.ids]))
     )
 
@@ -682,51 +504,56 @@ def _monitor_add(args):
     def go(g):
         return g.add_limit_monitor(
             args.pmon,
-            _key(args.parameter),
+            session.key(args.parameter),
             args.low,
             args.high,
-            _key(args.low_event),
-            _key(args.high_event),
+            session.key(args.low_event),
+            session.key(args.high_event),
             repetitions=args.repetitions,
             interval=args.interval,
             raw=args.raw,
         )
 
-    return _run(args, go)
+    return session.run(args, go)
 
 
 def _monitor_simple(args):
     if args.what == "list":
-        return _run(args, lambda g: g.monitors())
-    return _run(args, lambda g: g.out_of_limits())
+        return session.run(args, lambda g: g.monitors())
+    return session.run(args, lambda g: g.out_of_limits())
 
 
 def _monitor_ids(args):
     if args.what == "delete":
-        return _run(args, lambda g: g.delete_monitors(args.ids))
-    return _run(args, lambda g: g.enable_monitors(args.ids, args.what == "enable"))
+        return session.run(args, lambda g: g.delete_monitors(args.ids))
+    return session.run(args, lambda g: g.enable_monitors(args.ids, args.what == "enable"))
 
 
 def _action_add(args):
-    return _run(args, lambda g: g.add_action(_key(args.event), _request(_fresh(g), args.request)))
+    return session.run(
+        args,
+        lambda g: g.add_action(
+            session.key(args.event), session.request(session.fresh(g), args.request)
+        ),
+    )
 
 
 def _action_list(args):
-    return _run(args, lambda g: g.actions())
+    return session.run(args, lambda g: g.actions())
 
 
 def _action_events(args):
-    events = [_key(e) for e in args.events]
+    events = [session.key(e) for e in args.events]
     if args.what == "delete":
-        return _run(args, lambda g: g.delete_actions(events))
-    return _run(args, lambda g: g.enable_actions(events, args.what == "enable"))
+        return session.run(args, lambda g: g.delete_actions(events))
+    return session.run(args, lambda g: g.enable_actions(events, args.what == "enable"))
 
 
 def _sequence_load(args):
     import shlex
 
     def go(g):
-        _fresh(g)
+        session.fresh(g)
         items = []
         for step in args.steps:
             words = shlex.split(step)
@@ -734,14 +561,14 @@ def _sequence_load(args):
                 delay = float(words[0])
             except (ValueError, IndexError):
                 raise UserError("sequence step %r" % step, expected="'DELAY REQUEST..'") from None
-            items.append((_request(g, words[1:]), delay))
+            items.append((session.request(g, words[1:]), delay))
         return g.load_sequence(args.name, items)
 
-    return _run(args, go)
+    return session.run(args, go)
 
 
 def _sequence_status(args):
-    return _run(args, lambda g: g.sequences())
+    return session.run(args, lambda g: g.sequences())
 
 
 def _sequence_named(args):
@@ -751,7 +578,7 @@ def _sequence_named(args):
         "abort": "abort_sequence",
         "unload": "unload_sequence",
     }[args.what]
-    return _run(args, lambda g: getattr(g, method)(args.name))
+    return session.run(args, lambda g: getattr(g, method)(args.name))
 
 
 # ------------------------------------- parameter definitions (20), functional monitoring (12)
@@ -788,29 +615,33 @@ def _add_values_commands(s, params):
 
 
 def _params_definitions(args):
-    return _run(args, lambda g: g.parameter_definitions([_key(n) for n in args.names]))
+    return session.run(
+        args, lambda g: g.parameter_definitions([session.key(n) for n in args.names])
+    )
 
 
 def _params_define(args):
     if args.object is None:
-        item = (_key(args.name), args.memory, args.address)
+        item = (session.key(args.name), args.memory, args.address)
     else:
-        item = (_key(args.name), args.memory, args.object, args.address)
-    return _run(args, lambda g: g.define_parameters([item], args.object is not None))
+        item = (session.key(args.name), args.memory, args.object, args.address)
+    return session.run(args, lambda g: g.define_parameters([item], args.object is not None))
 
 
 def _fmon_add(args):
-    return _run(
+    return session.run(
         args,
-        lambda g: g.add_functional_monitor(args.fmon, args.pmons, args.failing, _key(args.event)),
+        lambda g: g.add_functional_monitor(
+            args.fmon, args.pmons, args.failing, session.key(args.event)
+        ),
     )
 
 
 def _fmon_report(args):
     if args.what == "list":
-        return _run(args, lambda g: g.functional_monitors())
-    return _run(args, lambda g: g.functional_status())
+        return session.run(args, lambda g: g.functional_monitors())
+    return session.run(args, lambda g: g.functional_status())
 
 
 def _fmon_action(args):
-    return _run(args, lambda g: g.functional_request(args.what, getattr(args, "ids", ())))
+    return session.run(args, lambda g: g.functional_request(args.what, getattr(args, "ids", ())))

@@ -28,9 +28,9 @@ from rich.console import Console, Group
 from rich.live import Live
 from rich.table import Table
 
-from obsw_host import ids as mission_ids
-from obsw_host.commands import arguments, ground
+from obsw_host.commands import arguments, session
 from obsw_host.errors import user_message
+from obsw_host.mission import ids as mission_ids
 from obsw_host.obc.state import default_state
 from obsw_host.pus import catalog
 from obsw_host.pus.display import Picture, number
@@ -112,7 +112,7 @@ def _ask_housekeeping(g, picture):
 
 def _watch(args):
     frames = 1 if args.once else args.count
-    with ground._ground(args) as g:
+    with session.ground(args) as g:
         picture = Picture(g.sdb, config=g.proc.config)
         g.proc.listeners.append(lambda tm, decoded, tx: picture.feed(tm, decoded))
         g.subscribe()
@@ -262,7 +262,7 @@ def run_line(line, base, parser):
 
 
 def _console(args):
-    with ground._ground(args) as g:  # the database and the target the console's commands use
+    with session.ground(args) as g:  # the database and the target the console's commands use
         sdb, target = g.sdb, g.target
     parser = _ground_parser()
     base = {k: v for k, v in vars(args).items() if k not in _CONSOLE_KEYS}
@@ -277,7 +277,7 @@ def _console(args):
         return status
     path = history_path(args, mission_ids.from_args(args))
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    session = PromptSession(
+    prompt = PromptSession(
         history=FileHistory(path),
         completer=GroundCompleter(parser, sdb),
         complete_while_typing=False,
@@ -288,7 +288,7 @@ def _console(args):
     )
     while True:
         try:
-            line = session.prompt("%s> " % (getattr(sdb, "mission", "") or "obsw"))
+            line = prompt.prompt("%s> " % (getattr(sdb, "mission", "") or "obsw"))
         except KeyboardInterrupt:
             continue
         except EOFError:

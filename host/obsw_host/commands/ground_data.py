@@ -26,7 +26,7 @@ from obsw.pus.sdb import field_type
 from obsw.pus.services.schedule_user import embed
 from obsw.utc import parse_utc
 
-from obsw_host.commands import ground
+from obsw_host.commands import session
 from obsw_host.errors import UserError
 from obsw_host.pus.storage_ground import StorageGround
 
@@ -175,7 +175,7 @@ def _stats(args):
             return sg.issue(user.enable_periodic(g.apid, args.interval))
         return sg.issue(user.disable_periodic(g.apid))
 
-    return ground._run(args, go)
+    return session.run(args, go)
 
 
 def _store(args):
@@ -216,7 +216,7 @@ def _store(args):
             return sg.retrieve_sequence(args.store, args.first, args.last)
         return sg.retrieve_time(args.store, start, end)
 
-    return ground._run(args, go)
+    return session.run(args, go)
 
 
 def _file(args):
@@ -237,7 +237,7 @@ def _file(args):
             return sg.issue(files.create_directory(apid, args.path))
         return sg.issue(files.delete_directory(apid, args.path))
 
-    return ground._run(args, go)
+    return session.run(args, go)
 
 
 def _large(args):
@@ -266,7 +266,7 @@ def _large(args):
                 return part  # the part's failure report says why
         return g.wait(inner)
 
-    return ground._run(args, go)
+    return session.run(args, go)
 
 
 # ------------------------------------------------------------------------------ tc by name
@@ -297,14 +297,14 @@ def tc_by_name(args):
         sdb = g.sdb
         if "=" in args.what:
             values = {}
-            for name, value in ground._assignments(words).items():
+            for name, value in session.assignments(words).items():
                 p = sdb.parameter(name)
                 if not p.writable:
                     raise UserError("parameter %s is read-only" % p.qualified)
                 values[p.qualified] = checked(p.type, value, p.qualified, p.range)
             return g.set_parameters(values)
         fn = _function(sdb, args.what)
-        given = {str(k): v for k, v in ground._assignments(args.rest).items()}
+        given = {str(k): v for k, v in session.assignments(args.rest).items()}
         declared = {a[1]: a for a in fn.arguments}
         for name, value in given.items():
             if name not in declared:
@@ -318,7 +318,7 @@ def tc_by_name(args):
             raise UserError("%s needs %s" % (fn.name, ", ".join(missing)), expected="ARG=VALUE")
         return g.perform(fn.name, **given)
 
-    return ground._run(args, go)
+    return session.run(args, go)
 
 
 def _function(sdb, name):

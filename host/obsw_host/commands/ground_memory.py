@@ -27,7 +27,7 @@ import shlex
 from obsw.crc import crc16_ccitt
 from obsw.utc import parse_utc
 
-from obsw_host.commands import ground as ground_cmd
+from obsw_host.commands import session
 from obsw_host.errors import UserError
 
 
@@ -180,7 +180,7 @@ def _memory_range(args):
             return sg.issue(m.dump(g.apid, args.memory, rng))
         return sg.issue(m.dump_object(g.apid, args.memory, args.object, rng))
 
-    return ground_cmd._run(args, go)
+    return session.run(args, go)
 
 
 def _long(g):
@@ -198,7 +198,7 @@ def _memory_load(args):
             return sg.issue(tx)
         return sg.issue(m.load(g.apid, args.memory, args.address, args.data))
 
-    return ground_cmd._run(args, go)
+    return session.run(args, go)
 
 
 def _memory_load_file(args):
@@ -219,7 +219,7 @@ def _memory_load_file(args):
             return sg.issue(m.load_by_reference(g.apid, args.memory, item))
         return sg.issue(m.load_object_by_reference(g.apid, args.memory, args.object, item))
 
-    return ground_cmd._run(args, go)
+    return session.run(args, go)
 
 
 def _memory_call(args):
@@ -227,7 +227,7 @@ def _memory_call(args):
         sg = _storage(g)
         return sg.issue(getattr(sg.memory, args.call)(g.apid, args.memory, args.object))
 
-    return ground_cmd._run(args, go)
+    return session.run(args, go)
 
 
 def _memory_abort(args):
@@ -235,7 +235,7 @@ def _memory_abort(args):
         sg = _storage(g)
         return sg.issue(sg.memory.abort_dumps(g.apid))
 
-    return ground_cmd._run(args, go)
+    return session.run(args, go)
 
 
 def _memory_switch(args):
@@ -244,7 +244,7 @@ def _memory_switch(args):
         fn = getattr(sg.memory, args.on if args.state == "on" else args.off)
         return sg.issue(fn(g.apid, args.memory))
 
-    return ground_cmd._run(args, go)
+    return session.run(args, go)
 
 
 # ------------------------------------------------------------------------------ service 15
@@ -260,7 +260,7 @@ def _store_copy(args):
             sg.storage.copy_window(g.apid, args.source, args.target, args.start, args.end)
         )
 
-    return ground_cmd._run(args, go)
+    return session.run(args, go)
 
 
 def _store_diag(args):
@@ -272,15 +272,15 @@ def _store_diag(args):
         fn = u.add_diag if args.what == "add" else u.delete_diag
         return sg.issue(fn(g.apid, args.store, {g.apid: list(args.sids)}))
 
-    return ground_cmd._run(args, go)
+    return session.run(args, go)
 
 
 # ------------------------------------------------------------------------------ 21 and 22
 
 
 def _sequence_file(args):
-    with ground_cmd._ground(args) as g:
-        ground_cmd._fresh(g)
+    with session.ground(args) as g:
+        session.fresh(g)
         items = []
         for step in args.steps:
             words = shlex.split(step)
@@ -288,7 +288,7 @@ def _sequence_file(args):
                 delay = float(words[0])
             except (ValueError, IndexError):
                 raise UserError("sequence step %r" % step, expected="'DELAY REQUEST..'") from None
-            items.append((ground_cmd._request(g, words[1:]), delay))
+            items.append((session.request(g, words[1:]), delay))
         data = g.sequencing.sequence_file(items)
     try:
         with open(args.out, "wb") as f:
@@ -308,8 +308,8 @@ def _sequence_load_file(args):
         fn = u.load_and_activate if args.activate else u.load_by_reference
         return g._issue(fn(g.apid, args.name, args.path))
 
-    return ground_cmd._run(args, go)
+    return session.run(args, go)
 
 
 def _orbit(args):
-    return ground_cmd._run(args, lambda g: g._issue(g.position.set_orbit(g.apid, args.orbit)))
+    return session.run(args, lambda g: g._issue(g.position.set_orbit(g.apid, args.orbit)))

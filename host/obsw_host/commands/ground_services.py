@@ -18,7 +18,7 @@ On SpaceCAN, an on/off address is node << 8 | on << 7 | line, a register address
 node << 16 | parameter id, a CPDU line node << 8 | output line (obsw.spacecan.device_access).
 """
 
-from obsw_host.commands import ground, ground_data
+from obsw_host.commands import ground_data, session
 from obsw_host.errors import UserError
 from obsw_host.pus import text
 from obsw_host.pus.storage_ground import StorageGround
@@ -128,7 +128,7 @@ def add_to_ground(s):
     x.set_defaults(func=_diag, what="interval")
     x = dg.add_parser("listen", help="print periodic diagnostic reports")
     x.add_argument("--seconds", type=float, default=3.0)
-    x.set_defaults(func=ground._listen, listen=(3, 26))
+    x.set_defaults(func=session.listen, listen=(3, 26))
 
     fr = s.add_parser("functional", help="service 3 parameter functional reporting")
     fr = fr.add_subparsers(dest="functional")
@@ -189,7 +189,7 @@ def add_to_ground(s):
 
 
 def _run(args, fn):
-    return ground._run(args, fn)
+    return session.run(args, fn)
 
 
 def _device(args):

@@ -86,7 +86,7 @@ def new_cmd(args):
 
 
 def _ids(folder):
-    from obsw_host.ids import MissionIds
+    from obsw_host.mission.ids import MissionIds
 
     return MissionIds.locate(folder)
 

@@ -19,10 +19,10 @@ import os
 import sys
 
 from obsw_host.errors import UserError
-from obsw_host.mission import locate
+from obsw_host.mission.config import ConfigError
+from obsw_host.mission.config import load as load_config
+from obsw_host.mission.folder import locate
 from obsw_host.obc import service
-from obsw_host.obc.config import ConfigError
-from obsw_host.obc.config import load as load_config
 from obsw_host.obc.state import StateLock, StateLocked, default_state
 from obsw_host.obc.state import reset as reset_state
 from obsw_host.obc.topology import Topology

@@ -26,7 +26,7 @@ import os
 import sys
 import threading
 
-from obsw_host import ids as mission_ids
+from obsw_host.mission import ids as mission_ids
 from obsw_host.net import DEFAULT_HOST
 
 _SIMPLE = {
@@ -213,10 +213,10 @@ def _run(args, fn):
 def _session(ground, args):
     """Sequence counts that differ from an earlier run's (unique request IDs), and the
     session log of ``--log`` (also `obsw ground --log .. obcp`)."""
-    from obsw_host.commands import ground as ground_command
+    from obsw_host.commands import session
     from obsw_host.pus.monitor import SessionLog
 
-    ground_command._fresh(ground)
+    session.fresh(ground)
     if getattr(args, "log", None):
         ground.session = SessionLog(args.log)
 

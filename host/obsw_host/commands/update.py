@@ -19,8 +19,8 @@ folder (``--mission``), signed; with ``--base`` an earlier package, only what ch
 import argparse
 import os
 
-from obsw_host import ids as mission_ids
 from obsw_host.errors import UserError
+from obsw_host.mission import ids as mission_ids
 from obsw_host.net import DEFAULT_HOST
 
 STATUS = ("Software.version", "Software.slot", "Software.pending", "Software.trial_starts")
@@ -81,7 +81,7 @@ def add_parser(sub):
 
 def _mission(args):
     """(MissionIds, the mission folder, its update public key or None)."""
-    from obsw_host.obc import defaults
+    from obsw_host.mission import defaults
     from obsw_host.update.build import load_public
 
     ids = mission_ids.from_args(args)
@@ -193,15 +193,15 @@ def push(args):
 
 
 def _perform(args, name, **arguments):
-    from obsw_host.commands.ground import _key, _run
+    from obsw_host.commands import session
 
-    return _run(_ground_args(args), lambda g: g.perform(_key(name), **arguments))
+    return session.run(_ground_args(args), lambda g: g.perform(session.key(name), **arguments))
 
 
 def status(args):
-    from obsw_host.commands.ground import _run
+    from obsw_host.commands import session
 
-    return _run(_ground_args(args), lambda g: g.get_parameters(*STATUS))
+    return session.run(_ground_args(args), lambda g: g.get_parameters(*STATUS))
 
 
 def activate(args):

@@ -21,8 +21,8 @@ import threading
 import time
 import urllib.request
 
-from obsw_host import ids as mission_ids
 from obsw_host.errors import UserError
+from obsw_host.mission import ids as mission_ids
 
 
 def add_parser(sub):
@@ -68,7 +68,7 @@ def add_parser(sub):
 
 
 def _instance_options(x):
-    from obsw_host.ports import YAMCS_LINKS
+    from obsw_host.mission.ports import YAMCS_LINKS
 
     x.add_argument(
         "--mission",
@@ -115,7 +115,7 @@ def _missions(args):
     given = getattr(args, "mission", None) or [None]
     if len(given) == 1:
         return [mission_ids.MissionIds.locate(given[0], getattr(args, "sdb", None))]
-    from obsw_host.ports import YAMCS_LINKS
+    from obsw_host.mission.ports import YAMCS_LINKS
 
     one = ["sdb", "keys"] + ["%s_port" % name for name in YAMCS_LINKS]
     for name in one:
@@ -129,7 +129,7 @@ def _missions(args):
 
 
 def _ports(args, ids):
-    """Yamcs' link ports: the command line's, else the mission's (``obsw_host.ports``)."""
+    """Yamcs' link ports: the command line's, else the mission's (``obsw_host.mission.ports``)."""
     ports = ids.ports.yamcs()
     for name in ports:
         given = getattr(args, "%s_port" % name)

@@ -9,7 +9,7 @@ frames are accepted without authentication. Anything else refuses to start with 
 from obsw.frames.sdls import SA_OPERATIONAL
 from obsw.frames.sdls_keys import KeyFileError, load_sas
 
-from obsw_host.obc import defaults
+from obsw_host.mission import defaults
 
 OFF_WARNING = (
     'frames: TC SECURITY OFF (frames.tc_security is "none"): every well-formed TC frame is '
@@ -21,7 +21,7 @@ def check(config):
     """The key file path the frame processor must use, or None when the mission switched TC
     security off; ConfigError (one line) when neither holds."""
     from obsw_host.frames.keys import read_key_file
-    from obsw_host.obc.config import ConfigError
+    from obsw_host.mission.config import ConfigError
 
     opts = config.section("frames")
     mode = opts.get("tc_security", defaults.FRAMES["tc_security"])

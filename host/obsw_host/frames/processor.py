@@ -1,11 +1,11 @@
 """The frame processor process: two serial links to the COM module, UDP to the applications.
 
 Telecommand packets go to UDP port ``port_base + APID`` (default: the base of
-``obsw_host.ports``), sent from the ``tm_port`` socket, so an application answering the sender
-reaches the TM input; telemetry packets sent to ``tm_port`` (default: the ports module's ``tm``,
-base - 1) leave as TM frames on both links, on the VC of their APID (the real-time VC unless
-mapped). Each entry of ``vc_ports`` (VC ID -> UDP port) is one more input whose packets all go
-on that VC, unchanged: by default the playback VC of the plan on ``tm_port + 1`` (the ports
+``obsw_host.mission.ports``), sent from the ``tm_port`` socket, so an application answering the
+sender reaches the TM input; telemetry packets sent to ``tm_port`` (default: the ports module's
+``tm``, base - 1) leave as TM frames on both links, on the VC of their APID (the real-time VC
+unless mapped). Each entry of ``vc_ports`` (VC ID -> UDP port) is one more input whose packets all
+go on that VC, unchanged: by default the playback VC of the plan on ``tm_port + 1`` (the ports
 module's ``playback``), where the PUS application process sends what service 15 retrieves
 from its packet stores.
 
@@ -30,8 +30,8 @@ from obsw.pus.app import ApplicationProcess
 from obsw.pus.services.s05_events import EventReporting
 
 from obsw_host.frames.links import SerialLink
+from obsw_host.mission.ports import Ports
 from obsw_host.net import DEFAULT_HOST
-from obsw_host.ports import Ports
 
 
 def sdb_events(sdb):

@@ -1,4 +1,5 @@
-"""The whole mission folder checked before anything starts: ``check(path) -> (Mission, problems)``.
+"""The whole mission folder checked before anything starts: ``check(path) -> (Mission, problems)``;
+``load(path)`` is the checked ``Mission`` or a ``MissionError`` listing every problem.
 
 First each file against its JSON Schema (``schema/``), then what a schema cannot say, in
 Python: names and ids given twice, references between the files (housekeeping, functions,
@@ -18,9 +19,10 @@ from obsw.spacecan.equipment import equipment_interface
 from obsw.spacecan.nodedef import NodeDefinition, NodeDefinitionError
 
 from obsw_host.mission import defaults
-from obsw_host.mission.errors import Problem, did_you_mean, short
+from obsw_host.mission.config import ConfigError, MissionConfig
+from obsw_host.mission.errors import MissionError, Problem, did_you_mean, short
+from obsw_host.mission.folder import locate
 from obsw_host.mission.schema import json_type, read_json, validate
-from obsw_host.obc.config import ConfigError, MissionConfig
 from obsw_host.obc.onboard_time import ONBOARD_TIME
 from obsw_host.obc.plugins import Component, PluginError
 from obsw_host.obc.registry import KINDS, WITH_PUS
@@ -714,3 +716,11 @@ def check(mission_file):
     if c.problems:
         return None, c.problems
     return Mission(config, sdb, c.interfaces), []
+
+
+def load(path=None):
+    """The checked ``Mission`` at ``path`` (see ``locate``); ``MissionError`` lists problems."""
+    mission, problems = check(locate(path))
+    if problems:
+        raise MissionError(problems)
+    return mission

@@ -1,6 +1,11 @@
-"""Mistakes in a mission folder: ``Problem`` (one line each) and ``MissionError`` (all of them).
+"""Mistakes in a mission folder: ``Problem`` (one line each) and the ``MissionError`` family.
 
 A problem reads ``FILE: $.json.path: what is wrong; expected ... (did you mean 'writable'?)``.
+Every error about a mission is a ``MissionError`` (a ``UserError``: one line each, exit 2):
+``ConfigError`` (a mission file the OBC cannot use, ``obsw_host.mission.config``),
+``PluginError`` (a component module, ``obsw_host.obc.plugins``), ``PortError``
+(``obsw_host.mission.ports``) and ``MissionError.at(file, key, text)`` for an id the mission
+does not give (``obsw_host.mission.ids``).
 """
 
 import difflib
@@ -55,11 +60,13 @@ class Problem:
     __slots__ = ("file", "path", "text")
 
     def __init__(self, file, path, text):
-        self.file = file
+        self.file = file  # None: the problem is not in one file
         self.path = path if isinstance(path, str) else json_path(path)
         self.text = text
 
     def __str__(self):
+        if self.file is None:
+            return "%s: %s" % (self.path, self.text)
         return "%s: %s: %s" % (display(self.file), self.path, self.text)
 
     def __repr__(self):
@@ -73,8 +80,28 @@ class Problem:
 
 
 class MissionError(UserError):
-    """A mission folder that cannot be used; ``problems`` lists every mistake found."""
+    """A mission that cannot be used; ``problems`` lists every mistake found (``Problem``)."""
 
     def __init__(self, problems):
         self.problems = list(problems)
         super().__init__("\n".join(str(p) for p in self.problems))
+
+    @classmethod
+    def at(cls, file, key, text):
+        """One problem: ``FILE: KEY: text``."""
+        return cls([Problem(file, key, text)])
+
+
+class ConfigError(MissionError, ValueError):
+    """A mission file the OBC cannot use: ``key`` says where (``FILE: KEY: text``)."""
+
+    def __init__(self, key, message, file=None):
+        super().__init__([Problem(file, key, message)])
+        self.key = key
+
+
+class PortError(MissionError):
+    """A port section or variable that cannot be used; the message names where."""
+
+    def __init__(self, message):
+        super().__init__([message])

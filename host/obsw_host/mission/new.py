@@ -71,7 +71,7 @@ def copy(template, name, folder, scid=None, port_base=None):
     """Write mission ``name`` into ``folder`` as a copy of mission folder ``template`` with its
     name (mission file and database), and with ``scid`` and ``port_base`` when given: the ports
     the mission file fixes by themselves move with the base. Returns the folder."""
-    from obsw_host.mission import locate
+    from obsw_host.mission.folder import locate
 
     if not NAME.match(name):
         raise UserError("mission name %r is not usable" % name,
@@ -119,7 +119,7 @@ def fleet(template, prefix, folder, count, scid=None, port_base=FLEET_BASE, step
     """Write ``count`` missions ``PREFIX-1`` .. ``PREFIX-N`` into ``folder`` from mission folder
     ``template``, each with its own spacecraft id (``scid`` + k, default the template's + k)
     and port base (``port_base`` + k * ``step``). Returns their folders."""
-    from obsw_host.ids import MissionIds
+    from obsw_host.mission.ids import MissionIds
 
     if count < 1:
         raise UserError("--count %d" % count, expected="one mission or more")

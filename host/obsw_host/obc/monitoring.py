@@ -14,7 +14,7 @@ theirs across restarts, so a deleted or changed definition stays deleted or chan
 from obsw.pus.services.s12_monitoring import Pmon
 from obsw.pus.services.s12_user import limit_check
 
-from obsw_host.obc.config import ConfigError
+from obsw_host.mission.config import ConfigError
 
 
 class MonitoringError(ConfigError):

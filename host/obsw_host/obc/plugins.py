@@ -40,7 +40,7 @@ from obsw.il.interface import Interface
 from obsw.il.node import Node
 
 from obsw_host.il.transport import SocketTransport
-from obsw_host.obc.config import ConfigError
+from obsw_host.mission.config import ConfigError
 
 
 class PluginError(ConfigError):

@@ -16,9 +16,10 @@ import os
 
 from obsw.il.interface import DATA, Attribute, Interface, Operation
 
-from obsw_host.ids import MissionIds
-from obsw_host.obc import defaults, plugins
-from obsw_host.obc.config import ConfigError
+from obsw_host.mission import defaults
+from obsw_host.mission.config import ConfigError
+from obsw_host.mission.ids import MissionIds
+from obsw_host.obc import plugins
 from obsw_host.obc.onboard_time import ONBOARD_TIME
 from obsw_host.obc.registry import WITH_PUS
 from obsw_host.update.component import SOFTWARE
@@ -134,7 +135,7 @@ class Topology:
         return self.process_of(name) is not None
 
     def section(self, name):
-        """The mission file's section ``name`` over its defaults (``obsw_host.obc.defaults``)."""
+        """The mission file's section ``name`` over its defaults (``mission.defaults``)."""
         return defaults.section(self.config, name)
 
     def check(self):
@@ -158,7 +159,7 @@ class Topology:
 
     @property
     def ids(self):
-        """Every id and port of the mission (``obsw_host.ids.MissionIds``), read once."""
+        """Every id and port of the mission (``obsw_host.mission.ids.MissionIds``), read once."""
         if self._ids is None:
             self._ids = MissionIds(self.sdb, self.config.sdb_path, self.config)
         return self._ids

@@ -8,7 +8,7 @@ magic character ``V`` disarms it ("magic close"); closing without it, or the pro
 leaves it armed, so a platform manager that hangs or dies resets the OBC.
 
 ``Watchdog(path, timeout)`` works on the real device and on a stand-in (a FIFO, or
-``obsw_host.obc.watchdog_sim.SimulatedWatchdog`` in tests): a device that refuses the ioctls
+``obsw_sim.watchdog.SimulatedWatchdog`` in tests): a device that refuses the ioctls
 (``ENOTTY``, ``EINVAL``) is kicked by writes alone and keeps whatever timeout it has.
 """
 

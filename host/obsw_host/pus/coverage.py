@@ -14,7 +14,7 @@ import tempfile
 
 from obsw.pus.sdb_services import FIRST_MISSION_TYPE
 
-from obsw_host.obc import config as obc_config
+from obsw_host.mission import config as obc_config
 from obsw_host.obc.topology import Topology
 from obsw_host.obc.units import PusUnit
 from obsw_host.pus.standard import MESSAGE_TYPES, SERVICE_NAMES

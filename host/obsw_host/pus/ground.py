@@ -42,9 +42,9 @@ from obsw.pus.services.s21_sequencing import RequestSequencingUser
 from obsw.pus.services.s22_position_scheduling import PositionSchedulingUser
 from obsw.pus.user import UserProcess
 
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
+from obsw_host.mission.ports import app_port
 from obsw_host.net import DEFAULT_HOST
-from obsw_host.ports import app_port
 from obsw_host.pus import text
 from obsw_host.pus.onboard import tai_now
 from obsw_host.pus.tm_fanout import SUBSCRIBE, UNSUBSCRIBE

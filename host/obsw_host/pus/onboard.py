@@ -47,9 +47,9 @@ from obsw.pus.services.s21_sequencing import RequestSequencing
 from obsw.pus.services.s22_position_scheduling import PositionScheduling
 from obsw.pus.services.s23_files import FileManagement
 
-from obsw_host.ids import EVENT_COPY_COMPLETED, EVENT_COPY_FAILED, EVENT_OVERRUN, event_id
+from obsw_host.mission.ids import EVENT_COPY_COMPLETED, EVENT_COPY_FAILED, EVENT_OVERRUN, event_id
+from obsw_host.mission.ports import app_port
 from obsw_host.net import DEFAULT_HOST
-from obsw_host.ports import app_port
 from obsw_host.pus.tm_fanout import TmFanout
 from obsw_host.pus.tm_log import TmLog
 

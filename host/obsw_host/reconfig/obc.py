@@ -74,7 +74,7 @@ def main(argv=None):
         ctx, offset = restore(link, args.line, say)
     ctrl = Controller(heartbeat_period=0.2, timeout=0.5, retries=3)
     if args.nodes is None:
-        from obsw_host.ids import MissionIds
+        from obsw_host.mission.ids import MissionIds
 
         args.nodes = "%d,%d" % MissionIds.sample().reconfig_nodes
     for n in args.nodes.split(","):

@@ -30,7 +30,7 @@ from obsw.spacecan.master import MASTER, SpaceCanMaster
 from obsw.spacecan.nodedef import NodeDefinition
 from obsw.spacecan.responder import Responder
 
-from obsw_host import ids as mission_ids
+from obsw_host.mission import ids as mission_ids
 from obsw_host.spacecan.adapter import CanAdapter
 
 # The reconfiguration module's CPDU as seen on SpaceCAN: the one definition the firmware also

@@ -17,7 +17,7 @@ each attribute or parameter:
 
 from obsw.pus import sdb as sdb_module
 
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 
 
 class Param:
@@ -75,7 +75,9 @@ class Spacecraft:
         self, mission, apids, params, events, functions, structures, filestores, ids=None
     ):
         self.mission = mission or "spacecraft"
-        self.ids = ids  # the mission's ids (obsw_host.ids.MissionIds): SCID, VCs, source id
+        self.ids = (
+            ids  # the mission's ids (obsw_host.mission.ids.MissionIds): SCID, VCs, source id
+        )
         self.apids = apids
         self.params = params  # id -> Param
         self.events = events  # id -> Event
@@ -107,7 +109,7 @@ def loads(text, path=None):
 
 
 def from_ids(ids):
-    """The Spacecraft of a mission's ids (``obsw_host.ids.MissionIds``)."""
+    """The Spacecraft of a mission's ids (``obsw_host.mission.ids.MissionIds``)."""
     return from_sdb(ids.sdb, ids)
 
 

@@ -8,8 +8,8 @@ name, Yamcs' link ports and the gateways' on the ground; the server's web port).
 raises the first as a ``UserError``, which ``obsw`` prints as one line.
 """
 
-from obsw_host import ports as ports_module
 from obsw_host.errors import UserError
+from obsw_host.mission import ports as ports_module
 from obsw_host.net import DEFAULT_HOST
 from obsw_host.yamcs.instance import instance_name
 

@@ -17,7 +17,7 @@ import threading
 
 from obsw.frames.processor import split_packets
 
-from obsw_host.ports import Ports
+from obsw_host.mission.ports import Ports
 
 
 class PacketGateway:
@@ -34,7 +34,7 @@ class PacketGateway:
         udp_host=None,
     ):
         self.host = host
-        ports = Ports()  # the defaults of this run (obsw_host.ports)
+        ports = Ports()  # the defaults of this run (obsw_host.mission.ports)
         self.port_base = ports.base if port_base is None else port_base
         tm_port = ports.tm if tm_port is None else tm_port
         self.routes = dict(routes or {})

@@ -19,17 +19,17 @@ Two link modes, every socket on loopback:
 
 The spacecraft id, the virtual channels, the CFDP entities (the database's onboard filestore
 and the first other one, whatever their prefixes) and the CFDP APID come from the mission
-(``obsw_host.ids.MissionIds``); a missing one is an error naming the file and key.
+(``obsw_host.mission.ids.MissionIds``); a missing one is an error naming the file and key.
 """
 
 import json
 import os
 
-from obsw_host.ports import Ports
+from obsw_host.mission.ports import Ports
 from obsw_host.yamcs.xtce import event_templates, generate
 
 INSTANCE = "obsw"  # the instance of library callers that name none (the CLI names the mission)
-_DEFAULT = Ports()  # the ports of this run without a mission file (obsw_host.ports)
+_DEFAULT = Ports()  # the ports of this run without a mission file (obsw_host.mission.ports)
 HTTP_PORT = _DEFAULT.yamcs_http
 # the default ports of the ground side of the links (all on 127.0.0.1)
 PORTS = _DEFAULT.yamcs()

@@ -27,7 +27,7 @@ from obsw.spp import TYPE_TM
 
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 from obsw_host.pus.onboard import Onboard
 from obsw_host.solar_panel import SOLAR_PANEL, SolarPanel
 from obsw_host.yamcs.gateway import PacketGateway

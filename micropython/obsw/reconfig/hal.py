@@ -1,7 +1,7 @@
 """The hardware layer the reconfiguration module's logic is given (pyb on a board, a model here).
 
 The core never touches a pin itself. A hardware layer is any object with the methods of `Hal`;
-`boards/common/hal_pyb.py` drives a Pyboard, `obsw_host.reconfig.simhal` a simulated module,
+`boards/common/hal_pyb.py` drives a Pyboard, `obsw_sim.reconfig_hal` a simulated module,
 and `obsw.reconfig.models.ModelHal` is an in-memory one for tests.
 """
 

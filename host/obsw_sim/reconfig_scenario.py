@@ -6,7 +6,7 @@ arbitrate the CPDU); the OBC process is killed; a high priority command from the
 power-cycles it through the CPDU; a controller with a stuck request line is reset.
 """
 
-from obsw_host.reconfig.sim import ReconfigSim  # noqa: F401
+from obsw_sim.reconfig import ReconfigSim  # noqa: F401
 
 
 def demo(out=print):
@@ -43,7 +43,7 @@ def demo(out=print):
 
 
 def _wire(sim):
-    from obsw_host.reconfig import simhal as W
+    from obsw_sim import reconfig_hal as W
 
     w = sim.wire()
     return sim.lines(), w[W.LATCHES], w[W.COLLISIONS]

@@ -22,6 +22,7 @@ import threading
 import time
 
 import obsw
+import obsw_host
 from obsw.frames import cltu, tc
 from obsw.frames.asm import CaduDecoder
 from obsw.frames.errors import FrameError
@@ -29,14 +30,13 @@ from obsw.frames.tm_demux import TmDemultiplexer
 from obsw.reconfig.essential import Report
 from obsw.reconfig.hal import RESET_NAMES, RESET_POWER, RESET_STUCK, RESET_WATCHDOG
 from obsw.reconfig.models import Tps3813Model
-
-import obsw_host
 from obsw_host.frames import keys
 from obsw_host.frames.links import open_pty_pair
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 from obsw_host.reconfig import board_file
-from obsw_host.reconfig import simhal as W
 from obsw_host.reconfig.canhub import CanHub
+
+from obsw_sim import reconfig_hal as W
 
 ROLES = ("nominal", "redundant")
 # a controller reset more often than this within a minute is in a crash loop: the supervisor
@@ -74,8 +74,7 @@ _CORE_MODULES = (
     "obsw/frames/*.py",
     "obsw/reconfig/*.py",
 )
-_HOST_MODULES = ("obsw_host/__init__.py", "obsw_host/reconfig/__init__.py")
-_HOST_MODULES += ("obsw_host/reconfig/simhal.py",)
+_HOST_MODULES = ("obsw_sim/__init__.py", "obsw_sim/reconfig_hal.py")
 
 
 # the unix port's machine code, for the core's @micropython.native hot paths
@@ -416,7 +415,7 @@ class ReconfigSim:
             "-X",
             "heapsize=" + self.heapsize,
             "-m",
-            "obsw_host.reconfig.simhal",
+            "obsw_sim.reconfig_hal",
             str(role),
             self.wire_path,
             str(self.hub.ports[0]),

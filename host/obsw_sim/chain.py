@@ -8,7 +8,7 @@ UDP hub, buses A and B) -> both reconfiguration controllers as MicroPython unix-
 
 ``Chain(work, mission=DIR)`` copies a mission folder (default: the sample's) into ``work`` and
 points its mission file at the chain's links: the SpaceCAN hub of the simulated
-reconfiguration module (``obsw_host.reconfig.sim.ReconfigSim``, on the mission's ids), two
+reconfiguration module (``obsw_sim.reconfig.ReconfigSim``, on the mission's ids), two
 pseudo-terminal UARTs, free UDP ports and the module's TC keys. The mission's CPDU line that
 its platform manager power-cycles (``platform.power_cycle``) powers the OBC: the OBC is
 ``obsw obc serve`` of that mission (the platform manager and the mission's processes, its
@@ -26,8 +26,8 @@ import threading
 import time
 
 from obsw_host.frames.links import FdLink
-from obsw_host.ids import MissionIds
-from obsw_host.obc import defaults
+from obsw_host.mission import defaults
+from obsw_host.mission.ids import MissionIds
 
 SWITCH = """\
 // Switch CPDU lines through the nominal controller and confirm the new state.
@@ -41,7 +41,6 @@ end procedure
 
 def _station_class():
     from obsw.frames import fop as F
-
     from obsw_host.frames.station import GroundStation
 
     class OperatorStation(GroundStation):
@@ -201,12 +200,12 @@ class Chain:
 
     def start(self):
         from obsw.pus import sdb as sdb_module
-
         from obsw_host.frames import keys
-        from obsw_host.obc.config import load
+        from obsw_host.mission.config import load
         from obsw_host.pus.ground import Ground
         from obsw_host.pus.obcp_ground import ObcpGround
-        from obsw_host.reconfig.sim import ReconfigSim
+
+        from obsw_sim.reconfig import ReconfigSim
 
         os.makedirs(self.state, exist_ok=True)
         ports = _free_ports(5)

@@ -25,21 +25,14 @@ JSON Schema of the file (``obsw_host/mission/schema``) states every key.
 import json
 import os
 
-from obsw_host.mission import locate
+from obsw_host.mission.defaults import PLATFORM as _PLATFORM
+from obsw_host.mission.errors import ConfigError  # noqa: F401 (raised here, public)
+from obsw_host.mission.folder import locate
 from obsw_host.net import DEFAULT_HOST
-from obsw_host.obc.defaults import PLATFORM as _PLATFORM
 from obsw_host.obc.registry import KINDS, WITH_PUS
 
 # component kinds that became plug-ins: the kind -> (component name, its entry)
 _LEGACY_KINDS = {"solar_panel": ("SolarPanel", {"module": "obsw_host.solar_panel"})}
-
-
-class ConfigError(ValueError):
-    """A mission configuration that cannot be used: ``key`` says where."""
-
-    def __init__(self, key, message):
-        super().__init__("%s: %s" % (key, message))
-        self.key = key
 
 
 def parse_json(text, where):

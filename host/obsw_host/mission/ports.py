@@ -27,7 +27,7 @@ by itself (``"ports": {"base": 6000, "yamcs_http": 8080}``).
 
 import os
 
-from obsw_host.errors import UserError
+from obsw_host.mission.errors import PortError
 
 ENV = "OBSW_PORT_BASE"
 DEFAULT_BASE = 5000
@@ -46,10 +46,6 @@ OFFSETS = {
 BY_APID = {"pus": ("pus", 0), "cfdp": ("cfdp", 0), "cfdp_ground": ("cfdp", 1)}
 NAMES = tuple(BY_APID) + tuple(OFFSETS)
 YAMCS_LINKS = ("pus", "cfdp", "cltu", "tm_frames")  # Yamcs' link names, yamcs_<link> here
-
-
-class PortError(UserError):
-    """A port section or variable that cannot be used; the message names where."""
 
 
 def _port(value, where):

@@ -5,7 +5,7 @@ Shared lines live in a small file both controllers and the host supervisor open 
 CAN goes through the host's UDP hub; the COM and OBC UARTs are pseudo-terminals; the EEPROMs
 and the DS3231 are the core's models, kept in files so they outlive a controller reset.
 
-Run: micropython -m obsw_host.reconfig.simhal ROLE WIRE HUB_A HUB_B COM OBC STATE_DIR CAUSE [BER]
+Run: micropython -m obsw_sim.reconfig_hal ROLE WIRE HUB_A HUB_B COM OBC STATE_DIR CAUSE [BER]
 """
 
 import select

@@ -20,10 +20,11 @@ from obsw.frames.tm_plan import TmPlanError, plan_channels, tm_plan
 from obsw.pus import sdb as sdb_module
 from obsw.pus.config import PusLayoutError, from_sdb
 
-from obsw_host import mission, sample
+from obsw_host import sample
 from obsw_host.errors import UserError
-from obsw_host.obc import config as mission_config
-from obsw_host.ports import Ports
+from obsw_host.mission import config as mission_config
+from obsw_host.mission.errors import MissionError
+from obsw_host.mission.ports import Ports
 
 ESSENTIAL_MAP = 63  # the reconfiguration module's MAP unless the frames plan names one
 PACKETS_MAP = 1  # the MAP of ordinary TC packets unless the frames plan names one
@@ -43,29 +44,6 @@ def event_id(sdb, name):
         return sdb.event(name).id
     except KeyError:
         return None
-
-
-class MissionError(UserError):
-    """An id the mission does not give or gives twice: ``FILE: KEY: what was expected``."""
-
-    def __init__(self, where, key, message):
-        super().__init__("%s: %s: %s" % (where, key, message))
-        self.where = where
-        self.key = key
-
-
-def locate(path=None):
-    """The mission file of ``path`` (``obsw_host.mission.locate``: a folder or file,
-    $OBSW_MISSION, or the nearest ``mission.json``; never the sample silently)."""
-    return mission.locate(path)
-
-
-def load_config(path):
-    """The ``MissionConfig`` of mission file ``path``; its errors as one line."""
-    try:
-        return mission_config.load(path)
-    except mission_config.ConfigError as e:
-        raise UserError(str(e)) from None
 
 
 def load_sdb(path):
@@ -99,9 +77,9 @@ class MissionIds:
 
     @classmethod
     def locate(cls, mission=None, sdb=None):
-        """The ids of mission folder or file ``mission`` (see ``locate``), with the database
-        at ``sdb`` instead of the mission's when given."""
-        config = load_config(locate(mission)) if mission is not None or sdb is None else None
+        """The ids of mission folder or file ``mission`` (``obsw_host.mission.folder.locate``),
+        with the database at ``sdb`` instead of the mission's when given."""
+        config = mission_config.load(mission) if mission is not None or sdb is None else None
         path = sdb or config.sdb_path
         return cls(load_sdb(path), path, config)
 
@@ -117,7 +95,7 @@ class MissionIds:
             return None
         section = self.config.doc.get("ports") or {}
         if not isinstance(section, dict):
-            raise MissionError(self.mission_file, "ports", 'expected an object {"base": N}')
+            raise MissionError.at(self.mission_file, "ports", 'expected an object {"base": N}')
         section = dict(section)
         for name, (kind, key) in LEGACY_PORTS.items():
             value = self.config.section(kind).get(key)
@@ -132,7 +110,7 @@ class MissionIds:
 
     def error(self, key, message):
         """A MissionError about ``key`` of the spacecraft database."""
-        return MissionError(self.sdb_file, key, message)
+        return MissionError.at(self.sdb_file, key, message)
 
     # -------------------------------------------------------------------------- names
 
@@ -164,7 +142,7 @@ class MissionIds:
         apid = self.apid("pus")
         other = self.config.section("pus").get("apid") if self.config else None
         if other is not None and other != apid:
-            raise MissionError(
+            raise MissionError.at(
                 self.mission_file,
                 "pus.apid",
                 "%r differs from the spacecraft database's apids.pus %d; give it once, in %s"
@@ -219,7 +197,7 @@ class MissionIds:
             raise self.error("frames.scid", "%d is above 1023" % scid)
         other = self.config.section("frames").get("scid") if self.config else None
         if other is not None and other != scid:
-            raise MissionError(
+            raise MissionError.at(
                 self.mission_file,
                 "frames.scid",
                 "%r differs from the spacecraft database's %d; give it once, in %s"
@@ -243,7 +221,7 @@ class MissionIds:
         vc = self.tm_vcs["playback"]
         other = self.config.section("frames").get("playback_vc") if self.config else None
         if other is not None and other != vc:
-            raise MissionError(
+            raise MissionError.at(
                 self.mission_file,
                 "frames.playback_vc",
                 "%r differs from the spacecraft database's frames.tm_vcs.playback %d; give it "

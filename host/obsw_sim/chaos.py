@@ -1,4 +1,4 @@
-"""The chaos campaign: the whole chain (``obsw_host.obc.chain``: ground, TC/TM frames on two
+"""The chaos campaign: the whole chain (``obsw_sim.chain``: ground, TC/TM frames on two
 UARTs, the OBC's processes under its platform manager, SpaceCAN, both reconfiguration
 controllers as MicroPython processes, the UART link to the module, CFDP, OBCPs) run for a given
 time while random faults are injected, and what was lost counted.
@@ -33,8 +33,8 @@ import sys
 import tempfile
 import time
 
-from obsw_host.obc.chain import Chain
-from obsw_host.reconfig.sim import descendants
+from obsw_sim.chain import Chain
+from obsw_sim.reconfig import descendants
 
 KILL_GOAL = 2.0  # s: a killed unit serves again (issue's goal)
 BOOT = 5.0  # s of boot the goal for a hung OBC allows on top of the module's deadline

@@ -19,7 +19,7 @@ import time
 
 from obsw_host import sample
 from obsw_host.cfdp.client import CfdpClient
-from obsw_host.ids import MissionIds
+from obsw_host.mission.ids import MissionIds
 from obsw_host.pus.ground import Ground
 from obsw_host.update import build as b
 from obsw_host.update.component import INBOX

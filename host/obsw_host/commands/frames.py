@@ -142,7 +142,12 @@ def processor(args):
         given = getattr(args, "%s_vc" % role)
         if given is not None:
             plan[role] = given
-    port_base = args.port_base if args.port_base is not None else ports.pus - ids.pus_apid
+    if args.port_base is not None:  # every TC packet to base + APID, names fixed or not
+        routes, route_to = {}, "base %d + APID" % args.port_base
+        default_route = lambda apid: (args.host, args.port_base + apid)  # noqa: E731
+    else:
+        routes, default_route = ports.routes(args.host), ports.route(args.host)
+        route_to = ", ".join("%d:%d" % (a, p) for a, (_, p) in sorted(routes.items()))
     tm_port = args.tm_port if args.tm_port is not None else ports.tm
     playback = args.playback_port
     if playback is None:
@@ -162,7 +167,8 @@ def processor(args):
             args.uart_b,
             scid,
             host=args.host,
-            port_base=port_base,
+            routes=routes,
+            default_route=default_route,
             tm_port=tm_port,
             vc_ports={plan["playback"]: playback},
             tm_frame_length=args.frame_length,
@@ -177,9 +183,9 @@ def processor(args):
         raise _mistake("processor", e) from None
     for link in host.links:
         link.port.baudrate = args.baudrate
-    print("frame processor: %s + %s, TC to UDP %s:%d+APID, TM on UDP %d (VC %d), playback "
-          "TM on UDP %d (VC %d)" % (
-        args.uart_a, args.uart_b, args.host, port_base, host.tm_port, plan["realtime"],
+    print("frame processor: %s + %s, TC to UDP %s (APID:port %s), TM on UDP %d (VC %d), "
+          "playback TM on UDP %d (VC %d)" % (
+        args.uart_a, args.uart_b, args.host, route_to, host.tm_port, plan["realtime"],
         host.playback_port, plan["playback"]))  # fmt: skip
     if args.keys:
         print("TC security: %d SA(s) from %s, events on APID %d" % (

@@ -1,13 +1,14 @@
 """The frame processor process: two serial links to the COM module, UDP to the applications.
 
-Telecommand packets go to UDP port ``port_base + APID`` (default: the base of
-``obsw_host.mission.ports``), sent from the ``tm_port`` socket, so an application answering the
-sender reaches the TM input; telemetry packets sent to ``tm_port`` (default: the ports module's
-``tm``, base - 1) leave as TM frames on both links, on the VC of their APID (the real-time VC
-unless mapped). Each entry of ``vc_ports`` (VC ID -> UDP port) is one more input whose packets all
-go on that VC, unchanged: by default the playback VC of the plan on ``tm_port + 1`` (the ports
-module's ``playback``), where the PUS application process sends what service 15 retrieves
-from its packet stores.
+Telecommand packets go to the UDP address their APID has in ``routes`` (APID -> (host, port),
+e.g. a mission's ``Ports.routes``), else to ``default_route(apid)`` (default: the run's
+``Ports.for_apid`` on ``host``), sent from the ``tm_port`` socket, so an application answering
+the sender reaches the TM input; a packet with no route is counted (``unrouted``); telemetry
+packets sent to ``tm_port`` (default: the ports module's ``tm``, base - 1) leave as TM frames
+on both links, on the VC of their APID (the real-time VC unless mapped). Each entry of
+``vc_ports`` (VC ID -> UDP port) is one more input whose packets all go on that VC, unchanged:
+by default the playback VC of the plan on ``tm_port + 1`` (the ports module's ``playback``),
+where the PUS application process sends what service 15 retrieves from its packet stores.
 
 TC security: with ``security`` (an ``obsw.frames.sdls.TcSecurity``, see
 ``obsw_host.frames.keys``) every TC frame is authenticated before FARM-1. A rejected frame is
@@ -91,7 +92,8 @@ class FrameProcessorHost:
         link_b,
         scid,
         host=DEFAULT_HOST,
-        port_base=None,
+        routes=None,
+        default_route=None,
         tm_port=None,
         essential_port=None,
         vc_ports=None,
@@ -108,7 +110,9 @@ class FrameProcessorHost:
         ]
         self.host = host
         ports = Ports()
-        self.port_base = ports.base if port_base is None else port_base
+        self.routes = dict(routes or {})
+        self.default_route = ports.route(host) if default_route is None else default_route
+        self.unrouted = 0  # TC packets whose APID has no route
         tm_port = ports.tm if tm_port is None else tm_port
         self.essential_port = essential_port
         self.clock = clock
@@ -179,8 +183,14 @@ class FrameProcessorHost:
         if self.pus is not None and apid == self.pus.apid:
             self.pus.receive(packet)
             return
+        address = self.routes.get(apid)
+        if address is None and self.default_route:
+            address = self.default_route(apid)
+        if address is None:
+            self.unrouted += 1
+            return
         try:
-            self.out.sendto(packet, (self.host, self.port_base + apid))
+            self.out.sendto(packet, address)
         except OSError:
             pass  # nobody listening: UDP drops it, as the thesis' processes expect
 

@@ -231,19 +231,7 @@ class SampleSpacecraft:
         return fut.result(timeout)
 
     def _route_frames(self, routes):
-        proc = self.processor
-        base = proc._route
-
-        def route(apid, packet):
-            address = routes.get(apid)
-            if address is None:
-                return base(apid, packet)
-            try:
-                proc.out.sendto(packet, address)
-            except OSError:
-                pass
-
-        proc.core.route = route
+        self.processor.routes.update(routes)
 
     def set_tm_frames_peer(self, port):
         """Where TM frames go (Yamcs' frame link UDP port)."""

@@ -1,0 +1,119 @@
+"""One way from an APID to its port: a mission that fixes the ``pus`` and ``cfdp`` ports by
+name gets its TCs there, through the frames (ground FOP-1, CLTUs, the OBC's frame unit)."""
+
+import json
+import os
+import shutil
+import socket
+import time
+
+import pytest
+from obsw.frames import fop as F
+from obsw_host import sample
+from obsw_host.frames.ground import Ground
+from obsw_host.frames.links import SerialLink
+from obsw_host.mission import config as mission_config
+from obsw_host.mission.ids import MissionIds
+from obsw_host.mission.ports import Ports
+from obsw_host.obc.frames_unit import FramesUnit
+from obsw_host.obc.topology import Topology
+
+
+def _bound(n):
+    socks = []
+    for _ in range(n):
+        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        s.bind(("127.0.0.1", 0))
+        s.setblocking(False)
+        socks.append(s)
+    return socks
+
+
+def _free_base():
+    """A base whose whole mission range (base - 1 .. base + 5100) is below 65536 and whose
+    TM port is free now."""
+    while True:
+        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+        s.close()
+        if port + 6000 < 65536:
+            return port + 1
+
+
+def test_for_apid_follows_ports_fixed_by_name():
+    ports = Ports(6000, {"pus": 10, "cfdp": 100, "frames": 12}, {"pus": 7001, "cfdp": 7002})
+    assert ports.for_apid(10) == 7001 and ports.for_apid(100) == 7002
+    assert ports.for_apid(12) == 6012 and ports.for_apid(11) == 6011
+    assert ports.cfdp_ground == 6101  # still base + cfdp APID + 1: only "cfdp" was fixed
+    assert ports.routes("h") == {10: ("h", 7001), 12: ("h", 6012), 100: ("h", 7002)}
+
+
+@pytest.fixture
+def mission(tmp_path, monkeypatch):
+    monkeypatch.delenv("OBSW_PORT_BASE", raising=False)
+    folder = str(tmp_path / "fixed")
+    shutil.copytree(sample.MISSION_DIR, folder)
+    pus, cfdp = _bound(2)
+    path = os.path.join(folder, "mission.json")
+    with open(path) as f:
+        doc = json.load(f)
+    doc["ports"] = {
+        "base": _free_base(),
+        "pus": pus.getsockname()[1],
+        "cfdp": cfdp.getsockname()[1],
+    }
+    doc["processes"]["frames"] = ["frames"]
+    doc["frames"]["tc_security"] = "none"
+    with open(path, "w") as f:
+        json.dump(doc, f)
+    yield path, pus, cfdp
+    pus.close()
+    cfdp.close()
+
+
+def _tc(apid, seq, payload):
+    n = len(payload)
+    return bytes((0x18 | apid >> 8, apid & 0xFF, 0xC0, seq, 0, n - 1)) + payload
+
+
+def test_tcs_reach_the_ports_fixed_by_name(mission):
+    path, pus, cfdp = mission
+    config = mission_config.load(path)
+    os.makedirs(config.state, exist_ok=True)
+    topology = Topology(config)
+    ids = MissionIds.locate(path)
+    unit = FramesUnit(topology, topology.process("frames"), out=lambda s: None)
+    assert unit.fp.routes[ids.apid("pus")] == ("127.0.0.1", pus.getsockname()[1])
+    links = []
+    for side in ("a", "b"):
+        with open(os.path.join(config.state, "uart_" + side)) as f:
+            links.append(SerialLink(f.read().strip()))
+    length = int(config.section("frames").get("tm_frame_length", 256))
+    ground = Ground(links, ids.scid, tm_frame_length=length)
+    unit.start()
+    try:
+        t0 = time.monotonic()
+        ground.initiate(0.0)
+        sent = {pus: _tc(ids.apid("pus"), 1, b"to pus"), cfdp: _tc(ids.apid("cfdp"), 2, b"cfdp")}
+        got = {}
+        end = t0 + 20
+        queued = False
+        while time.monotonic() < end and len(got) < 2:
+            now = time.monotonic() - t0
+            ground.poll(now, 0.02)
+            if ground.fop.state == F.ACTIVE and not queued:
+                for packet in sent.values():
+                    ground.send(packet, now)
+                queued = True
+            for s in sent:
+                try:
+                    got[s] = s.recv(4096)
+                except BlockingIOError:
+                    pass
+        assert got == sent
+        assert unit.fp.unrouted == 0
+    finally:
+        unit.stop()
+        for link in links:
+            link.close()

@@ -29,6 +29,8 @@ class TmEncoder:
         self.rs = ReedSolomon(e, depth, frame_length) if self.has_rs else None
         self.conv = ConvEncoder() if self.has_conv else None
         self.cadu_length = self.rs.block_length + 4 if self.rs else frame_length + 4
+        # octets on the channel per frame (the convolutional code doubles them)
+        self.channel_length = self.cadu_length * 2 if self.conv else self.cadu_length
 
     def encode(self, frame):
         if len(frame) != self.frame_length:

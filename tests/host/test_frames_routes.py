@@ -117,3 +117,79 @@ def test_tcs_reach_the_ports_fixed_by_name(mission):
         unit.stop()
         for link in links:
             link.close()
+
+
+def _write(path, edit):
+    with open(path) as f:
+        doc = json.load(f)
+    edit(doc)
+    with open(path, "w") as f:
+        json.dump(doc, f)
+
+
+def test_both_ends_code_as_the_mission_says(mission):
+    """The OBC's frame unit encodes with the mission's tm_coding, at its downlink rate; the
+    station built from the same mission decodes it, and TCs still go up through it."""
+    from obsw_host.frames.station import GroundStation
+
+    path, pus, _ = mission
+
+    def coded(doc):
+        doc["frames"]["tm_coding"] = {"scheme": "concatenated", "interleave": 2}
+        doc["frames"]["downlink_bps"] = 400000  # a fast radio: the test takes no longer
+
+    _write(path, coded)
+    config = mission_config.load(path)
+    os.makedirs(config.state, exist_ok=True)
+    topology = Topology(config)
+    ids = MissionIds.locate(path)
+    unit = FramesUnit(topology, topology.process("frames"), out=lambda s: None)
+    assert unit.fp.core.tm_coding.coding == "concatenated"
+    links = []
+    for side in ("a", "b"):
+        with open(os.path.join(config.state, "uart_" + side)) as f:
+            links.append(SerialLink(f.read().strip()))
+    station = GroundStation.for_mission(ids, links)
+    mcs = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    mcs.bind(("127.0.0.1", 0))
+    unit.start()
+    try:
+        tm = bytes((0x08 | ids.apid("pus") >> 8, ids.apid("pus") & 0xFF, 0xC0, 1, 0, 3)) + b"abcd"
+        tc = _tc(ids.apid("pus"), 3, b"up")
+        mcs.sendto(tc, station.address)  # the station learns where TM goes
+        got_tc = None
+        end = time.monotonic() + 30
+        while time.monotonic() < end:
+            station.step(0.02)
+            try:
+                got_tc = pus.recv(4096)
+                pus.sendto(tm, ("127.0.0.1", unit.fp.tm_port))  # answer: TM down
+            except BlockingIOError:
+                pass
+            if tm in [p for _, p in station.downlinked]:
+                break
+        assert got_tc == tc
+        assert tm in [p for _, p in station.downlinked]
+        coding = station.ground.coding()
+        assert coding["frames"] > 0 and coding["uncorrectable"] == 0 and coding["locks"] >= 1
+    finally:
+        unit.stop()
+        station.close()
+        mcs.close()
+
+
+def test_mission_check_names_a_coding_that_does_not_fit(mission, capsys):
+    from obsw_host.cli import main
+
+    path = mission[0]
+    _write(path, lambda d: d["frames"].update(tm_coding={"scheme": "rs", "rs_e": 8}))
+    assert main(["mission", "check", path]) != 0
+    err = capsys.readouterr()
+    line = (err.out + err.err).strip()
+    assert line == (
+        "%s: $.frames.tm_coding.interleave: 256-octet TM frames do not fit RS(255,239) "
+        "interleaved 1 (239 octets at most); expected interleave 2 or a shorter "
+        "tm_frame_length" % path
+    )
+    _write(path, lambda d: d["frames"]["tm_coding"].update(interleave=2))
+    assert main(["mission", "check", path]) == 0

@@ -12,6 +12,25 @@ from obsw.frames.tc import Segment
 from obsw.frames.tm import TmFrame
 from obsw.frames.tm_demux import TmDemultiplexer
 
+CODING_COUNTERS = ("frames", "corrected", "uncorrectable", "locks", "losses", "slips")
+
+
+class _Coded:
+    """A TmDecoder with a CaduDecoder's ``feed``: frames whose codeblock could be decoded."""
+
+    def __init__(self, decoder, soft):
+        self.decoder = decoder
+        self.feed_input = decoder.feed_soft if soft else decoder.feed_octets
+
+    def feed(self, data):
+        return [f.data for f in self.feed_input(data) if f.data is not None]
+
+    def counters(self):
+        d, s = self.decoder, self.decoder.sync
+        return {"frames": d.frames - d.uncorrectable, "corrected": d.corrected,
+                "uncorrectable": d.uncorrectable, "locks": s.locks, "losses": s.losses,
+                "slips": s.slips}  # fmt: skip
+
 
 class Ground:
     """Sends telecommand packets through FOP-1 as CLTUs on every link and decodes telemetry.
@@ -22,6 +41,13 @@ class Ground:
     channel's SA before FOP-1 (ApplySecurity in virtual channel generation), and ``state`` (a
     ``keys.StateFile``) saves the sequence numbers after each one. With ``tm_security`` (an
     ``obsw.frames.sdls_gcm.TmSecurity``) TM frames of secured VCs are verified and decrypted.
+
+    With ``tm_decoder`` (a function returning an ``obsw.frames.tm_coding.TmDecoder``, e.g.
+    ``LinkSettings.decoder`` of ``obsw_host.frames.coding``) each link's TM is channel decoded
+    (Reed-Solomon, Viterbi, frame synchronization with bit errors and slips); a link whose
+    ``soft`` is true gives soft symbols (``obsw_host.frames.radio``), the others octets.
+    ``coding()`` sums the decoders' counters (corrected symbols, uncorrectable codeblocks,
+    locks, losses of lock, slips).
     """
 
     def __init__(
@@ -40,6 +66,7 @@ class Ground:
         security=None,
         state=None,
         tm_security=None,
+        tm_decoder=None,
     ):
         self.links = list(links)
         self.scid = scid
@@ -50,7 +77,11 @@ class Ground:
         self.tc_randomize = tc_randomize
         self.fop = F.Fop1(scid, vcid, window, t1, transmission_limit)
         self.corrupt = corrupt
-        self.decoders = [CaduDecoder(tm_frame_length, tm_randomize) for _ in self.links]
+        if tm_decoder is None:
+            self.decoders = [CaduDecoder(tm_frame_length, tm_randomize) for _ in self.links]
+        else:
+            self.decoders = [_Coded(tm_decoder(), getattr(link, "soft", False))
+                             for link in self.links]  # fmt: skip
         self.dedup = Deduplicator(5.0)
         self.demux = TmDemultiplexer(scid, security=tm_security)
         self.queue = deque()
@@ -114,6 +145,15 @@ class Ground:
         self._flush(now)
         self.packets.extend(got)
         return got
+
+    def coding(self):
+        """The channel decoders' counters summed over the links (zeros without coding)."""
+        out = dict.fromkeys(CODING_COUNTERS, 0)
+        for d in self.decoders:
+            if isinstance(d, _Coded):
+                for name, value in d.counters().items():
+                    out[name] += value
+        return out
 
     @property
     def idle(self):

@@ -17,6 +17,11 @@ severity, aux: VC ID u8, SPI u16, sequence number u64) of the frame processor's 
 process, which also serves TCs to that APID (e.g. TC[5,6] to disable an event). At most
 ``event_limit`` such reports go out per second; the others are counted (``events_limited``).
 ``state`` (a ``keys.StateFile``) saves the sequence numbers each time a frame is accepted.
+
+The downlink (``tm_coding``, ``downlink_bps``, ``tm_spill``: see ``obsw.frames.processor``):
+a TM packet that finds its virtual channel and the spill store full is reported, with
+``overflow_event`` (an event ID), as a PUS event of that APID (TM[5,3], aux: VC ID u8, packet
+length u16), within the same ``event_limit``; it is counted (``tm_dropped``) in every case.
 """
 
 import os
@@ -103,6 +108,7 @@ class FrameProcessorHost:
         event_apid=None,
         event_ids=EVENT_IDS,
         event_limit=10,
+        overflow_event=None,
         **options,
     ):
         self.links = [
@@ -128,8 +134,12 @@ class FrameProcessorHost:
         self.pus = None
         if event_apid is not None:
             self.pus = ApplicationProcess(event_apid, self.core.send_packet, _Clock(clock))
-            self.pus.register(EventReporting(known=[i for i in event_ids if i]))
+            known = [i for i in event_ids if i] + ([overflow_event] if overflow_event else [])
+            self.pus.register(EventReporting(known=known))
         self.core.rejected_listeners.append(self._rejected)
+        self.overflow_event = overflow_event
+        self._overflowing = False
+        self.core.overflow_listeners.append(self._overflow)
         self._accepted = 0
         if vc_ports is None:
             pb = self.core.playback_vcid
@@ -166,7 +176,19 @@ class FrameProcessorHost:
         return s
 
     def _rejected(self, outcome, vcid, spi, sn):
-        if self.pus is None:
+        self._event(self.event_ids[outcome], struct.pack(">BHQ", vcid, spi, sn))
+
+    def _overflow(self, vcid, packet):
+        if self._overflowing:  # the report itself found no room: counted, not reported again
+            return
+        self._overflowing = True
+        try:
+            self._event(self.overflow_event, struct.pack(">BH", vcid, len(packet)))
+        finally:
+            self._overflowing = False
+
+    def _event(self, event_id, aux):
+        if self.pus is None or not event_id:
             return
         second = int(self.clock())
         start, n = self._event_window
@@ -176,8 +198,7 @@ class FrameProcessorHost:
             self.events_limited += 1
             return
         self._event_window = (start, n + 1)
-        aux = struct.pack(">BHQ", vcid, spi, sn)
-        self.pus.event(self.event_ids[outcome], 3, aux)
+        self.pus.event(event_id, 3, aux)
 
     def _route(self, apid, packet):
         if self.pus is not None and apid == self.pus.apid:

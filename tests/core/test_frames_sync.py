@@ -138,6 +138,21 @@ class TestLock(unittest.TestCase):
                 self.assertEqual(fs.losses, 1)
                 self.assertEqual(datas[-1], frames[-1])
 
+    def test_early_asm_found_across_a_chunk_boundary(self):
+        # bits lost just before an ASM make it come early; the feed that ended where the ASM
+        # was due kept the bits it needs to look back at
+        frames = frames_of(6)
+        period = 8 * (LEN + 4)
+        for slip in (1, 2):
+            bits = stream(frames)
+            at = 16 + 3 * period - 8
+            bits = bits[:at] + bits[at + slip :]
+            for cut in range(16 + 3 * period - 4, 16 + 3 * period + 4):
+                fs = sync.FrameSync(LEN, slip=2)
+                got = fs.feed(bits[:cut]) + fs.feed(bits[cut:]) + fs.flush()
+                self.assertEqual([g.data for g in got][3:], frames[3:])
+                self.assertEqual((fs.slips, fs.losses), (1, 0))
+
     def test_verify_needs_consecutive_asms(self):
         frames = frames_of(4)
         fs = sync.FrameSync(LEN, verify=3)

@@ -59,7 +59,7 @@ class Ground:
         tm_frame_length=256,
         tc_randomize=False,
         tm_randomize=True,
-        window=10,
+        window=5,  # FOP-1's K: at most FARM-1's positive window (W/2 of the OBC's W=10)
         t1=2.0,
         transmission_limit=5,
         corrupt=None,

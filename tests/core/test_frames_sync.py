@@ -1,6 +1,7 @@
 """Frame synchronization (131.0-B) and the TM coding chains: ASM errors, slips, polarity, lock."""
 
 import unittest
+from array import array
 
 from obsw.frames import sync, tm_coding
 from obsw.frames.asm import ASM
@@ -171,7 +172,7 @@ class TestChains(unittest.TestCase):
             bits = bits_mangler(bits)
         dec = tm_coding.TmDecoder(length, coding, 8, depth)
         if dec.has_conv:
-            got = dec.feed_soft([1 if b else -1 for b in bits]) + dec.flush()
+            got = dec.feed_soft(array("b", [1 if b else -1 for b in bits])) + dec.flush()
         else:
             got = dec.feed_bits(bits) + dec.flush()
         return frames, got, dec

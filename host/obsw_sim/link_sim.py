@@ -78,7 +78,8 @@ def run(bps=9600, ber=1e-3, ebn0_db=None, coding="concatenated", interleave=2,
     # link use: frame slots handed while data waited, and how many of them carried data
     slots_waiting = 0
     slots_used = 0
-    data_octets = 0
+    data_octets = 0  # packet octets in the frames received while the dump and file lasted
+    frames_while = 0
     t = 0.0
     next_hk = 0.0
     played = 0
@@ -120,8 +121,11 @@ def run(bps=9600, ber=1e-3, ebn0_db=None, coding="concatenated", interleave=2,
             if frame.data is None:
                 continue
             tm = TmFrame.unpack(frame.data)
-            for p in demux.on_frame(tm):
-                data_octets += len(p)
+            packets = demux.on_frame(tm)
+            if start <= t and done is None and tm.vcid != 7:  # while the dump and file last
+                frames_while += 1
+                data_octets += sum(len(p) for p in packets)
+            for p in packets:
                 kind = kinds.get(((p[0] & 7) << 8) | p[1])
                 if kind is not None:
                     got[kind].append(p)
@@ -151,11 +155,10 @@ def run(bps=9600, ber=1e-3, ebn0_db=None, coding="concatenated", interleave=2,
     total = sum(len(v) for v in sent.values())
     lost = sum(len(set(sent[k]) - set(got[k])) for k in sent)
     frames_down = fp.counters["tm_frames"]
-    return Figures(
+    return Figures(  # fmt: skip
         bps=bps, coding=coding, ber=ber if ebn0_db is None else 0.0, ebn0_db=ebn0_db,
         seconds=t, link_use=100.0 * slots_used / slots_waiting if slots_waiting else 0.0,
-        octet_use=100.0 * data_octets / max(1, (frames_down - fp.counters["tm_idle_frames"])
-                                             * fp.mux.data_length),
+        octet_use=100.0 * data_octets / max(1, frames_while * fp.mux.data_length),
         hk_period=hk_period, hk_mean=sum(intervals) / len(intervals) if intervals else 0.0,
         hk_min=min(intervals) if intervals else 0.0, hk_max=max(intervals) if intervals else 0.0,
         hk_received=len(got["hk"]), sent=total, lost=lost,

@@ -222,6 +222,35 @@ class TestChains(unittest.TestCase):
         datas = [g.data for g in got]
         self.assertEqual(datas[-4:], frames[-4:])
 
+    def test_viterbi_corrections_counted(self):
+        rnd = Lcg(5)
+        frames = [rnd.data(30) for _ in range(8)]
+        enc = tm_coding.TmEncoder(30, "conv")
+        clean = sync.unpack_bits(b"".join(enc.encode(f) for f in frames))
+        for where in ((), (100,), range(200, 2000, 61)):
+            bits = flip(clean, where)
+            dec = tm_coding.TmDecoder(30, "conv", count_symbols=True)
+            got = []
+            for i in range(0, len(bits), 300):
+                got += dec.feed_soft([1 if b else -1 for b in bits[i : i + 300]])
+            got += dec.flush()
+            self.assertEqual([g.data for g in got], frames)
+            self.assertEqual(dec.symbol_errors, len(where))
+            self.assertEqual(dec.check.symbols, len(bits))
+        self.assertEqual(tm_coding.TmDecoder(30, "rs", count_symbols=True).symbol_errors, 0)
+
+    def test_viterbi_count_after_a_realignment(self):
+        rnd = Lcg(11)
+        frames = [rnd.data(30) for _ in range(12)]
+        enc = tm_coding.TmEncoder(30, "conv")
+        bits = sync.unpack_bits(b"".join(enc.encode(f) for f in frames))[1:]  # one symbol lost
+        bits = flip(bits, (3001,))
+        dec = tm_coding.TmDecoder(30, "conv", realign=2, count_symbols=True)
+        for i in range(0, len(bits), 500):
+            dec.feed_soft([1 if b else -1 for b in bits[i : i + 500]])
+        dec.flush()
+        self.assertEqual(dec.symbol_errors, 1)  # the flip after the realignment, nothing else
+
     def test_bad_coding_name(self):
         with self.assertRaises(ValueError):
             tm_coding.TmEncoder(100, "turbo")

@@ -49,7 +49,8 @@ class LinkSettings:
     def decoder(self):
         """A ground ``TmDecoder`` (one per link: each keeps its own lock)."""
         length = self.encoder().cadu_length - 4
-        return TmDecoder(*self._args(), sync=FrameSync(length, **self.coding["sync"]))
+        return TmDecoder(*self._args(), sync=FrameSync(length, **self.coding["sync"]),
+                         count_symbols=True)  # fmt: skip
 
     @property
     def channel_length(self):

@@ -12,7 +12,8 @@ from obsw.frames.tc import Segment
 from obsw.frames.tm import TmFrame
 from obsw.frames.tm_demux import TmDemultiplexer
 
-CODING_COUNTERS = ("frames", "corrected", "uncorrectable", "locks", "losses", "slips")
+CODING_COUNTERS = ("frames", "corrected", "symbol_errors", "uncorrectable", "locks", "losses",
+                   "slips")  # fmt: skip
 
 
 class _Coded:
@@ -28,7 +29,7 @@ class _Coded:
     def counters(self):
         d, s = self.decoder, self.decoder.sync
         return {"frames": d.frames - d.uncorrectable, "corrected": d.corrected,
-                "uncorrectable": d.uncorrectable, "locks": s.locks, "losses": s.losses,
+                "symbol_errors": d.symbol_errors, "uncorrectable": d.uncorrectable, "locks": s.locks, "losses": s.losses,
                 "slips": s.slips}  # fmt: skip
 
 
@@ -46,8 +47,8 @@ class Ground:
     ``LinkSettings.decoder`` of ``obsw_host.frames.coding``) each link's TM is channel decoded
     (Reed-Solomon, Viterbi, frame synchronization with bit errors and slips); a link whose
     ``soft`` is true gives soft symbols (``obsw_host.frames.radio``), the others octets.
-    ``coding()`` sums the decoders' counters (corrected symbols, uncorrectable codeblocks,
-    locks, losses of lock, slips).
+    ``coding()`` sums the decoders' counters (frames, RS symbols corrected, channel symbols the
+    Viterbi decoder corrected, uncorrectable codeblocks, locks, losses of lock, slips).
     """
 
     def __init__(

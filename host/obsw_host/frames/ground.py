@@ -29,8 +29,8 @@ class _Coded:
     def counters(self):
         d, s = self.decoder, self.decoder.sync
         return {"frames": d.frames - d.uncorrectable, "corrected": d.corrected,
-                "symbol_errors": d.symbol_errors, "uncorrectable": d.uncorrectable, "locks": s.locks, "losses": s.losses,
-                "slips": s.slips}  # fmt: skip
+                "symbol_errors": d.symbol_errors, "uncorrectable": d.uncorrectable,
+                "locks": s.locks, "losses": s.losses, "slips": s.slips}  # fmt: skip
 
 
 class Ground:

@@ -108,11 +108,12 @@ class TmDecoder:
     """The ground side: ``feed_bits`` (hard bits, one per octet), ``feed_octets`` (hard
     octets) or ``feed_soft`` (soft symbols, positive means 1) give DecodedFrames.
 
-    Counters: ``frames``, ``corrected`` (RS symbols), ``uncorrectable`` (codeblocks),
-    with ``count_symbols`` ``symbol_errors`` (channel symbols the Viterbi decoder corrected,
-    see ``SymbolCheck``; 0 without the convolutional code), and the synchronizer's (``sync.locks``, ``sync.losses``, ``sync.slips``). With the
-    convolutional code, a stream that finds no lock within ``realign`` CADUs is shifted by one
-    symbol (the pair alignment of a stream joined in the middle is unknown)."""
+    Counters: ``frames``, ``corrected`` (RS symbols), ``uncorrectable`` (codeblocks), with
+    ``count_symbols`` ``symbol_errors`` (channel symbols the Viterbi decoder corrected, see
+    ``SymbolCheck``; 0 without the convolutional code), and the synchronizer's (``sync.locks``,
+    ``sync.losses``, ``sync.slips``). With the convolutional code, a stream that finds no lock
+    within ``realign`` CADUs is shifted by one symbol (the pair alignment of a stream joined in
+    the middle is unknown)."""
 
     def __init__(self, frame_length, coding="none", e=16, depth=1, randomize=True,
                  sync=None, realign=3, count_symbols=False):  # fmt: skip

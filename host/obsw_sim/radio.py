@@ -9,10 +9,11 @@ bursts (``burst_rate`` per bit, ``burst_length`` bits each wrong with probabilit
 slips (``slip_rate`` per bit: a bit dropped or repeated). The clock is the caller's (a
 simulated one in tests). ``busy`` counts the seconds the channel was on the air.
 
-``RadioLink`` runs a channel each way in real time between the controller end of the OBC's
-UART (a pty) and a ground station's ``UdpLink`` (soft symbols or octets), and takes the
-station's CLTUs back on the same UDP socket: the simulation's radio, configured from a
-mission's ``frames`` section (``from_mission``).
+``RadioLink`` runs a channel each way in real time between the OBC's side (the controller end
+of its UART, a pty; or, with ``space_peer``, a UDP link of the frame processor that sends its
+channel octets to ``space_address``) and a ground station's ``UdpLink`` (soft symbols or
+octets), and takes the station's CLTUs back on the same UDP socket: the simulation's radio,
+configured from a mission's ``frames`` section (``from_mission``).
 """
 
 import array
@@ -155,9 +156,18 @@ class RadioLink:
     ``down`` and ``up`` are the two RadioChannels; soft symbols go as int8 (the station's
     ``udp:PORT:int8``), octets as they are."""
 
-    def __init__(self, uart_fd, station, down, up, host="127.0.0.1", clock=time.monotonic):
+    def __init__(self, uart_fd, station, down, up, host="127.0.0.1", clock=time.monotonic,
+                 space_peer=None):  # fmt: skip
         self.fd = uart_fd
-        os.set_blocking(uart_fd, False)
+        self.space_peer = space_peer
+        self.space = None
+        if uart_fd is None:  # the OBC's side on UDP
+            self.space = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+            self.space.bind((host, 0))
+            self.space.setblocking(False)
+            self.space_address = self.space.getsockname()
+        else:
+            os.set_blocking(uart_fd, False)
         self.station = station
         self.down = down
         self.up = up
@@ -171,7 +181,7 @@ class RadioLink:
         self.t0 = None
 
     @classmethod
-    def from_mission(cls, link, uart_fd, station, seed=None):
+    def from_mission(cls, link, uart_fd, station, seed=None, space_peer=None):
         """A radio for ``link`` (``obsw_host.frames.coding.LinkSettings``): its downlink and
         uplink rates (9,600 and 2,400 bit/s when the mission gives none) and radio model."""
         r = dict(link.radio)
@@ -183,15 +193,32 @@ class RadioLink:
             r["burst_length"], r["slip_rate"], r["seed"],
         )  # fmt: skip
         up = RadioChannel(link.uplink_bps or 2400, 0.0, seed=r["seed"] + 1, soft=False)
-        return cls(uart_fd, station, down, up)
+        return cls(uart_fd, station, down, up, space_peer=space_peer)
+
+    def _space_read(self):
+        if self.space is None:
+            return os.read(self.fd, 65536)
+        chunks = []
+        while True:
+            try:
+                chunks.append(self.space.recv(65536))
+            except OSError:
+                return b"".join(chunks)
+
+    def _space_write(self, data):
+        if self.space is None:
+            os.write(self.fd, data)
+        elif self.space_peer is not None:
+            self.space.sendto(data, self.space_peer)
 
     def step(self, timeout=0.01):
         now = self.clock()
-        readable, _, _ = select.select([self.fd, self.sock], [], [], timeout)
-        if self.fd in readable:
+        side = self.fd if self.space is None else self.space
+        readable, _, _ = select.select([side, self.sock], [], [], timeout)
+        if side in readable:
             try:
-                self.down.send(os.read(self.fd, 65536), now)
-            except (BlockingIOError, OSError):
+                self.down.send(self._space_read(), now)
+            except OSError:
                 pass
         if self.sock in readable:
             while True:
@@ -214,7 +241,7 @@ class RadioLink:
         cltus = self.up.receive(now)
         if cltus:
             try:
-                os.write(self.fd, cltus)
+                self._space_write(cltus)
             except OSError:
                 pass
 
@@ -232,3 +259,5 @@ class RadioLink:
         if self._thread is not None:
             self._thread.join(2)
         self.sock.close()
+        if self.space is not None:
+            self.space.close()

@@ -16,7 +16,7 @@ CODING_COUNTERS = ("frames", "corrected", "symbol_errors", "uncorrectable", "loc
                    "slips")  # fmt: skip
 
 
-class _Coded:
+class CodedInput:
     """A TmDecoder with a CaduDecoder's ``feed``: frames whose codeblock could be decoded."""
 
     def __init__(self, decoder, soft):
@@ -31,6 +31,16 @@ class _Coded:
         return {"frames": d.frames - d.uncorrectable, "corrected": d.corrected,
                 "symbol_errors": d.symbol_errors, "uncorrectable": d.uncorrectable,
                 "locks": s.locks, "losses": s.losses, "slips": s.slips}  # fmt: skip
+
+
+def coding_counters(decoders):
+    """The counters of the ``CodedInput`` among ``decoders``, summed."""
+    out = dict.fromkeys(CODING_COUNTERS, 0)
+    for d in decoders:
+        if isinstance(d, CodedInput):
+            for name, value in d.counters().items():
+                out[name] += value
+    return out
 
 
 class Ground:
@@ -81,7 +91,7 @@ class Ground:
         if tm_decoder is None:
             self.decoders = [CaduDecoder(tm_frame_length, tm_randomize) for _ in self.links]
         else:
-            self.decoders = [_Coded(tm_decoder(), getattr(link, "soft", False))
+            self.decoders = [CodedInput(tm_decoder(), getattr(link, "soft", False))
                              for link in self.links]  # fmt: skip
         self.dedup = Deduplicator(5.0)
         self.demux = TmDemultiplexer(scid, security=tm_security)
@@ -149,12 +159,7 @@ class Ground:
 
     def coding(self):
         """The channel decoders' counters summed over the links (zeros without coding)."""
-        out = dict.fromkeys(CODING_COUNTERS, 0)
-        for d in self.decoders:
-            if isinstance(d, _Coded):
-                for name, value in d.counters().items():
-                    out[name] += value
-        return out
+        return coding_counters(self.decoders)
 
     @property
     def idle(self):

@@ -54,6 +54,10 @@ class GroundStation:
         options.setdefault("tm_decoder", link.decoder)
         return cls(links, ids.scid, **options)
 
+    def coding(self):
+        """The channel decoders' counters (``Ground.coding``)."""
+        return self.ground.coding()
+
     def now(self):
         return self.clock() - self._t0
 

@@ -177,8 +177,8 @@ def processor(args):
     section = dict(ids.config.section("frames")) if ids.config is not None else {}
     if args.frame_length is not None:
         section["tm_frame_length"] = args.frame_length
-    link = LinkSettings(section)
-    problems = link.problems()
+    space = LinkSettings(section)
+    problems = space.problems()
     if problems:
         raise UserError("processor: frames.tm_coding", expected=problems[0][1])
     security = {}
@@ -199,10 +199,10 @@ def processor(args):
             default_route=default_route,
             tm_port=tm_port,
             vc_ports={plan["playback"]: playback},
-            tm_frame_length=link.frame_length,
-            tm_coding=link.encoder(),
-            downlink_bps=link.downlink_bps,
-            tm_spill=link.tm_spill,
+            tm_frame_length=space.frame_length,
+            tm_coding=space.encoder(),
+            downlink_bps=space.downlink_bps,
+            tm_spill=space.tm_spill,
             essential_map=args.essential_map,
             tm_plan=plan,
             tm_channels=ids.tm_channels() if plan == ids.tm_vcs else None,
@@ -218,7 +218,7 @@ def processor(args):
           "playback TM on UDP %d (VC %d)" % (
         args.uart_a, args.uart_b, args.host, route_to, host.tm_port, plan["realtime"],
         host.playback_port, plan["playback"]))  # fmt: skip
-    print("space link: %s" % link.describe())
+    print("space link: %s" % space.describe())
     if args.keys:
         print("TC security: %d SA(s) from %s, events on APID %d" % (
             len(security["security"].sas), args.keys, security["event_apid"]))  # fmt: skip

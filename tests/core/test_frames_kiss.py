@@ -44,6 +44,10 @@ class KissTest(unittest.TestCase):
         self.assertEqual(got, [b"p1"])
         self.assertEqual(kiss.encode(b"", port=2)[1], 0x20)
 
+    def test_port_12_command_octet_escaped(self):
+        self.assertEqual(kiss.encode(b"a", port=12), b"\xc0\xdb\xdca\xc0")
+        self.assertEqual(kiss.KissDecoder(port=12).feed(kiss.encode(b"a", port=12)), [b"a"])
+
     def test_bad_escape_counted_octet_kept(self):
         d = kiss.KissDecoder()
         self.assertEqual(d.feed(b"\xc0\x00a\xdbzb\xc0"), [b"azb"])

@@ -12,9 +12,10 @@ DATA = const(0)
 
 
 def encode(data, port=0, command=DATA):
-    """One KISS frame carrying ``data`` (command ``command`` on TNC port ``port``)."""
-    out = bytearray((FEND, (port << 4) | command))
-    for b in data:
+    """One KISS frame carrying ``data`` (command ``command`` on TNC port ``port``); the
+    command octet is escaped too (port 12's data frames would otherwise start with FEND)."""
+    out = bytearray((FEND,))
+    for b in bytes(((port << 4) | command,)) + bytes(data):
         if b == FEND:
             out.append(FESC)
             out.append(TFEND)

@@ -157,7 +157,7 @@ class RadioLink:
     ``udp:PORT:int8``), octets as they are."""
 
     def __init__(self, uart_fd, station, down, up, host="127.0.0.1", clock=time.monotonic,
-                 space_peer=None):  # fmt: skip
+                 space_peer=None, port=0):  # fmt: skip
         self.fd = uart_fd
         self.space_peer = space_peer
         self.space = None
@@ -173,7 +173,7 @@ class RadioLink:
         self.up = up
         self.clock = clock
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self.sock.bind((host, 0))
+        self.sock.bind((host, port))
         self.sock.setblocking(False)
         self.address = self.sock.getsockname()
         self._stop = threading.Event()
@@ -181,7 +181,7 @@ class RadioLink:
         self.t0 = None
 
     @classmethod
-    def from_mission(cls, link, uart_fd, station, seed=None, space_peer=None):
+    def from_mission(cls, link, uart_fd, station, seed=None, space_peer=None, port=0):
         """A radio for ``link`` (``obsw_host.frames.coding.LinkSettings``): its downlink and
         uplink rates (9,600 and 2,400 bit/s when the mission gives none) and radio model."""
         r = dict(link.radio)
@@ -193,7 +193,7 @@ class RadioLink:
             r["burst_length"], r["slip_rate"], r["seed"],
         )  # fmt: skip
         up = RadioChannel(link.uplink_bps or 2400, 0.0, seed=r["seed"] + 1, soft=False)
-        return cls(uart_fd, station, down, up, space_peer=space_peer)
+        return cls(uart_fd, station, down, up, space_peer=space_peer, port=port)
 
     def _space_read(self):
         if self.space is None:
@@ -254,6 +254,10 @@ class RadioLink:
         self._thread.start()
         return self
 
+    def wait(self, timeout=None):
+        """Until ``stop`` (or ``timeout`` seconds)."""
+        self._stop.wait(timeout)
+
     def stop(self):
         self._stop.set()
         if self._thread is not None:
@@ -261,3 +265,48 @@ class RadioLink:
         self.sock.close()
         if self.space is not None:
             self.space.close()
+
+
+def main(argv=None):
+    import argparse
+
+    from obsw_host.frames.coding import LinkSettings
+    from obsw_host.mission.ids import MissionIds
+
+    ap = argparse.ArgumentParser(
+        prog="python -m obsw_sim.radio",
+        description="the simulated radio between an OBC's UART and a station's UDP link, as "
+        "the mission's frames section says",
+    )
+    ap.add_argument("--mission", required=True, help="mission folder or file")
+    ap.add_argument("--uart", required=True, help="the OBC's UART device (STATE/uart_a names it)")
+    ap.add_argument("--station", required=True, help="HOST:PORT of the station's UDP link")
+    ap.add_argument("--port", type=int, default=0, help="this radio's UDP port (0: free)")
+    ap.add_argument("--duration", type=float, help="stop after N seconds")
+    args = ap.parse_args(argv)
+    ids = MissionIds.locate(args.mission)
+    link = LinkSettings.of(ids.config)
+    host, _, port = args.station.rpartition(":")
+    fd = os.open(args.uart, os.O_RDWR | os.O_NOCTTY)
+    radio = RadioLink.from_mission(link, fd, (host or "127.0.0.1", int(port)), port=args.port)
+    soft = "int8" if radio.down.soft else "octets"
+    print("radio: %s <-> udp %s (%s), listening on udp %s:%d; down %g bit/s, up %g bit/s"
+          % (args.uart, args.station, soft, radio.address[0], radio.address[1],
+             radio.down.bps, radio.up.bps), flush=True)  # fmt: skip
+    radio.start()
+    try:
+        radio.wait(args.duration)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        radio.stop()
+        os.close(fd)
+    print("radio: %d bits down (%d flipped, %d slips), %d bits up" % (
+        radio.down.bits, radio.down.flipped, radio.down.slips, radio.up.bits))  # fmt: skip
+    return 0
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.exit(main())

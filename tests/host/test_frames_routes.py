@@ -193,3 +193,62 @@ def test_mission_check_names_a_coding_that_does_not_fit(mission, capsys):
     )
     _write(path, lambda d: d["frames"]["tm_coding"].update(interleave=2))
     assert main(["mission", "check", path]) == 0
+
+
+def test_the_obcs_uart_through_the_simulated_radio(mission):
+    """The OBC's frame unit on its pty, the radio model on the other end of it (bit errors at
+    1e-3 on AWGN-free hard bits, the mission's rates), the station on the radio's UDP side:
+    a TC goes up through COP-1 and its answer comes down decoded."""
+    from obsw_host.frames.coding import LinkSettings
+    from obsw_host.frames.radio import UdpLink
+    from obsw_host.frames.station import GroundStation
+    from obsw_sim.radio import RadioLink
+
+    path, pus, _ = mission
+
+    def radio(doc):
+        doc["frames"].update(
+            tm_coding={"scheme": "concatenated", "interleave": 2},
+            downlink_bps=64000, uplink_bps=9600, radio={"ber": 1e-3, "seed": 5},
+        )  # fmt: skip
+
+    _write(path, radio)
+    config = mission_config.load(path)
+    os.makedirs(config.state, exist_ok=True)
+    topology = Topology(config)
+    ids = MissionIds.locate(path)
+    unit = FramesUnit(topology, topology.process("frames"), out=lambda s: None)
+    with open(os.path.join(config.state, "uart_a")) as f:
+        uart = os.open(f.read().strip(), os.O_RDWR | os.O_NOCTTY)
+    station_link = UdpLink(0, "octets")
+    station = GroundStation.for_mission(ids, [station_link])
+    air = RadioLink.from_mission(LinkSettings.of(config), uart, station_link.address)
+    station_link.peer = air.address
+    mcs = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    mcs.bind(("127.0.0.1", 0))
+    unit.start()
+    air.start()
+    try:
+        tm = bytes((0x08 | ids.apid("pus") >> 8, ids.apid("pus") & 0xFF, 0xC0, 9, 0, 3)) + b"down"
+        tc = _tc(ids.apid("pus"), 4, b"over the air")
+        mcs.sendto(tc, station.address)
+        got_tc = None
+        end = time.monotonic() + 60
+        while time.monotonic() < end and tm not in [p for _, p in station.downlinked]:
+            station.step(0.02)
+            try:
+                got_tc = pus.recv(4096)
+                pus.sendto(tm, ("127.0.0.1", unit.fp.tm_port))
+            except BlockingIOError:
+                pass
+        assert got_tc == tc
+        assert tm in [p for _, p in station.downlinked]
+        coding = station.coding()
+        assert air.down.flipped > 0 and coding["symbol_errors"] > 0
+        assert coding["uncorrectable"] == 0 and coding["losses"] == 0
+    finally:
+        air.stop()
+        unit.stop()
+        station.close()
+        mcs.close()
+        os.close(uart)

@@ -140,7 +140,7 @@ def _port(args, ids, apid):
     """``--port``, else the mission's UDP port of process ``apid``."""
     if args.port is not None:
         return args.port
-    return ids.ports.pus if apid == ids.apid("pus") else ids.ports.app(apid)
+    return ids.ports.for_apid(apid)
 
 
 def _client(args):

@@ -178,9 +178,11 @@ def make_entity(
     limit=10,
     inactivity=60.0,
     keep_alive=0.5,
+    state=None,
 ):
     """A CfdpEntity with one MIB entry per peer and timer values suited to a UDP link (a
-    receiver reports its progress in a keep-alive PDU every ``keep_alive`` seconds)."""
+    receiver reports its progress in a keep-alive PDU every ``keep_alive`` seconds).
+    ``state``: the folder of the persisted state, outside the filestore (None: inside it)."""
     remotes = [
         RemoteEntity(
             eid,
@@ -196,7 +198,11 @@ def make_entity(
         )
         for eid in peers
     ]
-    return CfdpEntity(Mib(local_id, remotes), filestore, persist=persist)
+    if state is not None:
+        from obsw_host.cfdp.filestore import RootedFilestore
+
+        state = RootedFilestore(state)
+    return CfdpEntity(Mib(local_id, remotes), filestore, persist=persist, state=state)
 
 
 def packet_type_for(onboard):

@@ -123,7 +123,7 @@ class Transaction:
         st["timers"] = [t.state() for t in self.timers]
         st["origin"] = list(self.origin) if self.origin else None
         st["proxy_put"] = self.proxy_put
-        ent.fs.write_atomic(ent.state_name(self.tid, self.role), json.dumps(st).encode())
+        ent.state_fs.write_atomic(ent.state_name(self.tid, self.role), json.dumps(st).encode())
 
     def restore_common(self, st, now):
         self.suspended = st["suspended"]

@@ -162,3 +162,34 @@ def test_a_task_that_dies_is_reported_and_restarted(tmp_path):
         assert not unit.alive()  # five within the window: the platform restarts the process
     finally:
         unit.stop()
+
+
+SPOILED = [b"{}", b"[]", b"null", b"\xff\xfe", b"[" * 100000, b'{"active": "z"}']
+
+
+def state_files(state):
+    """Every file of the OBC's state folder but the filestore's and the lock."""
+    out = []
+    for folder, _, names in os.walk(state):
+        if os.path.relpath(folder, state).split(os.sep)[0] == "files":
+            continue
+        out += [os.path.join(folder, n) for n in names
+                if not n.endswith((".lock", ".bad")) and not n.startswith("bad-")]  # fmt: skip
+    return sorted(out)
+
+
+def test_no_content_of_any_state_file_stops_a_start(obc):
+    assert obc.obsw("ground", "params", "set", "nav.distance=7").returncode == 0
+    obc.stop()
+    files = state_files(obc.state)
+    names = [os.path.relpath(f, obc.state) for f in files]
+    assert {"context/parameters", "software/boot.json", "cfdp/seq"} <= set(names), names
+    for content in SPOILED:
+        for path in state_files(obc.state):
+            with open(path, "wb") as f:
+                f.write(content)
+        obc.lines.clear()
+        obc.start(wait=False)
+        assert obc.wait_up() and obc.ping(), (content[:10], obc.text())
+        assert not obc.said("Traceback"), obc.text()
+        obc.stop()

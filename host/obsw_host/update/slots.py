@@ -30,7 +30,15 @@ import os
 import shutil
 
 from obsw import jsonsafe
-from obsw.update.package import BadManifest, HashMismatch, PackageError, Reader, sha256_hex
+from obsw.update.package import (
+    BadManifest,
+    HashMismatch,
+    PackageError,
+    Reader,
+    check_floor,
+    sha256_hex,
+    version_key,
+)
 
 FACTORY = "factory"
 SLOTS = ("a", "b")
@@ -235,10 +243,30 @@ class Software:
         self._change(staged)
         return manifest
 
+    # ---------------------------------------------------------------------- anti-rollback
+
+    def floor(self):
+        """The oldest version this OBC takes: the newest it has confirmed (kept in
+        ``floor``, written before the boot record says so), never below the factory's."""
+        best = self.factory
+        try:
+            with open(os.path.join(self.root, "floor"), "rb") as f:
+                text = f.read(256).decode().strip()
+            if text and version_key(text) > version_key(best):
+                best = text
+        except (OSError, ValueError):
+            pass
+        return best
+
+    def _raise_floor(self, version):
+        if version and version_key(version) > version_key(self.floor()):
+            _write_atomic(os.path.join(self.root, "floor"), version.encode())
+            _sync_dir(self.root)
+
     def _unpack(self, package, part, active, verify, key, mission):
         with open(package, "rb") as stream:
             reader = Reader(stream, verify, key, mission, "obc")
-            m = reader.manifest
+            m = check_floor(reader.manifest, self.floor())
             if m["base"] is not None and m["base"] != self.version(active):
                 raise BadManifest("a delta to version %s, the OBC runs %s" % (
                     m["base"], self.version(active)))  # fmt: skip
@@ -347,6 +375,7 @@ class Software:
             trial = record["trial"]
             if not trial:
                 return None
+            self._raise_floor(self.version(trial["slot"]))  # no going below it from now on
             record["previous"], record["active"] = record["active"], trial["slot"]
             record["trial"] = None
             self._log(record, "confirmed", self.version(trial["slot"]))

@@ -38,10 +38,9 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(ROOT, "tools"))
+from obsw_host import firmware
 
-import firmware  # noqa: E402
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 OPS_SCRIPT = os.path.join(ROOT, "tools", "bench", "board_ops.py")
 SHIFT = 7  # -icount shift: 2**SHIFT ns of virtual time per guest instruction

@@ -31,8 +31,8 @@ class Filestore:
     """What the entity needs from a filestore. Names are '/'-separated strings.
 
     Subclasses implement the methods that raise NotImplementedError; the others are built on them.
-    Read handles have ``read(offset, n)`` and ``close()``; write handles ``write(offset, data)``
-    and ``close()``.
+    Read handles have ``read(offset, n)`` and ``close()``; write handles ``write(offset, data)``,
+    ``close()`` and optionally ``sync()`` (the data on the medium before it returns).
     """
 
     def open_read(self, name):
@@ -119,6 +119,9 @@ class _MemHandle:
             if offset > size:
                 buf.extend(bytes(offset - size))
             buf[offset:] = data
+
+    def sync(self):
+        pass
 
     def close(self):
         pass
@@ -228,6 +231,14 @@ class _FileHandle:
             f.seek(offset)
         f.write(data)
         self.pos = offset + len(data)
+
+    def sync(self):
+        """On the medium before this returns (``os.fsync`` where the interpreter has it)."""
+        f = self.f
+        f.flush()
+        fsync = getattr(os, "fsync", None)
+        if fsync is not None:
+            fsync(f.fileno())
 
     def close(self):
         self.f.close()

@@ -56,8 +56,8 @@ class StateError(ValueError):
 def _ints(name, v, n):
     if not isinstance(v, list) or (n is not None and len(v) != n):
         raise StateError("%s: expected a list of %s integers, got %r" % (name, n, v), name)
-    for x in v:
-        if not isinstance(x, int) or x < 0:
+    for x in v:  # flags are booleans (not ints on MicroPython)
+        if not isinstance(x, _BOOL) or x < 0:
             raise StateError("%s: expected integers >= 0, got %r" % (name, v), name)
 
 

@@ -213,6 +213,13 @@ class Receiver(Transaction):
         self.save(force=True)
         self._check_done(now)
 
+    def sync_data(self):
+        fh = self._fh
+        if fh is not None:
+            sync = getattr(fh, "sync", None)
+            if sync is not None:
+                sync()
+
     def _file(self):
         if self._fh is None:
             fs = self.entity.fs
@@ -334,8 +341,7 @@ class Receiver(Transaction):
         return ck.value == self.eof[0]
 
     def _complete(self, now):
-        if self._fh is not None and hasattr(self._fh, "flush"):
-            self._fh.flush()
+        self.sync_data()  # the whole file on the medium before it is renamed and reported
         if not self._verify():
             if not self.fault(FILE_CHECKSUM_FAILURE, now):
                 return

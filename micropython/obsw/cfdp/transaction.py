@@ -109,10 +109,14 @@ class Transaction:
         return 0
 
     # -- persistence ----------------------------------------------------------------------
+    def sync_data(self):
+        """Put the data this transaction wrote on the medium (before its state claims it)."""
+
     def save(self, force=False):
         ent = self.entity
         if not ent.persist or self.done:
             return
+        self.sync_data()  # durability order: the data first, then the progress that claims it
         st = self.state()
         st["role"] = self.role
         st["tid"] = list(self.tid)

@@ -69,7 +69,10 @@ def add_to_ground(s):
 
 
 def render(picture):
-    """The picture as rich tables: values, events, commands."""
+    """The picture as rich tables: values, events, commands (what came from the spacecraft is
+    escaped: no control character and no rich markup of its own reaches the terminal)."""
+    from rich.markup import escape as markup
+
     values = Table(title="current values", expand=True, title_justify="left")
     for column in ("parameter", "value", "unit", "limit", "on-board time (UTC)"):
         values.add_column(column)
@@ -77,13 +80,15 @@ def render(picture):
         limit = v["limit"]
         style = _LIMIT_STYLES.get(limit, "")
         value = number(v["value"])
-        values.add_row(name, value, v["unit"], limit or "-", v["time"], style=style or None)
+        values.add_row(markup(name), markup(value), v["unit"], limit or "-", v["time"],
+                       style=style or None)  # fmt: skip
     events = Table(title="latest events", expand=True, title_justify="left")
     for column in ("time (UTC)", "event", "severity", "data"):
         events.add_column(column)
     for e in picture.events:
         style = _SEVERITY_STYLES.get(e["severity"], "") or None
-        events.add_row(e["time"], e["event"], str(e["severity"]), e["data"], style=style)
+        events.add_row(e["time"], markup(e["event"]), markup(str(e["severity"])),
+                       markup(e["data"]), style=style)  # fmt: skip
     commands = Table(title="commands", expand=True, title_justify="left")
     for column in ("request", "apid", "seq", "verification"):
         commands.add_column(column)

@@ -37,6 +37,7 @@ from obsw_host.pus.display import Picture, number
 from obsw_host.pus.tm_fanout import LINGER
 
 HISTORY_FILE = "ground-history"
+LOS_AFTER = 5.0  # seconds without TM before `watch` shows loss of signal
 _LIMIT_STYLES = {"ok": "green", "warning": "yellow", "critical": "bold red", "out of range": "red"}
 _SEVERITY_STYLES = {"info": "", "low": "cyan", "medium": "yellow", "high": "bold red"}
 _CONSOLE_KEYS = ("func", "action", "history", "once", "count", "every", "seconds")
@@ -54,6 +55,13 @@ def add_to_ground(s):
     x.add_argument("--count", type=arguments.count, help="print this many frames and exit")
     x.add_argument("--every", type=arguments.seconds, default=1.0, help="seconds between frames")
     x.add_argument("--seconds", type=arguments.seconds, help="stop after this many seconds")
+    x.add_argument(
+        "--los",
+        type=arguments.seconds,
+        default=LOS_AFTER,
+        help="seconds without TM before the view shows loss of signal and marks every value "
+        "as stale (default %g)" % LOS_AFTER,
+    )
     x.set_defaults(func=_watch)
     x = s.add_parser(
         "console",
@@ -68,19 +76,23 @@ def add_to_ground(s):
 # ------------------------------------------------------------------------------ watch
 
 
-def render(picture):
-    """The picture as rich tables: values, events, commands (what came from the spacecraft is
-    escaped: no control character and no rich markup of its own reaches the terminal)."""
+def render(picture, los_after=LOS_AFTER):
+    """The picture as rich tables: values, events, commands; at loss of signal the values are
+    dimmed and their limit column says so. What came from the spacecraft is escaped: no
+    control character and no rich markup of its own reaches the terminal."""
     from rich.markup import escape as markup
 
-    values = Table(title="current values", expand=True, title_justify="left")
+    signal, lost = picture.signal(los_after)
+    title = "current values (%s)" % signal
+    values = Table(title=title, expand=True, title_justify="left")
     for column in ("parameter", "value", "unit", "limit", "on-board time (UTC)"):
         values.add_column(column)
     for name, v in picture.values.items():
         limit = v["limit"]
-        style = _LIMIT_STYLES.get(limit, "")
+        style = "dim" if lost else _LIMIT_STYLES.get(limit, "")
         value = number(v["value"])
-        values.add_row(markup(name), markup(value), v["unit"], limit or "-", v["time"],
+        limit = "stale (%s)" % (limit or "-") if lost else (limit or "-")
+        values.add_row(markup(name), markup(value), v["unit"], limit, v["time"],
                        style=style or None)  # fmt: skip
     events = Table(title="latest events", expand=True, title_justify="left")
     for column in ("time (UTC)", "event", "severity", "data"):
@@ -123,13 +135,24 @@ def _watch(args):
         g.subscribe()
         _ask_housekeeping(g, picture)
         if args.json:
-            show = lambda: print(json.dumps(picture.snapshot()), flush=True)  # noqa: E731
-            return _frames(g, args, frames, show)
-        console = Console()
-        if frames is not None or not console.is_terminal:
-            return _frames(g, args, frames, lambda: console.print(render(picture)))
-        with Live(render(picture), console=console, auto_refresh=False) as live:
-            return _frames(g, args, None, lambda: live.update(render(picture), refresh=True))
+            show = lambda: print(json.dumps(picture.snapshot(args.los)), flush=True)  # noqa: E731
+            rc = _frames(g, args, frames, show)
+        else:
+            console = Console()
+            if frames is not None or not console.is_terminal:
+                rc = _frames(g, args, frames, lambda: console.print(render(picture, args.los)))
+            else:
+                with Live(render(picture, args.los), console=console, auto_refresh=False) as live:
+                    rc = _frames(
+                        g, args, None, lambda: live.update(render(picture, args.los), refresh=True)
+                    )
+        if picture.received == 0:
+            print(
+                "no TM from %s:%s: is `obsw obc serve` running there?" % g.target,
+                file=sys.stderr,
+            )
+            return 1
+        return rc
 
 
 def _frames(g, args, frames, show):

@@ -162,5 +162,21 @@ class TestFileGone(unittest.TestCase):
         self.assertTrue(tid2[1] > tid[1])
 
 
+class TestNulInNames(unittest.TestCase):
+    def test_a_nul_in_a_file_name_is_a_filestore_rejection_the_sender_is_told(self):
+        a = entity(1, 2, MemoryFilestore({"src.bin": DATA}))
+        b = entity(2, 1)
+        tid = a.put(2, "src.bin", "bad\0name.bin")
+        link = Link(a, b)
+        self.assertTrue(link.run())
+        self.assertEqual([i.info["condition"] for i in link.finished(0)], [FILESTORE_REJECTION])
+        self.assertEqual([i.info["condition"] for i in link.finished(1)], [FILESTORE_REJECTION])
+        self.assertEqual(b.tx, {})
+        self.assertEqual([n for n in b.fs.files if "bad" in n], [])
+        self.assertTrue(tid[1] >= 1)
+        with self.assertRaises(OSError):
+            MemoryFilestore().open_write("a\0b")
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -138,6 +138,8 @@ class MemoryFilestore(Filestore):
 
     @staticmethod
     def _n(name):
+        if "\0" in name:
+            raise FilestoreError("a NUL in the file name %r" % name, name)
         return name.strip("/")
 
     def _parent_ok(self, n):
@@ -273,6 +275,8 @@ class OsFilestore(Filestore):
         self.root = root.rstrip("/") or "/"
 
     def path(self, name):
+        if "\0" in name:  # no file system takes one; refused as the standard's filestore error
+            raise FilestoreError("a NUL in the file name %r" % name, name)
         n = normalize(name)
         if n is None:
             raise FilestoreError("name escapes the filestore: %s" % name, name)

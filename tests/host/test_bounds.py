@@ -7,11 +7,11 @@ import os
 import shutil
 import socket
 
-from brick_rig import LiveObc, make_mission
 from obsw_host import sample
 from obsw_host.mission.folder import MAX_JSON_FILE, MAX_PROCEDURE
 from obsw_host.mission.new import free_fleet_base
 from obsw_host.pus.tm_fanout import MAX_SUBSCRIBERS, SUBSCRIBE, TmFanout
+from obsw_sim.brick import LiveObc, make_mission
 from test_mission_examples import ENV, obsw
 
 

@@ -8,13 +8,13 @@ import os
 import time
 
 import pytest
-from brick_rig import LiveObc, make_mission, wait_for
 from obsw.cfdp import msgs
 from obsw.cfdp.defs import FS_DELETE_FILE
 from obsw.cfdp.tlv import FilestoreRequest
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity, packet_type_for
 from obsw_host.mission.ids import MissionIds
+from obsw_sim.brick import LiveObc, make_mission, wait_for
 
 
 @pytest.fixture
@@ -181,6 +181,10 @@ def state_files(state):
 def test_no_content_of_any_state_file_stops_a_start(obc):
     assert obc.obsw("ground", "params", "set", "nav.distance=7").returncode == 0
     obc.stop()
+    os.makedirs(os.path.join(obc.state, "cfdp"), exist_ok=True)
+    for name, text in (("cfdp/seq", "5"), ("cfdp/remote-copy.json", "[]")):
+        with open(os.path.join(obc.state, name), "w") as f:
+            f.write(text)
     files = state_files(obc.state)
     names = [os.path.relpath(f, obc.state) for f in files]
     assert {"context/parameters", "software/boot.json", "cfdp/seq"} <= set(names), names

@@ -1,7 +1,7 @@
-"""A live OBC for the brick reproductions (issue 34): `obsw obc serve` of a copy of the sample
-with the PUS process and the CFDP entity, on a port base whose every port is free, with its
-own state folder; the ground reaches it through the real `obsw` command. Used by
-``test_brick.py`` and by ``tools/brick_campaign.py``."""
+"""A live OBC for the brick reproductions: `obsw obc serve` of a copy of the sample with the
+PUS process and the CFDP entity, on a port base whose every port is free, with its own state
+folder; the ground reaches it through the real `obsw` command. Used by the brick tests and by
+``tools/brick_campaign.py``."""
 
 import json
 import os
@@ -15,7 +15,7 @@ import time
 from obsw_host import sample
 from obsw_host.mission.new import free_fleet_base
 
-ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))  # a checkout
 OBSW = [sys.executable, "-m", "obsw_host.cli"]
 BOUND = 60.0  # seconds any one wait of these runs may take, at most
 

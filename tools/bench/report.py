@@ -37,6 +37,7 @@ RUNS = {
     "il": ("il.py", {}, "Interaction layer"),
     "cfdp": ("cfdp.py", {}, "CFDP in memory"),
     "cfdp_udp": ("cfdp_udp.py", {}, "CFDP over UDP, two processes"),
+    "cfdp_loss": ("cfdp_loss.py", {}, "CFDP over UDP at 10 % loss: octets sent per octet"),
     "spacecan": ("spacecan.py", {}, "SpaceCAN"),
     "frames": ("frames.py", {}, "Space data link: frames, CLTU, COP-1, SDLS"),
     "sdls": ("sdls.py", {}, "SDLS AES-256-GCM per frame"),

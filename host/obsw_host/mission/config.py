@@ -22,7 +22,6 @@ was expected. ``obsw_host.mission.check`` checks the whole mission folder before
 JSON Schema of the file (``obsw_host/mission/schema``) states every key.
 """
 
-import json
 import os
 
 from obsw_host.mission.defaults import PLATFORM as _PLATFORM
@@ -38,8 +37,10 @@ _LEGACY_KINDS = {"solar_panel": ("SolarPanel", {"module": "obsw_host.solar_panel
 
 def parse_json(text, where):
     """The one place a configuration's JSON is parsed."""
+    from obsw_host.mission.folder import loads_json
+
     try:
-        return json.loads(text)
+        return loads_json(text)
     except ValueError as e:
         raise ConfigError(where, "not valid JSON (%s)" % e) from None
 
@@ -138,10 +139,13 @@ class MissionConfig:
 def load(path=None):
     """The configuration of mission ``path`` (a folder or its file), else of the one
     ``obsw_host.mission.locate`` finds ($OBSW_MISSION, a mission.json here or above)."""
+    from obsw_host.mission.folder import read_text
+
     path = locate(path)
     try:
-        with open(path) as f:
-            text = f.read()
+        text = read_text(path, root=os.path.dirname(os.path.abspath(path)))
+    except UnicodeDecodeError as e:
+        raise ConfigError(path, "not UTF-8 text (%s)" % e) from None
     except OSError as e:
         raise ConfigError(path, "cannot read (%s)" % e.strerror) from None
     return MissionConfig(parse_json(text, path), path)

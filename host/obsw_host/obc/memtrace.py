@@ -2,7 +2,8 @@
 
 With ``$OBSW_TRACEMALLOC`` naming a folder, each process (the platform manager and every unit
 process) traces its allocations from its start (``tracemalloc``, a few frames deep) and, on
-SIGUSR2, writes a snapshot there as ``NAME-PID-N.snap``. Without it nothing is traced and the
+SIGUSR2, writes a snapshot there as ``NAME-PID-N.snap`` (``$OBSW_TRACEMALLOC_FRAMES`` sets
+the frames kept, default 4). Without it nothing is traced and the
 signal keeps its default. ``growers(old, new)`` names the lines whose memory grew most between
 two snapshots of one process.
 """
@@ -23,7 +24,7 @@ def install(name):
     import tracemalloc
 
     os.makedirs(folder, exist_ok=True)
-    tracemalloc.start(FRAMES)
+    tracemalloc.start(int(os.environ.get(ENV + "_FRAMES") or FRAMES))
     count = [0]
     safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in name)
 

@@ -50,15 +50,9 @@ from obsw.pus.services.s23_files import FileManagement
 from obsw_host.mission.ids import EVENT_COPY_COMPLETED, EVENT_COPY_FAILED, EVENT_OVERRUN, event_id
 from obsw_host.mission.ports import app_port
 from obsw_host.net import DEFAULT_HOST
+from obsw_host.pus.tai import TAI_MINUS_UNIX, tai_now  # noqa: F401 (names of this module too)
 from obsw_host.pus.tm_fanout import TmFanout
 from obsw_host.pus.tm_log import TmLog
-
-TAI_MINUS_UNIX = 378691200 + 37  # seconds from 1958-01-01 TAI to 1970-01-01 UTC, now
-
-
-def tai_now():
-    """On-board time: TAI seconds since 1958-01-01 from the host clock."""
-    return time.time() + TAI_MINUS_UNIX
 
 
 def copy_events(sdb):

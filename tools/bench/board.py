@@ -18,10 +18,10 @@ collection of the case's heap, counted on the board (to 10,000 instructions: the
 conservative stack scan reads a few words the REPL left at the host's pace), each time its
 allocations add up to the heap the application leaves free on a Pyboard (the low-water mark of
 the `heap` stage's session, which the benchmark runs itself on a freshly booted board and
-reports in its first row). The empty operation (the timer reads and a call) is subtracted. Each case
-runs on a freshly booted board (after a soft reset the heap was found a few bytes apart from
-one run to the next, and the counts with it), so no figure depends on which cases ran before;
-`--check` measures every case twice and compares every count.
+reports in its first row). The empty operation (the timer reads and a call) is subtracted.
+Each case runs on a freshly booted board (after a soft reset the heap was found a few bytes
+apart from one run to the next, and the counts with it), so no figure depends on which cases
+ran before; `--check` measures every case twice and compares every count.
 
 The counts are Thumb-2 instructions of the Cortex-M3 build; a Pyboard's Cortex-M4 runs the same
 interpreter code (its build adds the FPU, which the core's few float operations use). The CPU

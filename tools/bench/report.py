@@ -1,6 +1,6 @@
 """Benchmark pages from the benchmarks' own `--json` output: nothing on them is typed by hand.
 
-    python tools/bench/report.py run [--quick] [NAME...]   # run benchmarks, save their JSON
+    python tools/bench/report.py run [--quick] [--args '...'] [NAME...]   # run, save their JSON
     python tools/bench/report.py write                     # write the pages from the saved JSON
     python tools/bench/report.py check                     # exit 1 if a page differs from it
 
@@ -51,6 +51,7 @@ RUNS = {
     "recovery": ("recovery.py", {}, "Autonomous recovery of a hung OBC"),
     "update": ("update.py", {}, "In-flight update of the OBC"),
     "ed25519": ("ed25519.py", {}, "Ed25519 verify of an update's signature"),
+    "soak": ("soak.py", {}, "Soak: the OBC's memory over hours"),
 }
 # benchmarks whose figures do not depend on the host's load (instructions counted under QEMU)
 EXACT = ("board",)
@@ -73,13 +74,15 @@ def _commit():
     return res.stdout.strip() or None
 
 
-def run(names, quick):
-    """Run the named benchmarks (all when empty) and save each one's JSON with its run record."""
+def run(names, quick, args=()):
+    """Run the named benchmarks (all when empty) and save each one's JSON with its run record;
+    ``args``: more arguments for each (`--minutes 60`)."""
     DATA.mkdir(parents=True, exist_ok=True)
     failed = []
     for name in names or list(RUNS):
         script, extra, _ = RUNS[name]
         argv = [sys.executable, str(BENCH / script), "--json"] + (["--quick"] if quick else [])
+        argv += list(args)
         env = dict(os.environ, **extra)
         before, t0 = _loadavg(), time.time()
         res = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True)
@@ -96,6 +99,7 @@ def run(names, quick):
                 ["%s=%s" % kv for kv in sorted(extra.items())]
                 + ["python", "tools/bench/" + script, "--json"]
                 + (["--quick"] if quick else [])
+                + list(args)
             ),
             "quick": quick,
             "seconds": round(seconds, 1),
@@ -388,6 +392,9 @@ def main(argv=None):
     r = sub.add_parser("run", help="run benchmarks and save their --json output")
     r.add_argument("names", nargs="*", metavar="NAME", help="of: " + ", ".join(RUNS))
     r.add_argument("--quick", action="store_true", help="each benchmark's --quick run")
+    r.add_argument(
+        "--args", default="", help="more arguments for the benchmarks, in quotes: '--minutes 60'"
+    )
     sub.add_parser("write", help="write the pages from the saved data")
     sub.add_parser("check", help="exit 1 if a page differs from the saved data")
     args = ap.parse_args(argv)
@@ -395,7 +402,7 @@ def main(argv=None):
         unknown = [n for n in args.names if n not in RUNS]
         if unknown:
             ap.error("unknown benchmark %s; expected one of %s" % (unknown, ", ".join(RUNS)))
-        failed = run(args.names, args.quick)
+        failed = run(args.names, args.quick, args.args.split())
         write()
         return 1 if failed else 0
     if args.action == "write":

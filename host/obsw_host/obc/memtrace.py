@@ -3,7 +3,8 @@
 With ``$OBSW_TRACEMALLOC`` naming a folder, each process (the platform manager and every unit
 process) traces its allocations from its start (``tracemalloc``, a few frames deep) and, on
 SIGUSR2, writes a snapshot there as ``NAME-PID-N.snap`` (``$OBSW_TRACEMALLOC_FRAMES`` sets
-the frames kept, default 4). Without it nothing is traced and the
+the frames kept, default 4); with ``$OBSW_TRACEMALLOC_PERIOD`` (seconds) it also appends the
+memory it traces now to ``NAME-PID.traced`` that often. Without it nothing is traced and the
 signal keeps its default. ``growers(old, new)`` names the lines whose memory grew most between
 two snapshots of one process.
 """
@@ -35,7 +36,25 @@ def install(name):
         os.replace(path + ".part", path)  # a reader never sees half a snapshot
 
     signal.signal(signal.SIGUSR2, dump)
+    period = float(os.environ.get(ENV + "_PERIOD") or 0)
+    if period > 0:
+        import threading
+
+        path = os.path.join(folder, "%s-%d.traced" % (safe, os.getpid()))
+        threading.Thread(target=_record, args=(path, period), daemon=True).start()
     return folder
+
+
+def _record(path, period):
+    """Append 'unix-time traced-bytes' to ``path`` every ``period`` seconds (cheap: no
+    snapshot, so the process's memory does not jump as it does when one is taken)."""
+    import time
+    import tracemalloc
+
+    while True:
+        with open(path, "a") as f:
+            f.write("%.1f %d\n" % (time.time(), tracemalloc.get_traced_memory()[0]))
+        time.sleep(period)
 
 
 def growers(old_path, new_path, top=10):

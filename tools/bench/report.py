@@ -84,7 +84,7 @@ def run(names, quick, args=()):
         argv = [sys.executable, str(BENCH / script), "--json"] + (["--quick"] if quick else [])
         argv += list(args)
         env = dict(os.environ, **extra)
-        before, t0 = _loadavg(), time.time()
+        before, t0, commit = _loadavg(), time.time(), _commit()  # the code that runs
         res = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True)
         seconds = time.time() - t0
         lines = [line for line in res.stdout.splitlines() if line.startswith("{")]
@@ -108,7 +108,7 @@ def run(names, quick, args=()):
             "cpus": os.cpu_count(),
             "python": "%s %s" % (platform.python_implementation(), platform.python_version()),
             "machine": platform.machine(),
-            "commit": _commit(),
+            "commit": commit,
         }
         path = DATA / (name + ".json")
         path.write_text(json.dumps(result, indent=1, sort_keys=True) + "\n")

@@ -340,6 +340,8 @@ def main(argv=None):
     phase = args.phase or (0.3 if q else 10.0)
     sample = args.sample or (5.0 if q else 10.0)
     out = (lambda s: print(s, file=sys.stderr, flush=True)) if args.json else print
+    # stopped early (SIGTERM): the OBC is stopped and the folder removed all the same
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(1))
     work = tempfile.mkdtemp(prefix="obsw-soak-")
     soak = Soak(work, not args.no_trace, sample, out)
     try:

@@ -1076,6 +1076,148 @@ cbor_frame_loads(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
     return v;
 }
 
+/* ------------------------------------------------------------------------------------------
+ * Viterbi decoding of the CCSDS rate 1/2, K=7 code (131.0-B 3.3): the add-compare-select and
+ * the chainback of obsw.frames.viterbi.Viterbi27 on signed 8-bit soft symbols (positive: 1).
+ * Same metrics, same tie rule (the lower predecessor wins), so the same bits as the Python loop.
+ * Decisions are one little-endian 64-bit word per bit: bit s set when state s came from s/2+32.
+ */
+static int
+v27_parity(unsigned x)
+{
+    x ^= x >> 4;
+    x ^= x >> 2;
+    x ^= x >> 1;
+    return (int)(x & 1u);
+}
+
+static PyObject *
+viterbi27(PyObject *self, PyObject *args)
+{
+    PyObject *metrics, *decisions, *out;
+    Py_buffer view;
+    Py_ssize_t n, base;
+    long long p[64], q[64];
+    int tab[32];
+    const signed char *sy;
+    unsigned char *dst;
+
+    (void)self;
+    if (!PyArg_ParseTuple(args, "O!y*nO!:viterbi27", &PyList_Type, &metrics, &view, &n,
+                          &PyByteArray_Type, &decisions))
+        return NULL;
+    if (PyList_GET_SIZE(metrics) != 64 || n < 0 || n > view.len || (n & 1)) {
+        PyBuffer_Release(&view);
+        PyErr_SetString(PyExc_ValueError, "viterbi27: 64 metrics and an even symbol count");
+        return NULL;
+    }
+    for (int s = 0; s < 64; s++) {
+        p[s] = PyLong_AsLongLong(PyList_GET_ITEM(metrics, s));
+        if (p[s] == -1 && PyErr_Occurred()) {
+            PyBuffer_Release(&view);
+            return NULL;
+        }
+    }
+    for (int j = 0; j < 32; j++) {
+        int c1 = v27_parity((unsigned)(2 * j) & 0x4Fu);
+        int c2 = v27_parity((unsigned)(2 * j) & 0x6Du) ^ 1;
+        tab[j] = (1 - c1) * 2 + (1 - c2);
+    }
+    base = PyByteArray_GET_SIZE(decisions);
+    if (PyByteArray_Resize(decisions, base + (n / 2) * 8) < 0) {
+        PyBuffer_Release(&view);
+        return NULL;
+    }
+    dst = (unsigned char *)PyByteArray_AS_STRING(decisions) + base;
+    sy = (const signed char *)view.buf;
+    for (Py_ssize_t i = 0; i < n; i += 2) {
+        long long a = sy[i], b = sy[i + 1], m[4];
+        unsigned long long d = 0;
+        m[0] = a + b;
+        m[1] = a - b;
+        m[2] = b - a;
+        m[3] = -a - b;
+        for (int j = 0; j < 32; j++) {
+            long long mu = m[tab[j]], x, y;
+            x = p[j] + mu;
+            y = p[j + 32] - mu;
+            if (x >= y)
+                q[2 * j] = x;
+            else {
+                q[2 * j] = y;
+                d |= 1ull << (2 * j);
+            }
+            x = p[j] - mu;
+            y = p[j + 32] + mu;
+            if (x >= y)
+                q[2 * j + 1] = x;
+            else {
+                q[2 * j + 1] = y;
+                d |= 2ull << (2 * j);
+            }
+        }
+        if (q[0] > (1 << 24) || q[0] < -(1 << 24)) {
+            long long top = q[0];
+            for (int s = 0; s < 64; s++)
+                q[s] -= top;
+        }
+        memcpy(p, q, sizeof(p));
+        for (int k = 0; k < 8; k++)
+            dst[k] = (unsigned char)(d >> (8 * k));
+        dst += 8;
+    }
+    PyBuffer_Release(&view);
+    out = PyList_New(64);
+    if (out == NULL)
+        return NULL;
+    for (int s = 0; s < 64; s++) {
+        PyObject *v = PyLong_FromLongLong(p[s]);
+        if (v == NULL) {
+            Py_DECREF(out);
+            return NULL;
+        }
+        PyList_SET_ITEM(out, s, v);
+    }
+    return out;
+}
+
+static PyObject *
+viterbi27_chainback(PyObject *self, PyObject *args)
+{
+    Py_buffer view;
+    unsigned int state;
+    Py_ssize_t count, steps;
+    PyObject *out;
+    unsigned char *o;
+    const unsigned char *dec;
+
+    (void)self;
+    if (!PyArg_ParseTuple(args, "y*In:viterbi27_chainback", &view, &state, &count))
+        return NULL;
+    steps = view.len / 8;
+    if (count < 0 || count > steps) {
+        PyBuffer_Release(&view);
+        PyErr_SetString(PyExc_ValueError, "viterbi27_chainback: count beyond the decisions");
+        return NULL;
+    }
+    out = PyBytes_FromStringAndSize(NULL, count);
+    if (out == NULL) {
+        PyBuffer_Release(&view);
+        return NULL;
+    }
+    o = (unsigned char *)PyBytes_AS_STRING(out);
+    dec = (const unsigned char *)view.buf;
+    state &= 63u;
+    for (Py_ssize_t t = steps - 1; t >= 0; t--) {
+        unsigned bit = (dec[8 * t + (state >> 3)] >> (state & 7u)) & 1u;
+        if (t < count)
+            o[t] = (unsigned char)(state & 1u);
+        state = (state >> 1) | (bit << 5);
+    }
+    PyBuffer_Release(&view);
+    return out;
+}
+
 #define FASTCALL(f) (PyCFunction)(void (*)(void))(f), METH_FASTCALL
 
 static PyMethodDef methods[] = {
@@ -1090,6 +1232,8 @@ static PyMethodDef methods[] = {
     {"cbor_frame_loads", FASTCALL(cbor_frame_loads),
      "Decode the one whole length-prefixed frame data holds, or return the second arg."},
     {"crc16_ccitt", crc16_ccitt, METH_VARARGS, "CRC-16/CCITT-FALSE continuing a register."},
+    {"viterbi27", viterbi27, METH_VARARGS, "K=7 r=1/2 add-compare-select on int8 soft symbols."},
+    {"viterbi27_chainback", viterbi27_chainback, METH_VARARGS, "Bits traced back, oldest first."},
     {NULL, NULL, 0, NULL},
 };
 

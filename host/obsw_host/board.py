@@ -67,11 +67,8 @@ def frozen_modules():
 
 
 def firmware_tools():
-    """tools/firmware.py of this repository (the pinned-source builds and the QEMU board)."""
-    tools = os.path.join(repo_root(), "tools")
-    if tools not in sys.path:
-        sys.path.insert(0, tools)
-    import firmware
+    """``obsw_host.firmware``: the pinned-source builds and the QEMU board."""
+    from obsw_host import firmware
 
     return firmware
 
@@ -206,7 +203,7 @@ def deploy(
 
         # written after the modules were listed: the board's /mission.json, not a module
         cmd += ["+", "cp", board_file(ids, out_dir), ":mission.json"]
-        public = _update_key(ids)
+        public = update_key(ids)
         if public is not None:  # what the board checks update packages with
             cmd += ["+", "cp", public, ":update.pub"]
     if keys is not None:
@@ -302,7 +299,7 @@ def update(package, port=None):
     return lines[-1]
 
 
-def _update_key(ids):
+def update_key(ids):
     """The mission's update public key file, or None."""
     from obsw_host.mission import defaults
 

@@ -235,3 +235,10 @@ def ed25519_accelerator():
         return True
 
     return verify
+
+
+def bytes_ops():
+    """True where the channel codecs may use CPython's C byte operations (``bytes.translate``
+    and slices with a step, which MicroPython lacks), i.e. on CPython without OBSW_PURE; the
+    codecs' loops in Python stay the definition and a test shows both give the same octets."""
+    return not pure() and hasattr(bytes, "translate")

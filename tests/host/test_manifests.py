@@ -2,12 +2,10 @@
 or not (lazy imports inside functions too), is in the image's manifest."""
 
 import pathlib
-import sys
+
+from obsw_host import mpy
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tools"))
-
-import mpy  # noqa: E402
 
 ROOTS = [ROOT / "micropython", ROOT / "boards" / "common", ROOT / "boards" / "OBSW_RECONFIG"]
 IMAGES = {

@@ -190,7 +190,7 @@ class FakeManager:
         self.children = [FakeChild(n) for n in names]
         self.lines = []
 
-    def _say(self, text):
+    def say(self, text):
         self.lines.append(text)
 
 

@@ -24,14 +24,14 @@ import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path[:0] = [str(ROOT / "micropython"), str(ROOT / "tools")]
+sys.path[:0] = [str(ROOT / "micropython")]
 
-import firmware  # noqa: E402
 from cryptography.hazmat.primitives.asymmetric.ed25519 import (  # noqa: E402
     Ed25519PrivateKey,
     Ed25519PublicKey,
 )
 from obsw.update import ed25519  # noqa: E402
+from obsw_host import firmware  # noqa: E402
 
 SHIFT = 5  # -icount shift: 2**SHIFT ns of virtual time per guest instruction
 TICK_NS = 40  # the CMSDK APB timer at the MPS2 board's 25 MHz

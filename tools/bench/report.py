@@ -40,6 +40,7 @@ RUNS = {
     "spacecan": ("spacecan.py", {}, "SpaceCAN"),
     "frames": ("frames.py", {}, "Space data link: frames, CLTU, COP-1, SDLS"),
     "sdls": ("sdls.py", {}, "SDLS AES-256-GCM per frame"),
+    "coding": ("coding.py", {}, "TM channel coding: Reed-Solomon, convolutional, Viterbi"),
     "pluto": ("pluto.py", {}, "PLUTO procedures"),
     "reconfig": ("reconfig.py", {}, "Reconfiguration module logic (host)"),
     "board": ("board.py", {}, "Reconfiguration module CPU budget (Cortex-M, QEMU)"),

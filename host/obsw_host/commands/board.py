@@ -146,7 +146,7 @@ def _deploy(args):
         print("%d modules deployed" % len(names))
         if ids is not None:
             print("mission.json of %s installed on the board" % ids.name)
-            if board._update_key(ids) is not None:
+            if board.update_key(ids) is not None:
                 print("update.pub installed: the board takes packages signed for %s" % ids.name)
             else:
                 print("update.pub NOT installed (the mission names no update.public_key): "

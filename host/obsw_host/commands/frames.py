@@ -83,13 +83,43 @@ def add_parser(sub):
     dec.add_argument("--randomize", action="store_true", help="remove the TC randomizer")
     dec.set_defaults(func=cltu_decode)
 
-    tm = s.add_parser("tm", help="decode a TM frame")
+    tm = s.add_parser("tm", help="encode or decode TM frames (CCSDS 131.0-B channel coding)")
     ts = tm.add_subparsers(dest="tm_action", metavar="ACTION")
     ts.required = True
-    tdec = ts.add_parser("decode", help="TM frame (hex, ASM and randomization optional)")
-    tdec.add_argument("hex")
+    tenc = ts.add_parser("encode", help="TM frames to a coded channel stream (ASM, RS, conv)")
+    tenc.add_argument("hex", nargs="?", help="one TM frame in hex (or --in FILE)")
+    _coding_arguments(tenc)
+    tenc.set_defaults(func=tm_encode)
+    tdec = ts.add_parser("decode", help="TM frame (hex, ASM and randomization optional), or a "
+                         "coded stream with --coding")  # fmt: skip
+    tdec.add_argument("hex", nargs="?", help="one TM frame or CADU in hex (or --in FILE)")
     tdec.add_argument("--randomized", action="store_true", help="frame is TM-randomized")
+    _coding_arguments(tdec)
+    tdec.add_argument(
+        "--soft", action="store_true", help="--in holds int8 soft symbols (positive: 1)"
+    )
+    tdec.add_argument("--no-fecf", action="store_true", help="frames carry no FECF")
     tdec.set_defaults(func=tm_decode)
+
+
+def _coding_arguments(p):
+    p.add_argument(
+        "--coding",
+        choices=("none", "rs", "conv", "concatenated"),
+        help="131.0-B channel coding (decode: a stream, not one frame)",
+    )
+    p.add_argument("--interleave", type=int, default=1, help="RS interleaving depth I (1)")
+    p.add_argument(
+        "--rs-e", type=int, choices=(16, 8), default=16,
+        help="RS correction capability: 16 = (255,223), 8 = (255,239)",
+    )  # fmt: skip
+    p.add_argument("--frame-length", type=int,
+                   help="TM frame length in octets (encode: the frames' own)")  # fmt: skip
+    p.add_argument("--no-randomize", action="store_true", help="no pseudo-randomizer")
+    p.add_argument("--in", dest="infile", help="input file, hex or binary (- for stdin)")
+    p.add_argument("--out", help="output file: binary (.bin) or hex (anything else)")
+    p.add_argument("--format", choices=("auto", "hex", "bin"), default="auto",
+                   help="how --in is written (auto: hex if it is only hex digits)")  # fmt: skip
 
 
 def _int(text):
@@ -242,23 +272,69 @@ def cltu_decode(args):
     return 0
 
 
-def tm_decode(args):
-    from obsw.frames.asm import ASM
-    from obsw.frames.errors import FrameError
-    from obsw.frames.randomizer import randomize_tm
-    from obsw.frames.tm import TmFrame
+def _read_input(args):
+    import sys
+
+    if args.infile is None:
+        if args.hex is None:
+            raise UserError("no input", expected="a frame in hex or --in FILE")
+        return _hex(args.hex)
+    try:
+        if args.infile == "-":
+            raw = sys.stdin.buffer.read()
+        else:
+            with open(args.infile, "rb") as f:
+                raw = f.read()
+    except OSError as e:
+        raise _mistake("tm", e) from None
+    if args.format == "hex" or (
+        args.format == "auto" and raw and not raw.strip(b"0123456789abcdefABCDEF \t\r\n")
+    ):
+        return _hex(raw.decode())
+    return raw
+
+
+def _write_output(args, data):
+    if args.out is None:
+        print(binascii.hexlify(data).decode())
+        return
+    try:
+        with open(args.out, "wb") as f:
+            f.write(data if args.out.endswith(".bin") else binascii.hexlify(data) + b"\n")
+    except OSError as e:
+        raise _mistake("tm", e) from None
+
+
+def _frames_of(raw, length):
+    if length is None:
+        return [raw]
+    if length <= 0 or len(raw) % length:
+        raise UserError(
+            "input of %d octets is not a whole number of %s-octet frames" % (len(raw), length),
+            expected="a multiple of --frame-length",
+        )
+    return [raw[i : i + length] for i in range(0, len(raw), length)]
+
+
+def tm_encode(args):
+    from obsw.frames.tm_coding import TmEncoder
+
+    raw = _read_input(args)
+    frames = _frames_of(raw, args.frame_length)
+    try:
+        enc = TmEncoder(len(frames[0]), args.coding or "none", args.rs_e, args.interleave,
+                        not args.no_randomize)  # fmt: skip
+        out = b"".join(enc.encode(f) for f in frames)
+    except ValueError as e:
+        raise _mistake("tm encode", e) from None
+    _write_output(args, out)
+    return 0
+
+
+def _tm_json(frame, fecf=True):
     from obsw.frames.tm_demux import PacketExtractor
 
-    raw = _hex(args.hex)
-    if raw[:4] == ASM:
-        raw = raw[4:]
-    if args.randomized:
-        raw = randomize_tm(raw)
-    try:
-        frame = TmFrame.unpack(raw)
-    except FrameError as e:
-        raise _mistake("tm decode", e) from None
-    out = {
+    return {
         "scid": frame.scid,
         "vcid": frame.vcid,
         "mc_count": frame.mc_count,
@@ -267,8 +343,74 @@ def tm_decode(args):
         "ocf": None if frame.ocf is None else binascii.hexlify(frame.ocf).decode(),
         "packets": [binascii.hexlify(p).decode() for p in PacketExtractor().feed(frame)],
     }
-    print(json.dumps(out))
+
+
+def tm_decode(args):
+    from obsw.frames.asm import ASM
+    from obsw.frames.errors import FrameError
+    from obsw.frames.randomizer import randomize_tm
+    from obsw.frames.tm import TmFrame
+
+    if args.coding is not None or args.soft:
+        return _tm_decode_stream(args)
+    raw = _read_input(args)
+    if raw[:4] == ASM:
+        raw = raw[4:]
+    if args.randomized:
+        raw = randomize_tm(raw)
+    try:
+        frame = TmFrame.unpack(raw, not args.no_fecf)
+    except FrameError as e:
+        raise _mistake("tm decode", e) from None
+    print(json.dumps(_tm_json(frame)))
     return 0
+
+
+def _tm_decode_stream(args):
+    from obsw.frames.errors import FrameError
+    from obsw.frames.sync import STATE_NAMES
+    from obsw.frames.tm import TmFrame
+    from obsw.frames.tm_coding import TmDecoder
+
+    if args.frame_length is None:
+        raise UserError("a coded stream needs --frame-length", expected="the TM frame length")
+    raw = _read_input(args)
+    try:
+        dec = TmDecoder(args.frame_length, args.coding or "none", args.rs_e, args.interleave,
+                        not args.no_randomize)  # fmt: skip
+    except ValueError as e:
+        raise _mistake("tm decode", e) from None
+    if args.soft:
+        from array import array
+
+        got = dec.feed_soft(array("b", raw)) + dec.flush()
+    else:
+        got = dec.feed_octets(raw) + dec.flush()
+    frames = []
+    for d in got:
+        out = {
+            "position": d.position,
+            "sync": STATE_NAMES[d.state],
+            "asm_errors": d.asm_errors,
+            "inverted": bool(d.inverted),
+            "rs_corrected": d.corrected,
+        }
+        if d.data is None:
+            out["error"] = str(d.error)
+        else:
+            frames.append(d.data)
+            try:
+                out.update(_tm_json(TmFrame.unpack(d.data, not args.no_fecf)))
+            except FrameError as e:
+                out["error"] = str(e)
+        print(json.dumps(out))
+    s = dec.sync
+    print(json.dumps({"frames": dec.frames, "rs_corrected": dec.corrected,
+                      "uncorrectable": dec.uncorrectable, "locks": s.locks,
+                      "losses": s.losses, "slips": s.slips}))  # fmt: skip
+    if args.out is not None:
+        _write_output(args, b"".join(frames))
+    return 0 if dec.frames and not dec.uncorrectable else 1
 
 
 def verify_frame(args):

@@ -459,7 +459,7 @@ def _sched_insert(args):
             at = parse_utc(args.at) if args.at else tai_now() + args.delay
             user = g.schedule
             item = (at, request, args.subschedule, args.group)
-        return g._issue(user.insert(g.apid, [item]))
+        return g.issue(user.insert(g.apid, [item]))
 
     return session.run(args, go)
 
@@ -478,7 +478,7 @@ def _sched_simple(args):
             "disable": user.disable,
             "reset": user.reset,
         }[args.what]
-        return g._issue(fn(g.apid))
+        return g.issue(fn(g.apid))
 
     return session.run(args, go)
 
@@ -488,15 +488,15 @@ def _sched_shift(args):
         user = _sched_user(g, args)
         offset = int(args.offset) if args.service == "position" else args.offset
         if args.ids:
-            return g._issue(user.shift(g.apid, offset, [_rid(i) for i in args.ids]))
-        return g._issue(user.shift_all(g.apid, offset))
+            return g.issue(user.shift(g.apid, offset, [_rid(i) for i in args.ids]))
+        return g.issue(user.shift_all(g.apid, offset))
 
     return session.run(args, go)
 
 
 def _sched_delete(args):
     return session.run(
-        args, lambda g: g._issue(_sched_user(g, args).delete(g.apid, [_rid(i) for i in args.ids]))
+        args, lambda g: g.issue(_sched_user(g, args).delete(g.apid, [_rid(i) for i in args.ids]))
     )
 
 

@@ -306,10 +306,10 @@ def _sequence_load_file(args):
     def go(g):
         u = g.sequencing
         fn = u.load_and_activate if args.activate else u.load_by_reference
-        return g._issue(fn(g.apid, args.name, args.path))
+        return g.issue(fn(g.apid, args.name, args.path))
 
     return session.run(args, go)
 
 
 def _orbit(args):
-    return session.run(args, lambda g: g._issue(g.position.set_orbit(g.apid, args.orbit)))
+    return session.run(args, lambda g: g.issue(g.position.set_orbit(g.apid, args.orbit)))

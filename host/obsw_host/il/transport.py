@@ -238,6 +238,18 @@ class SocketTransport:
         )
         return s
 
+    def fds(self):
+        """The file descriptors the transport waits on (they change as peers come and go)."""
+        return set(self._fds)
+
+    def add_reader(self, reader):
+        """Wait on ``reader`` too (``fileno()``, ``on_readable()``): one wait serves both."""
+        self._add(reader)
+
+    def remove_reader(self, reader):
+        """Stop waiting on a reader ``add_reader`` gave."""
+        self._forget(reader)
+
     def _add(self, conn):
         self._fds[conn.fileno()] = conn
         self._poll.register(conn.fileno(), _POLLIN)
@@ -250,8 +262,9 @@ class SocketTransport:
                 self._poll.unregister(fd)
             except (KeyError, ValueError):
                 pass
-        if conn.address is not None and self._by_address.get(conn.address) is conn:
-            del self._by_address[conn.address]
+        address = getattr(conn, "address", None)  # a reader of add_reader has none
+        if address is not None and self._by_address.get(address) is conn:
+            del self._by_address[address]
 
     def connections(self):
         return [c for c in self._fds.values() if isinstance(c, Connection)]
@@ -265,7 +278,7 @@ class SocketTransport:
             # of poll() then recv(), one system call less per reply
             for conn in list(self._fds.values()):
                 conn.on_readable()
-            if self.node._remote_topics:
+            if self.node.subscribed_remotely():
                 self._renew()
             return
         hot = self._hot
@@ -289,7 +302,7 @@ class SocketTransport:
             ms = -1
         else:
             ms = int(timeout * 1000 + 0.999) if timeout > 0 else 0
-        if self.node._remote_topics:
+        if self.node.subscribed_remotely():
             self._renew()
             if ms < 0 or ms > self.renew_interval * 1000:
                 ms = int(self.renew_interval * 1000)
@@ -323,7 +336,7 @@ class SocketTransport:
             return
         self._next_renew = now + self.renew_interval
         registry = self.node.registry
-        for comp in {k[0] for k in self.node._remote_topics}:
+        for comp in self.node.remote_components():
             if comp not in registry:
                 registry.resolve(comp)
 

@@ -63,7 +63,7 @@ def install(app, sdb, entries):
         if d["pmon"] in pmons:
             raise MonitoringError(i, "PMON %d twice" % d["pmon"])
         try:
-            s12._check_definition(d)
+            s12.check_definition(d)
         except Exception as e:  # PusFailure: what a TC[12,5] would be refused for
             raise MonitoringError(i, str(e)) from None
         pmons[d["pmon"]] = Pmon(d, bool(entry.get("enabled", True)))

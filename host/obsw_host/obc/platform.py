@@ -124,7 +124,7 @@ class PlatformManager:
 
             self.software = SoftwareWatch(self, software, slot, trial)
 
-    def _say(self, text):
+    def say(self, text):
         self.log.append((self.clock(), text))
         self.out("[platform] " + text)
 
@@ -176,7 +176,7 @@ class PlatformManager:
             if status == EXIT_REFUSED or child.early_deaths >= limit:
                 self._stop_child(child, why, status)
                 return
-        self._say("%s (pid %d) %s: restarting" % (child.name, child.pid, why))
+        self.say("%s (pid %d) %s: restarting" % (child.name, child.pid, why))
         self._event("died", child)
         self._kill(child)
         self._spawn(child)
@@ -193,7 +193,7 @@ class PlatformManager:
         else:
             child.stopped = "died %d times in a row before its first heartbeat (last: %s)" % (
                 child.early_deaths, why)  # fmt: skip
-        self._say("%s %s: stopped, not restarted (fix the mission, then start the OBC again)" % (
+        self.say("%s %s: stopped, not restarted (fix the mission, then start the OBC again)" % (
             child.name, child.stopped))  # fmt: skip
         self._event("stopped", child)
         if all(c.stopped for c in self.children):
@@ -215,7 +215,7 @@ class PlatformManager:
         self._event("power_cycle", child)
         self._flush_events()
         self.power_cycles += 1
-        self._say("%d failures within %ss: asking %s to power-cycle the OBC" % (
+        self.say("%d failures within %ss: asking %s to power-cycle the OBC" % (
             len(self.failures), self.settings["window"], pc["component"]))  # fmt: skip
         try:
             itf = [i for i in self.topology.equipment_interfaces() if i.name == pc["component"]]
@@ -224,7 +224,7 @@ class PlatformManager:
             cpdu = self.node.proxy(itf[0], timeout=2.0, retries=1)
             cpdu.power_cycle(int(pc["line"]), int(pc["off_ms"])).result(5.0)
         except Exception as e:  # the request is best effort: the module's watchdog remains
-            self._say("power-cycle request failed: %s" % e)
+            self.say("power-cycle request failed: %s" % e)
 
     # -------------------------------------------------------------------------- watching
 
@@ -254,7 +254,7 @@ class PlatformManager:
                     self._failed(child, "silent for %.1f s" % (self.clock() - since))
                 continue
             if child.last_beat is None:
-                self._say("%s up (pid %d)" % (child.name, child.pid))
+                self.say("%s up (pid %d)" % (child.name, child.pid))
                 self._event("started", child)
                 child.early_deaths = 0
             child.last_beat = self.clock()

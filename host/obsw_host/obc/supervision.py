@@ -68,7 +68,7 @@ class Supervision:
         try:
             if not self.watchdog.armed:
                 self.watchdog.open()
-                self.manager._say("watchdog %s armed (timeout %s s)" % (
+                self.manager.say("watchdog %s armed (timeout %s s)" % (
                     self.watchdog.path, self.watchdog.timeout))  # fmt: skip
             if now >= self._next_kick:
                 self.watchdog.kick()
@@ -77,7 +77,7 @@ class Supervision:
         except OSError as e:
             self.state = wd.FAILED
             self.error = str(e)
-            self.manager._say("%s: the OBC runs without its hardware watchdog" % e)
+            self.manager.say("%s: the OBC runs without its hardware watchdog" % e)
 
     def _systemd(self, now, sick):
         n = self.notifier

@@ -64,7 +64,7 @@ async def drive_transport(transport, node):
     watched = set()
     try:
         while True:
-            fds = set(transport._fds)  # the transport's poll set changes as peers come and go
+            fds = transport.fds()  # the transport's poll set changes as peers come and go
             for fd in fds - watched:
                 loop.add_reader(fd, wake.set)
             for fd in watched - fds:

@@ -184,7 +184,7 @@ class Ground:
             self.poll(left)
         return tx
 
-    def _issue(self, tx, timeout=None):
+    def issue(self, tx, timeout=None):
         if self.log is not None:
             self.log(text.tc_line(tx.tc))
         return self.wait(tx, timeout)
@@ -193,11 +193,11 @@ class Ground:
 
     def ping(self, apid=None, timeout=None):
         """TC[17,1] are-you-alive; returns the Transaction (``tx.reply`` is TM[17,2])."""
-        return self._issue(self.test.ping(self.apid if apid is None else apid), timeout)
+        return self.issue(self.test.ping(self.apid if apid is None else apid), timeout)
 
     def connection_test(self, target, apid=None, timeout=None):
         """TC[17,3]: ask the process whether on-board process ``target`` answers."""
-        return self._issue(
+        return self.issue(
             self.test.connection_test(self.apid if apid is None else apid, target), timeout
         )
 
@@ -206,7 +206,7 @@ class Ground:
         ``tx.reply['values']`` by name. A structure this ground does not know yet (one created
         by another client or session) is asked for first (TC[3,9] / TC[3,11])."""
         self.learn_structure(sid, apid, timeout, kind)
-        return self._issue(self.hk.one_shot(self._apid(apid), [sid], kind), timeout)
+        return self.issue(self.hk.one_shot(self._apid(apid), [sid], kind), timeout)
 
     def learn_structure(self, sid, apid=None, timeout=None, kind="hk"):
         """Ask for structure ``sid``'s definition unless this ground knows it; True if known."""
@@ -217,33 +217,33 @@ class Ground:
 
     def hk_structures(self, sids, apid=None, timeout=None):
         """TC[3,9]; ``tx.replies`` holds one TM[3,10] per structure."""
-        return self._issue(self.hk.report_structures(self._apid(apid), sids), timeout)
+        return self.issue(self.hk.report_structures(self._apid(apid), sids), timeout)
 
     def hk_properties(self, sids, apid=None, timeout=None):
         """TC[3,33]; ``tx.reply['items']`` gives each structure's status and interval."""
-        return self._issue(self.hk.report_properties(self._apid(apid), sids), timeout)
+        return self.issue(self.hk.report_properties(self._apid(apid), sids), timeout)
 
     def create_hk(self, sid, interval, parameters, apid=None, timeout=None):
         """TC[3,1]: a new structure of parameters (names or IDs), disabled."""
         pids = [self.sdb.parameter(p).id for p in parameters]
-        return self._issue(self.hk.create(self._apid(apid), sid, interval, pids), timeout)
+        return self.issue(self.hk.create(self._apid(apid), sid, interval, pids), timeout)
 
     def delete_hk(self, sids, apid=None, timeout=None):
-        return self._issue(self.hk.delete(self._apid(apid), sids), timeout)
+        return self.issue(self.hk.delete(self._apid(apid), sids), timeout)
 
     def enable_hk(self, sids, apid=None, timeout=None):
-        return self._issue(self.hk.enable(self._apid(apid), sids), timeout)
+        return self.issue(self.hk.enable(self._apid(apid), sids), timeout)
 
     def disable_hk(self, sids, apid=None, timeout=None):
-        return self._issue(self.hk.disable(self._apid(apid), sids), timeout)
+        return self.issue(self.hk.disable(self._apid(apid), sids), timeout)
 
     def set_hk_interval(self, sid, interval, apid=None, timeout=None):
         """TC[3,31]: ``interval`` in cycles of the on-board activity loop."""
-        return self._issue(self.hk.modify_interval(self._apid(apid), {sid: interval}), timeout)
+        return self.issue(self.hk.modify_interval(self._apid(apid), {sid: interval}), timeout)
 
     def get_parameters(self, *keys, apid=None, timeout=None):
         """TC[20,1]; ``tx.reply['values']`` maps names to values."""
-        return self._issue(self.params.report(self._apid(apid), keys), timeout)
+        return self.issue(self.params.report(self._apid(apid), keys), timeout)
 
     def set_parameter(self, key, value, apid=None, timeout=None, raw=False):
         """TC[20,3] for one parameter (name or ID)."""
@@ -252,24 +252,24 @@ class Ground:
     def set_parameters(self, values, apid=None, timeout=None, raw=False):
         """TC[20,3]: engineering values (labels, calibrated numbers; ``raw``: raw values),
         refused here (``RangeError``) when outside a parameter's range."""
-        return self._issue(self.params.set(self._apid(apid), values, raw), timeout)
+        return self.issue(self.params.set(self._apid(apid), values, raw), timeout)
 
     def _event_ids(self, keys):
         return [self.sdb.event(k).id for k in keys]
 
     def enable_events(self, keys, apid=None, timeout=None):
-        return self._issue(self.events.enable(self._apid(apid), self._event_ids(keys)), timeout)
+        return self.issue(self.events.enable(self._apid(apid), self._event_ids(keys)), timeout)
 
     def disable_events(self, keys, apid=None, timeout=None):
-        return self._issue(self.events.disable(self._apid(apid), self._event_ids(keys)), timeout)
+        return self.issue(self.events.disable(self._apid(apid), self._event_ids(keys)), timeout)
 
     def disabled_events(self, apid=None, timeout=None):
         """TC[5,7]; ``tx.reply['ids']`` lists the disabled event IDs."""
-        return self._issue(self.events.report_disabled(self._apid(apid)), timeout)
+        return self.issue(self.events.report_disabled(self._apid(apid)), timeout)
 
     def set_time_rate(self, exponent, apid=None, timeout=None):
         """TC[9,1]: a time report every 2 ** exponent seconds."""
-        return self._issue(self.time.set_rate(self._apid(apid), exponent), timeout)
+        return self.issue(self.time.set_rate(self._apid(apid), exponent), timeout)
 
     # -------------------------------------------------------------------------- automation
 
@@ -305,16 +305,16 @@ class Ground:
         """Send request ``request`` of mission service ``service`` (names or numbers) with
         named arguments, checked first; ``tx.reply`` is its report decoded by name."""
         user = self.mission_service(service)
-        return self._issue(user.send(self._apid(apid), request, arguments), timeout)
+        return self.issue(user.send(self._apid(apid), request, arguments), timeout)
 
     def perform(self, key, apid=None, timeout=None, **arguments):
         """TC[8,1]: perform function ``key`` (ID or name) with named arguments."""
-        return self._issue(self.functions.perform(self._apid(apid), key, arguments), timeout)
+        return self.issue(self.functions.perform(self._apid(apid), key, arguments), timeout)
 
     def schedule_at(self, at, request, subschedule=0, group=0, apid=None, timeout=None):
         """TC[11,4]: release ``request`` (a Transaction of ``request``) at on-board TAI ``at``."""
         items = [(at, request, subschedule, group)]
-        return self._issue(self.schedule.insert(self._apid(apid), items), timeout)
+        return self.issue(self.schedule.insert(self._apid(apid), items), timeout)
 
     def schedule_in(self, seconds, request, **options):
         """TC[11,4] releasing ``request`` ``seconds`` from now (the ground's clock)."""
@@ -322,39 +322,39 @@ class Ground:
 
     def scheduled(self, apid=None, timeout=None):
         """TC[11,16]; ``tx.reply['activities']`` lists the time-based schedule."""
-        return self._issue(self.schedule.detail_all(self._apid(apid)), timeout)
+        return self.issue(self.schedule.detail_all(self._apid(apid)), timeout)
 
     def schedule_summary(self, apid=None, timeout=None):
         """TC[11,17]; ``tx.reply['activities']`` names the activities by request ID."""
-        return self._issue(self.schedule.summary_all(self._apid(apid)), timeout)
+        return self.issue(self.schedule.summary_all(self._apid(apid)), timeout)
 
     def shift_schedule(self, seconds, ids=None, apid=None, timeout=None):
         """TC[11,15] (all) or TC[11,7] (``ids``: request IDs or transactions)."""
         a = self._apid(apid)
         if ids is None:
-            return self._issue(self.schedule.shift_all(a, seconds), timeout)
-        return self._issue(self.schedule.shift(a, seconds, ids), timeout)
+            return self.issue(self.schedule.shift_all(a, seconds), timeout)
+        return self.issue(self.schedule.shift(a, seconds, ids), timeout)
 
     def unschedule(self, ids, apid=None, timeout=None):
         """TC[11,5]: delete activities by request ID (or transaction)."""
-        return self._issue(self.schedule.delete(self._apid(apid), ids), timeout)
+        return self.issue(self.schedule.delete(self._apid(apid), ids), timeout)
 
     def enable_schedule(self, enabled=True, apid=None, timeout=None):
         """TC[11,1] or TC[11,2]."""
         user = self.schedule
         tx = user.enable(self._apid(apid)) if enabled else user.disable(self._apid(apid))
-        return self._issue(tx, timeout)
+        return self.issue(tx, timeout)
 
     def reset_schedule(self, apid=None, timeout=None):
-        return self._issue(self.schedule.reset(self._apid(apid)), timeout)
+        return self.issue(self.schedule.reset(self._apid(apid)), timeout)
 
     def schedule_at_position(self, position, request, apid=None, timeout=None):
         """TC[22,4]: release ``request`` when the position parameter reaches ``position``."""
-        return self._issue(self.position.insert(self._apid(apid), [(position, request)]), timeout)
+        return self.issue(self.position.insert(self._apid(apid), [(position, request)]), timeout)
 
     def position_scheduled(self, apid=None, timeout=None):
         """TC[22,16]; ``tx.reply['activities']`` lists the position-based schedule."""
-        return self._issue(self.position.detail_all(self._apid(apid)), timeout)
+        return self.issue(self.position.detail_all(self._apid(apid)), timeout)
 
     def add_limit_monitor(
         self,
@@ -377,31 +377,31 @@ class Ground:
         if swapped:  # a falling calibration: the low raw limit is the high engineering one
             low_event, high_event = high_event, low_event
         d = limit_check(pmon, parameter, low, high, low_event, high_event, **options)
-        tx = self._issue(self.monitoring.add(self._apid(apid), [d]), timeout)
+        tx = self.issue(self.monitoring.add(self._apid(apid), [d]), timeout)
         if not tx.ok:
             return tx
         return self.enable_monitors([pmon], apid=apid, timeout=timeout)
 
     def add_monitors(self, definitions, apid=None, timeout=None):
         """TC[12,5] for definitions built with ``obsw.pus.services.s12_user``."""
-        return self._issue(self.monitoring.add(self._apid(apid), definitions), timeout)
+        return self.issue(self.monitoring.add(self._apid(apid), definitions), timeout)
 
     def enable_monitors(self, ids, enabled=True, apid=None, timeout=None):
         """TC[12,1] or TC[12,2]."""
         user = self.monitoring
         fn = user.enable if enabled else user.disable
-        return self._issue(fn(self._apid(apid), ids), timeout)
+        return self.issue(fn(self._apid(apid), ids), timeout)
 
     def delete_monitors(self, ids, apid=None, timeout=None):
-        return self._issue(self.monitoring.delete(self._apid(apid), ids), timeout)
+        return self.issue(self.monitoring.delete(self._apid(apid), ids), timeout)
 
     def monitors(self, ids=(), apid=None, timeout=None):
         """TC[12,8]; ``tx.reply['items']`` are the definitions (all if no ``ids``)."""
-        return self._issue(self.monitoring.report_definitions(self._apid(apid), ids), timeout)
+        return self.issue(self.monitoring.report_definitions(self._apid(apid), ids), timeout)
 
     def out_of_limits(self, apid=None, timeout=None):
         """TC[12,10]; ``tx.reply['items']`` are the parameters now out of limits."""
-        return self._issue(self.monitoring.report_out_of_limits(self._apid(apid)), timeout)
+        return self.issue(self.monitoring.report_out_of_limits(self._apid(apid)), timeout)
 
     # -------------------------------------------------------------------------- functional
 
@@ -409,15 +409,15 @@ class Ground:
         """TC[12,23]: FMON ``fmon`` fails when ``failing`` of ``pmons`` are out of limits and
         raises ``event`` (name or ID); new FMONs are disabled."""
         d = functional_check(fmon, pmons, failing, self._event_id(event))
-        return self._issue(self.monitoring.add_functional(self._apid(apid), [d]), timeout)
+        return self.issue(self.monitoring.add_functional(self._apid(apid), [d]), timeout)
 
     def functional_monitors(self, apid=None, timeout=None, ids=()):
         """TC[12,25]; ``tx.reply['functional']`` are the FMON definitions (all if no ids)."""
-        return self._issue(self.monitoring.report_functional(self._apid(apid), ids), timeout)
+        return self.issue(self.monitoring.report_functional(self._apid(apid), ids), timeout)
 
     def functional_status(self, apid=None, timeout=None):
         """TC[12,27]; ``tx.reply['functional']`` gives each FMON's statuses."""
-        return self._issue(self.monitoring.report_functional_status(self._apid(apid)), timeout)
+        return self.issue(self.monitoring.report_functional_status(self._apid(apid)), timeout)
 
     def functional_request(self, action, ids=(), apid=None, timeout=None):
         """TC[12,17]-[12,24] by name: enable-function, disable-function (no IDs), enable,
@@ -426,22 +426,22 @@ class Ground:
         a = self._apid(apid)
         if action in ("enable-function", "disable-function"):
             fn = getattr(user, action.replace("-function", "") + "_functional_function")
-            return self._issue(fn(a), timeout)
+            return self.issue(fn(a), timeout)
         fn = getattr(user, action + "_functional", None)
         if fn is None or action in ("add", "report"):
             raise ValueError("functional monitoring action %r unknown" % action)
-        return self._issue(fn(a, list(ids)), timeout)
+        return self.issue(fn(a, list(ids)), timeout)
 
     def parameter_definitions(self, keys=(), apid=None, timeout=None):
         """TC[20,6]; ``tx.reply['definitions']`` says where each parameter lives."""
-        return self._issue(self.params.report_definitions(self._apid(apid), keys), timeout)
+        return self.issue(self.params.report_definitions(self._apid(apid), keys), timeout)
 
     def define_parameters(self, items, object_memory=False, apid=None, timeout=None):
         """TC[20,4]: ``items`` are (parameter, memory ID, absolute address); or TC[20,5]
         (``object_memory``): (parameter, memory ID, object ID, offset in the object)."""
         user = self.params
         fn = user.change_object_definitions if object_memory else user.change_raw_definitions
-        return self._issue(fn(self._apid(apid), items), timeout)
+        return self.issue(fn(self._apid(apid), items), timeout)
 
     def _event_id(self, key):
         return key if isinstance(key, int) else self.sdb.event(key).id
@@ -450,10 +450,10 @@ class Ground:
         """TC[19,1] running ``request`` when ``event`` (name or ID) occurs, then TC[19,4]."""
         a = self._apid(apid)
         key = (a, self._event_id(event))
-        tx = self._issue(self.event_action.add(a, [key + (request,)]), timeout)
+        tx = self.issue(self.event_action.add(a, [key + (request,)]), timeout)
         if not tx.ok or not enable:
             return tx
-        return self._issue(self.event_action.enable(a, [key]), timeout)
+        return self.issue(self.event_action.enable(a, [key]), timeout)
 
     def enable_actions(self, events, enabled=True, apid=None, timeout=None):
         """TC[19,4] or TC[19,5] for the actions of ``events`` of this process."""
@@ -461,36 +461,36 @@ class Ground:
         keys = [(a, self._event_id(e)) for e in events]
         user = self.event_action
         fn = user.enable if enabled else user.disable
-        return self._issue(fn(a, keys), timeout)
+        return self.issue(fn(a, keys), timeout)
 
     def delete_actions(self, events, apid=None, timeout=None):
         a = self._apid(apid)
         keys = [(a, self._event_id(e)) for e in events]
-        return self._issue(self.event_action.delete(a, keys), timeout)
+        return self.issue(self.event_action.delete(a, keys), timeout)
 
     def actions(self, apid=None, timeout=None):
         """TC[19,10]; ``tx.reply['items']`` are every event-action definition."""
-        return self._issue(self.event_action.report_definitions(self._apid(apid)), timeout)
+        return self.issue(self.event_action.report_definitions(self._apid(apid)), timeout)
 
     def load_sequence(self, name, items, apid=None, timeout=None):
         """TC[21,1]: ``items`` are (request, delay in seconds) pairs."""
-        return self._issue(self.sequencing.load(self._apid(apid), name, items), timeout)
+        return self.issue(self.sequencing.load(self._apid(apid), name, items), timeout)
 
     def activate_sequence(self, name, apid=None, timeout=None):
-        return self._issue(self.sequencing.activate(self._apid(apid), name), timeout)
+        return self.issue(self.sequencing.activate(self._apid(apid), name), timeout)
 
     def abort_sequence(self, name, apid=None, timeout=None):
-        return self._issue(self.sequencing.abort(self._apid(apid), name), timeout)
+        return self.issue(self.sequencing.abort(self._apid(apid), name), timeout)
 
     def unload_sequence(self, name, apid=None, timeout=None):
-        return self._issue(self.sequencing.unload(self._apid(apid), name), timeout)
+        return self.issue(self.sequencing.unload(self._apid(apid), name), timeout)
 
     def sequences(self, apid=None, timeout=None):
         """TC[21,6]; ``tx.reply['items']`` gives each loaded sequence's status."""
-        return self._issue(self.sequencing.report_status(self._apid(apid)), timeout)
+        return self.issue(self.sequencing.report_status(self._apid(apid)), timeout)
 
     def sequence_content(self, name, apid=None, timeout=None):
-        return self._issue(self.sequencing.report_content(self._apid(apid), name), timeout)
+        return self.issue(self.sequencing.report_content(self._apid(apid), name), timeout)
 
     def wait_for(self, service, subtype, timeout=None, since=0):
         """The next TM[service, subtype] no request asked for (an event, a periodic report),

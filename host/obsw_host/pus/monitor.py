@@ -112,7 +112,7 @@ class Display:
                 parts.insert(0, "structure %s" % decoded["sid"])
             return ", ".join(parts)
         if isinstance(decoded, dict):
-            return text._values(text.plain(decoded))
+            return text.pairs(text.plain(decoded))
         return str(text.plain(decoded))
 
 

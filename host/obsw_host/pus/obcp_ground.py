@@ -36,7 +36,7 @@ class ObcpGround:
     def _apid(self, apid):
         return self.ground.apid if apid is None else apid
 
-    def _issue(self, tx, timeout=None):
+    def issue(self, tx, timeout=None):
         g = self.ground
         if g.log is not None:
             g.log("TC[%d,%d] seq %d" % (tx.tc.service, tx.tc.subtype, tx.tc.seq_count))
@@ -46,7 +46,7 @@ class ObcpGround:
 
     def load(self, name, source, arguments=None, apid=None, timeout=None):
         """TC[18,1]: upload procedure text ``source`` as OBCP ``name``."""
-        return self._issue(self.user.load(self._apid(apid), name, source, arguments), timeout)
+        return self.issue(self.user.load(self._apid(apid), name, source, arguments), timeout)
 
     def load_file(self, name, path, arguments=None, apid=None, timeout=None):
         """TC[18,1] with the text of the local file ``path``."""
@@ -56,7 +56,7 @@ class ObcpGround:
     def load_by_reference(self, name, repository, file, arguments=None, apid=None, timeout=None):
         """TC[18,13]: load ``repository/file`` of the on-board filestore."""
         tx = self.user.load_by_reference(self._apid(apid), name, repository, file, arguments)
-        return self._issue(tx, timeout)
+        return self.issue(tx, timeout)
 
     def load_and_activate(
         self, name, repository, file, arguments=None, level=LEVEL_STEP, apid=None, timeout=None
@@ -65,60 +65,60 @@ class ObcpGround:
         tx = self.user.load_and_activate(
             self._apid(apid), name, repository, file, arguments, level
         )
-        return self._issue(tx, timeout)
+        return self.issue(tx, timeout)
 
     def activate(self, name, arguments=None, level=LEVEL_STEP, apid=None, timeout=None):
         """TC[18,3]; ``arguments`` maps names to values or ``{"value": v, "unit": u}``."""
         tx = self.user.activate(self._apid(apid), name, arguments, level)
-        return self._issue(tx, timeout)
+        return self.issue(tx, timeout)
 
     def activate_and_step(self, name, arguments=None, level=LEVEL_STEP, apid=None, timeout=None):
         """TC[18,14]: activate; the OBCP suspends once its first step has ended."""
         tx = self.user.activate_and_step(self._apid(apid), name, arguments, level)
-        return self._issue(tx, timeout)
+        return self.issue(tx, timeout)
 
     def resume_and_step(self, name, apid=None, timeout=None):
         """TC[18,15]: a suspended OBCP runs its next step, then suspends again."""
-        return self._issue(self.user.resume_and_step(self._apid(apid), name), timeout)
+        return self.issue(self.user.resume_and_step(self._apid(apid), name), timeout)
 
     def unload(self, name, apid=None, timeout=None):
-        return self._issue(self.user.unload(self._apid(apid), name), timeout)
+        return self.issue(self.user.unload(self._apid(apid), name), timeout)
 
     def stop(self, name, apid=None, timeout=None):
-        return self._issue(self.user.stop(self._apid(apid), name), timeout)
+        return self.issue(self.user.stop(self._apid(apid), name), timeout)
 
     def suspend(self, name, apid=None, timeout=None):
-        return self._issue(self.user.suspend(self._apid(apid), name), timeout)
+        return self.issue(self.user.suspend(self._apid(apid), name), timeout)
 
     def resume(self, name, apid=None, timeout=None):
-        return self._issue(self.user.resume(self._apid(apid), name), timeout)
+        return self.issue(self.user.resume(self._apid(apid), name), timeout)
 
     def abort(self, name, apid=None, timeout=None):
-        return self._issue(self.user.abort(self._apid(apid), name), timeout)
+        return self.issue(self.user.abort(self._apid(apid), name), timeout)
 
     def stop_and_unload(self, name, apid=None, timeout=None):
-        return self._issue(self.user.stop_and_unload(self._apid(apid), name), timeout)
+        return self.issue(self.user.stop_and_unload(self._apid(apid), name), timeout)
 
     def answer(self, name, value, apid=None, timeout=None):
         """TC[18,7]: the answer to the question OBCP ``name`` asks."""
-        return self._issue(self.user.answer(self._apid(apid), name, value), timeout)
+        return self.issue(self.user.answer(self._apid(apid), name, value), timeout)
 
     def set_observability(self, levels, apid=None, timeout=None):
-        return self._issue(self.user.set_observability(self._apid(apid), levels), timeout)
+        return self.issue(self.user.set_observability(self._apid(apid), levels), timeout)
 
     def abort_all(self, apid=None, timeout=None):
         """TC[18,17]; ``tx.reply["ids"]`` names the OBCPs aborted."""
-        return self._issue(self.user.abort_all(self._apid(apid)), timeout)
+        return self.issue(self.user.abort_all(self._apid(apid)), timeout)
 
     def start_engine(self, apid=None, timeout=None):
-        return self._issue(self.user.start_engine(self._apid(apid)), timeout)
+        return self.issue(self.user.start_engine(self._apid(apid)), timeout)
 
     def stop_engine(self, apid=None, timeout=None):
-        return self._issue(self.user.stop_engine(self._apid(apid)), timeout)
+        return self.issue(self.user.stop_engine(self._apid(apid)), timeout)
 
     def report_status(self, apid=None, timeout=None):
         """TC[18,8]; ``tx.reply["obcps"]`` is the decoded TM[18,9]."""
-        return self._issue(self.user.report_status(self._apid(apid)), timeout)
+        return self.issue(self.user.report_status(self._apid(apid)), timeout)
 
     def status(self, apid=None, timeout=None):
         """The loaded OBCPs and their status by name (TC[18,8] and TM[18,9])."""

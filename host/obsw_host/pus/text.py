@@ -178,16 +178,17 @@ def plain(value):
     return value
 
 
-def _values(decoded):
+def pairs(decoded):
+    """``name=value, ...`` of a decoded dict (nested dicts in braces, lists in brackets)."""
     parts = []
     for k, v in decoded.items():
         if isinstance(v, float):
             v = "%.6g" % v
         elif isinstance(v, dict):
-            v = "{%s}" % _values(v)
+            v = "{%s}" % pairs(v)
         elif isinstance(v, list):
             v = "[%s]" % ", ".join(
-                ("{%s}" % _values(x)) if isinstance(x, dict) else str(plain(x)) for x in v
+                ("{%s}" % pairs(x)) if isinstance(x, dict) else str(plain(x)) for x in v
             )
         parts.append("%s=%s" % (k, v))
     return ", ".join(parts)
@@ -208,7 +209,7 @@ def summary(tm, decoded):
             decoded["exponent"],
             decoded["status"],
         )
-    return _values(decoded)
+    return pairs(decoded)
 
 
 def tc_line(tc, note=""):

@@ -42,7 +42,7 @@ def filters_for(node):
     a responder's own ids."""
     if isinstance(getattr(node, "controller", node), Controller):
         return [{"can_id": ID_REP, "can_mask": FUNCTION_MASK, "extended": False}]
-    ids = (ID_HEARTBEAT, ID_SYNC, ID_SCET, ID_UTC, node._req_id)
+    ids = (ID_HEARTBEAT, ID_SYNC, ID_SCET, ID_UTC, node.req_id)
     return [{"can_id": i, "can_mask": FULL_MASK, "extended": False} for i in ids]
 
 

@@ -152,8 +152,7 @@ class ObcSpaceCan:
 
             self.transport = t = SocketTransport(self.node, directory)
             # the waker joins the transport's poll set: one blocking wait covers both worlds
-            t._fds[self._waker.fileno()] = self._waker
-            t._poll.register(self._waker.fileno(), select.POLLIN)
+            t.add_reader(self._waker)
         self.node.provide(MASTER, self.master)
         if self.access is not None:
             from obsw.spacecan.device_access import DEVICE_ACCESS
@@ -213,12 +212,7 @@ class ObcSpaceCan:
         for ad in self.simulated:
             ad.close()
         if self.transport is not None:
-            fd = self._waker.fileno()
-            self.transport._fds.pop(fd, None)
-            try:
-                self.transport._poll.unregister(fd)
-            except (KeyError, ValueError):
-                pass
+            self.transport.remove_reader(self._waker)
             self.transport.close()
         self.adapter.close()
         self._waker.close()

@@ -64,7 +64,7 @@ class SoftwareWatch:
         self._refresh()
         running = self.software.running()
         if running != self.slot:
-            self.manager._say("the boot record now runs %s (%s): restarting the processes" % (
+            self.manager.say("the boot record now runs %s (%s): restarting the processes" % (
                 running, self.software.version(running)))  # fmt: skip
             self._restart_at = now + _RESTART_DELAY
 
@@ -92,7 +92,7 @@ class SoftwareWatch:
         self.trial = False
         self.software.confirm()
         self._mtime = self._stamp()
-        m._say("version %s (slot %s) is healthy: confirmed" % (
+        m.say("version %s (slot %s) is healthy: confirmed" % (
             self.software.version(self.slot), self.slot))  # fmt: skip
         self._refresh()
         return None
@@ -100,7 +100,7 @@ class SoftwareWatch:
     def _fail(self, reason):
         self.trial = False
         self.software.fail_trial(reason)
-        self.manager._say("version %s (slot %s) rolled back: %s" % (
+        self.manager.say("version %s (slot %s) rolled back: %s" % (
             self.software.version(self.slot), self.slot, reason))  # fmt: skip
         self.outcome = "rolled back: " + reason
         return None

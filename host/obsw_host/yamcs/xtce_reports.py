@@ -51,7 +51,7 @@ _PID_REPORTS = (
     "statistics",
     "statistics_definitions",
 )
-_CANDIDATES = {s18._arg_type: s18._ARG_TYPES}  # other selectors: the values they may take
+_CANDIDATES = {s18.arg_type: s18.ARG_TYPES}  # other selectors: the values they may take
 
 
 def _sub(parent, tag, **attrs):

@@ -6,6 +6,6 @@ require("obsw-frames", library="obsw")
 
 package(
     "obsw/frames",
-    files=["fop.py", "fop_table.py", "tm_demux.py"],
+    files=["fop.py", "fop_table.py", "sync.py", "tm_demux.py", "viterbi.py"],
     base_path="../../../micropython",
 )

@@ -58,3 +58,19 @@ class ControlCommandError(FrameError):
     def __init__(self, data):
         super().__init__("control command %r is neither Unlock nor Set V(R)" % (bytes(data),))
         self.data = bytes(data)
+
+
+class RsUncorrectableError(FrameError):
+    """A Reed-Solomon codeblock (131.0-B) with more errors than its codewords can correct.
+
+    ``codewords`` lists the interleaved codewords (0 to I-1) that failed; ``corrected`` the
+    symbols corrected in each codeword (-1 where it failed); ``data`` the frame as received."""
+
+    def __init__(self, codewords, corrected, data):
+        super().__init__(
+            "Reed-Solomon codeword %s uncorrectable (corrected per codeword: %s)"
+            % (", ".join(str(w) for w in codewords), corrected)
+        )
+        self.codewords = codewords
+        self.corrected = corrected
+        self.data = data

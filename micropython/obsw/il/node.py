@@ -209,6 +209,14 @@ class Node(Calls):
             if route is not None and not route.local:
                 route.send((UNSUBSCRIBE, 0, sub.component, sub.member, None, (), None))
 
+    def subscribed_remotely(self):
+        """True while this node has a subscription in another process."""
+        return bool(self._remote_topics)
+
+    def remote_components(self):
+        """The components this node has subscribed to in another process."""
+        return {k[0] for k in self._remote_topics}
+
     def remote_topics(self, component):
         """Members of ``component`` this node has subscribed to in another process."""
         return [k[1] for k in self._remote_topics if k[0] == component]

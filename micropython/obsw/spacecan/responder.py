@@ -91,7 +91,7 @@ class Responder:
         self.on_function = None
         self.on_parameters_set = None
         self.on_raw = None
-        self._req_id = ID_REQ + node_id
+        self.req_id = ID_REQ + node_id
         self._rep_id = ID_REP + node_id
         self.event_kinds = None
         self._frames = []
@@ -197,7 +197,7 @@ class Responder:
             return
         if not self._started:
             self.start(now)
-        if can_id == self._req_id:
+        if can_id == self.req_id:
             self.counters["rx"] += 1
             h = self.health[bus]  # BusHealth.received, inline
             h.rx_frames += 1

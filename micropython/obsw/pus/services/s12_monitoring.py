@@ -159,7 +159,7 @@ class OnBoardMonitoring(Service):
     def restore(self, ctx):
         pmons = {}
         for d, enabled in ctx["pmons"]:
-            self._check_definition(d)
+            self.check_definition(d)
             pmons[d["pmon"]] = Pmon(d, bool(enabled))
         self.function = bool(ctx["function"])
         self.delay = int(ctx["delay"])
@@ -167,7 +167,7 @@ class OnBoardMonitoring(Service):
 
     # -------------------------------------------------------------------------- checks
 
-    def _check_definition(self, d):
+    def check_definition(self, d):
         """Raise PusFailure unless definition ``d`` can be monitored."""
         pmon = d["pmon"]
         for key in ("parameter", "validity"):
@@ -210,7 +210,7 @@ class OnBoardMonitoring(Service):
             if d["pmon"] in self.pmons or d["pmon"] in seen:
                 raise _pmon_failure(FAILURE_REFUSED, "PMON %d exists" % d["pmon"], d["pmon"])
             seen.add(d["pmon"])
-            self._check_definition(d)
+            self.check_definition(d)
         req.start()
         for d in items:
             self.pmons[d["pmon"]] = Pmon(d)
@@ -249,7 +249,7 @@ class OnBoardMonitoring(Service):
                 raise _pmon_failure(FAILURE_REFUSED, "PMON monitors another parameter", d["pmon"])
             merged = {k: old[k] for k in _HEAD}
             merged.update(d)
-            self._check_definition(merged)
+            self.check_definition(merged)
             new.append(merged)
         req.start()
         for d in new:

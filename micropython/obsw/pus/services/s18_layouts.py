@@ -82,11 +82,12 @@ ARG_UINT = const(0x0310)
 ARG_REAL = const(0x0502)
 ARG_TEXT = const(0x0800)
 ARG_OCTETS = const(0x0700)
-_ARG_TYPES = (ARG_BOOL, ARG_INT, ARG_UINT, ARG_REAL, ARG_TEXT, ARG_OCTETS)
+ARG_TYPES = (ARG_BOOL, ARG_INT, ARG_UINT, ARG_REAL, ARG_TEXT, ARG_OCTETS)
 
 
-def _arg_type(code):
-    if code not in _ARG_TYPES:
+def arg_type(code):
+    """The field type of argument type code ``code`` (None: an unknown code)."""
+    if code not in ARG_TYPES:
         return None  # the deduced field then reports an unknown type code
     return field(code >> 8, code & 0xFF)
 
@@ -97,7 +98,7 @@ ARGS = Repeated(
         ("name", TEXT),
         ("type", U16),
         ("unit", TEXT),
-        ("value", Deduced("type", _arg_type)),
+        ("value", Deduced("type", arg_type)),
     ],
 )
 

@@ -1,6 +1,6 @@
 """Every benchmark alive: each one in its quickest mode with --json, its figures checked.
 
-    python tools/bench/smoke.py [NAME...] [--timeout SECONDS]
+    python tools/bench/smoke.py [NAME...] [--timeout SECONDS] [--jobs N]
 
 Runs each benchmark of report.py's list (all when no NAME is given) as `report.py run --quick`
 would, but saves nothing: it checks that the benchmark exited 0 and printed one JSON object in
@@ -13,6 +13,7 @@ The last line is `N passed, N failed, N skipped`.
 """
 
 import argparse
+import concurrent.futures
 import json
 import math
 import os
@@ -105,6 +106,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("names", nargs="*", metavar="NAME", help="of: " + ", ".join(report.RUNS))
     ap.add_argument("--timeout", type=float, default=TIMEOUT, help="seconds per benchmark")
+    ap.add_argument("--jobs", type=int, default=1, help="benchmarks run at once (default 1)")
     args = ap.parse_args(argv)
     unknown = [n for n in args.names if n not in report.RUNS]
     if unknown:
@@ -114,11 +116,14 @@ def main(argv=None):
     for script in unlisted():
         print("FAIL tools/bench/%s: not in report.py's RUNS nor a helper" % script)
         counts["failed"] += 1
-    for name in args.names or list(report.RUNS):
-        outcome, seconds, detail = smoke(name, args.timeout)
-        counts[outcome] += 1
-        mark = {"passed": "ok  ", "failed": "FAIL", "skipped": "skip"}[outcome]
-        print("%s %-14s %6.1f s  %s" % (mark, name, seconds, detail), flush=True)
+    names = args.names or list(report.RUNS)
+    with concurrent.futures.ThreadPoolExecutor(max(1, args.jobs)) as pool:
+        runs = {name: pool.submit(smoke, name, args.timeout) for name in names}
+        for name in names:  # in the list's order, each as soon as it and those before are done
+            outcome, seconds, detail = runs[name].result()
+            counts[outcome] += 1
+            mark = {"passed": "ok  ", "failed": "FAIL", "skipped": "skip"}[outcome]
+            print("%s %-14s %6.1f s  %s" % (mark, name, seconds, detail), flush=True)
     print("(%.0f s in all)" % (time.monotonic() - t0))
     print("%(passed)d passed, %(failed)d failed, %(skipped)d skipped" % counts)
     return 1 if counts["failed"] else 0

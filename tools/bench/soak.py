@@ -1,7 +1,7 @@
 """Soak: the OBC and its processes for hours, their memory sampled, with traffic and idle phases.
 
 `obsw obc serve` of the sample spacecraft (a state folder and free ports of its own) runs for
---minutes (default 120; --quick: 2). The resident memory (RSS, /proc) of the platform manager
+--minutes (default 120; --quick: 1). The resident memory (RSS, /proc) of the platform manager
 and of each process it started is sampled every --sample seconds (default 10). Phases
 alternate, traffic first, each --phase long (default 10 minutes):
 
@@ -326,19 +326,19 @@ def analyse(soak):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--minutes", type=float, help="how long (default 120; --quick 2)")
-    ap.add_argument("--warmup", type=float, help="minutes not counted (default 10; quick 0.6)")
-    ap.add_argument("--phase", type=float, help="minutes of each phase (default 10; quick 0.3)")
-    ap.add_argument("--sample", type=float, help="seconds between samples (default 10; quick 5)")
-    ap.add_argument("--quick", action="store_true", help="2 minutes: proves it runs")
+    ap.add_argument("--minutes", type=float, help="how long (default 120; --quick 1)")
+    ap.add_argument("--warmup", type=float, help="minutes not counted (default 10; quick 0.3)")
+    ap.add_argument("--phase", type=float, help="minutes of each phase (default 10; quick 0.2)")
+    ap.add_argument("--sample", type=float, help="seconds between samples (default 10; quick 3)")
+    ap.add_argument("--quick", action="store_true", help="1 minute: proves it runs")
     ap.add_argument("--no-trace", action="store_true", help="no tracemalloc in the processes")
     ap.add_argument("--json", action="store_true", help="print one JSON object")
     args = ap.parse_args(argv)
     q = args.quick
-    minutes = args.minutes or (2.0 if q else 120.0)
-    warmup = args.warmup if args.warmup is not None else (0.6 if q else min(10.0, minutes / 4))
-    phase = args.phase or (0.3 if q else 10.0)
-    sample = args.sample or (5.0 if q else 10.0)
+    minutes = args.minutes or (1.0 if q else 120.0)
+    warmup = args.warmup if args.warmup is not None else (0.3 if q else min(10.0, minutes / 4))
+    phase = args.phase or (0.2 if q else 10.0)
+    sample = args.sample or (3.0 if q else 10.0)
     out = (lambda s: print(s, file=sys.stderr, flush=True)) if args.json else print
     # stopped early (SIGTERM): the OBC is stopped and the folder removed all the same
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(1))

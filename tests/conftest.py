@@ -8,6 +8,29 @@ import tempfile
 
 from hypothesis import HealthCheck, settings
 
+
+def _own_loopback():
+    """Under pytest-xdist (``tools/test`` runs the suite in parallel), each worker takes a
+    network namespace of its own with only a loopback, when it may (root): the tests that run
+    the sample on its default ports, as a reader of the docs would, never meet each other nor an
+    OBC or Yamcs already running on this machine. Subprocesses inherit it."""
+    if os.environ.get("PYTEST_XDIST_WORKER") is None or os.geteuid() != 0:
+        return False
+    import ctypes
+    import subprocess
+
+    ip = shutil.which("ip") or next(
+        (p for p in ("/usr/sbin/ip", "/sbin/ip") if os.path.exists(p)), None
+    )
+    libc = ctypes.CDLL(None, use_errno=True)
+    if ip is None or libc.unshare(0x40000000) != 0:  # CLONE_NEWNET
+        return False
+    subprocess.run([ip, "link", "set", "lo", "up"], check=True)
+    return True
+
+
+OWN_LOOPBACK = _own_loopback()
+
 # One profile for the whole suite: enough examples to find codec bugs, bounded so that
 # tools/test stays within its time budget on a 2-core machine.
 settings.register_profile(

@@ -109,6 +109,7 @@ class TestValues(unittest.TestCase):
         self.assertIn("outside", v.out_of_range(2000))  # 50 degC
         self.assertIn("outside", v.out_of_range(0))  # -50 degC
         self.assertIsNone(Values(F32, {"range": [None, 3]}).out_of_range(-1e9))
+        self.assertIn("is not a number", Values(F32, {"range": [0, 3]}).out_of_range("fast"))
 
     def test_raw_limits_rounded_inwards(self):
         v = Values(U16, {"calibration": {"polynomial": [-50, 0.05]}})

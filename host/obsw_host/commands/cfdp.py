@@ -10,8 +10,12 @@ import os
 import sys
 import time
 
+from obsw.cfdp.filestore import FilestoreError
+
 from obsw_host.cfdp.client import parse_transaction
+from obsw_host.errors import UserError
 from obsw_host.mission import ids as mission_ids
+from obsw_host.mission.errors import display
 from obsw_host.net import DEFAULT_HOST
 
 
@@ -221,6 +225,20 @@ def _transfer(args, method, *names):
 
 
 def cmd_put(args):
+    from obsw_host.cfdp.filestore import RootedFilestore
+
+    Endpoints(args, onboard=False)  # a mistake in the peers or the mission is said first
+    fs = RootedFilestore(args.root)
+    try:
+        found = os.path.isfile(fs.path(args.source))
+    except FilestoreError:
+        found = False
+    if not found:
+        raise UserError(
+            "no file %s in the filestore folder %s/" % (args.source, display(fs.root)),
+            expected="a file inside the filestore folder, named from it (copy the file there, "
+            "or name another folder with --root or $OBSW_FILESTORE)",
+        )
     return _transfer(args, "put", args.source, args.dest)
 
 

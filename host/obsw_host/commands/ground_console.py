@@ -18,6 +18,8 @@ import argparse
 
 from obsw_host.commands import arguments
 
+LOS_AFTER = 5.0  # seconds without TM before `watch` shows loss of signal
+
 # the console and the live view import their libraries (prompt_toolkit, rich) in
 # ground_tui, only when they run: every other command starts without them
 
@@ -34,6 +36,13 @@ def add_to_ground(s):
     x.add_argument("--count", type=arguments.count, help="print this many frames and exit")
     x.add_argument("--every", type=arguments.seconds, default=1.0, help="seconds between frames")
     x.add_argument("--seconds", type=arguments.seconds, help="stop after this many seconds")
+    x.add_argument(
+        "--los",
+        type=arguments.seconds,
+        default=LOS_AFTER,
+        help="seconds without TM before the view shows loss of signal and marks every value "
+        "as stale (default %g)" % LOS_AFTER,
+    )
     x.set_defaults(func=_watch)
     x = s.add_parser(
         "console",

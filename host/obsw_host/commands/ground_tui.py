@@ -17,6 +17,7 @@ from rich.live import Live
 from rich.table import Table
 
 from obsw_host.commands import session
+from obsw_host.commands.ground_console import LOS_AFTER
 from obsw_host.errors import user_message
 from obsw_host.mission import ids as mission_ids
 from obsw_host.obc.state import default_state
@@ -33,16 +34,20 @@ CONSOLE_KEYS = ("func", "action", "history", "once", "count", "every", "seconds"
 # ------------------------------------------------------------------------------ watch
 
 
-def render(picture):
-    """The picture as rich tables: values, events, commands."""
-    values = Table(title="current values", expand=True, title_justify="left")
+def render(picture, los_after=LOS_AFTER):
+    """The picture as rich tables: values, events, commands; at loss of signal the values are
+    dimmed and their limit column says so."""
+    signal, lost = picture.signal(los_after)
+    title = "current values (%s)" % signal
+    values = Table(title=title, expand=True, title_justify="left")
     for column in ("parameter", "value", "unit", "limit", "on-board time (UTC)"):
         values.add_column(column)
     for name, v in picture.values.items():
         limit = v["limit"]
-        style = _LIMIT_STYLES.get(limit, "")
+        style = "dim" if lost else _LIMIT_STYLES.get(limit, "")
         value = number(v["value"])
-        values.add_row(name, value, v["unit"], limit or "-", v["time"], style=style or None)
+        limit = "stale (%s)" % (limit or "-") if lost else (limit or "-")
+        values.add_row(name, value, v["unit"], limit, v["time"], style=style or None)
     events = Table(title="latest events", expand=True, title_justify="left")
     for column in ("time (UTC)", "event", "severity", "data"):
         events.add_column(column)
@@ -83,13 +88,24 @@ def watch(args):
         g.subscribe()
         _ask_housekeeping(g, picture)
         if args.json:
-            show = lambda: print(json.dumps(picture.snapshot()), flush=True)  # noqa: E731
-            return _frames(g, args, frames, show)
-        console = Console()
-        if frames is not None or not console.is_terminal:
-            return _frames(g, args, frames, lambda: console.print(render(picture)))
-        with Live(render(picture), console=console, auto_refresh=False) as live:
-            return _frames(g, args, None, lambda: live.update(render(picture), refresh=True))
+            show = lambda: print(json.dumps(picture.snapshot(args.los)), flush=True)  # noqa: E731
+            rc = _frames(g, args, frames, show)
+        else:
+            console = Console()
+            if frames is not None or not console.is_terminal:
+                rc = _frames(g, args, frames, lambda: console.print(render(picture, args.los)))
+            else:
+                with Live(render(picture, args.los), console=console, auto_refresh=False) as live:
+                    rc = _frames(
+                        g, args, None, lambda: live.update(render(picture, args.los), refresh=True)
+                    )
+        if picture.received == 0:
+            print(
+                "no TM from %s:%s: is `obsw obc serve` running there?" % g.target,
+                file=sys.stderr,
+            )
+            return 1
+        return rc
 
 
 def _frames(g, args, frames, show):

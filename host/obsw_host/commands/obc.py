@@ -94,6 +94,31 @@ def check_mission(path):
     return check(locate(path))[1]
 
 
+def ports_in_use(topology):
+    """The UDP ports this OBC binds (PUS, CFDP, the frame processor's inputs) that another
+    program holds now: ``["5010 (pus)", ...]``."""
+    import socket
+
+    ids, host = topology.ids, topology.config.host
+    wanted = []
+    if topology.runs("pus"):
+        wanted.append(("pus", ids.ports.pus))
+    if topology.runs("cfdp"):
+        wanted.append(("cfdp", ids.ports.cfdp))
+    if topology.runs("frames"):
+        wanted += [("tm", ids.ports.tm), ("playback", ids.ports.playback)]
+    taken = []
+    for name, port in wanted:
+        s = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            s.bind((host, port))
+        except OSError:
+            taken.append("%d (%s)" % (port, name))
+        finally:
+            s.close()
+    return taken
+
+
 def _refuse(text):
     print("obsw obc: %s" % text, file=sys.stderr, flush=True)
     return EXIT_REFUSED
@@ -120,6 +145,14 @@ def serve(args):
         if args.process:
             return _serve_process(topology, args, out)
         topology.check()  # component modules import, before anything starts
+        taken = ports_in_use(topology)
+        if taken:
+            raise UserError(
+                "UDP port%s %s on %s in use (another OBC of this mission?)"
+                % ("s" if len(taken) > 1 else "", ", ".join(taken), config.host),
+                expected="free ports: stop the other OBC, or move this one's with "
+                "$OBSW_PORT_BASE or the mission's `ports`",
+            )
     except (ConfigError, UserError) as e:
         return _refuse(e)
     try:

@@ -76,8 +76,8 @@ def _instance_options(x):
         action="append",
         default=argparse.SUPPRESS,
         help="mission folder (with mission.json) or mission file; repeat it to operate several "
-        "spacecraft, one Yamcs instance each (default: ./mission.json, else $OBSW_MISSION, "
-        "else the nearest mission.json)",
+        "spacecraft, one Yamcs instance each (default: $OBSW_MISSION, else the nearest "
+        "mission.json from here up)",
     )
     x.add_argument(
         "--sdb",

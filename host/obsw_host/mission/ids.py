@@ -389,8 +389,8 @@ def add_arguments(parser, sdb_help="spacecraft database JSON (overrides the miss
         "--mission",
         metavar="DIR",
         default=argparse.SUPPRESS,
-        help="mission folder (with mission.json) or mission file (default: ./mission.json, "
-        "else $OBSW_MISSION, else the nearest mission.json)",
+        help="mission folder (with mission.json) or mission file (default: $OBSW_MISSION, "
+        "else the nearest mission.json from here up)",
     )
     parser.add_argument("--sdb", default=argparse.SUPPRESS, help=sdb_help)
 

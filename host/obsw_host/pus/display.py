@@ -10,6 +10,7 @@ the state that `obsw ground watch` shows; ``snapshot()`` is its JSON-able form.
 
 import collections
 import json
+import time
 
 from obsw import cbor
 from obsw.pus.config import DEFAULT
@@ -87,8 +88,10 @@ def utc(tai):
 class Picture:
     """The state an operator watches, built from the TM a ground receives."""
 
-    def __init__(self, sdb=None, events=10, commands=10, config=None):
+    def __init__(self, sdb=None, events=10, commands=10, config=None, clock=time.monotonic):
         self.sdb = sdb
+        self.clock = clock
+        self.last_tm = None  # the clock's time of the last TM received (None: none yet)
         self.config = config  # the PusConfig the TM was decoded with (its time code)
         self.values = collections.OrderedDict()  # name -> {value, unit, limit, time}
         self.events = collections.deque((), events)
@@ -123,6 +126,7 @@ class Picture:
     def feed(self, tm, decoded):
         """Take one received TM (and its decoded form, or None)."""
         self.received += 1
+        self.last_tm = self.clock()
         if not isinstance(decoded, dict):
             return
         when = utc(tm_seconds(tm, self.config))
@@ -174,14 +178,28 @@ class Picture:
             "data": data or "",
         }
 
-    def snapshot(self):
-        """The picture as JSON-able data."""
-        return {
+    def signal(self, los_after):
+        """(text, lost): how long ago the last TM came; lost (loss of signal) when none came
+        for ``los_after`` seconds, or none yet."""
+        if self.last_tm is None:
+            return "no TM received", True
+        age = self.clock() - self.last_tm
+        if age >= los_after:
+            return "LOSS OF SIGNAL: no TM for %.0f s (values as last received)" % age, True
+        return "last TM %.1f s ago" % age, False
+
+    def snapshot(self, los_after=None):
+        """The picture as JSON-able data (with the signal when ``los_after`` is given)."""
+        out = {
             "values": [dict(name=k, **v) for k, v in self.values.items()],
             "events": list(self.events),
             "commands": [dict(r) for r in reversed(self.commands.values())],
             "received": self.received,
         }
+        if los_after is not None:
+            text_, lost = self.signal(los_after)
+            out["signal"] = {"text": text_, "lost": lost}
+        return out
 
 
 # ------------------------------------------------------------------------------ replies by name

@@ -313,6 +313,8 @@ class Values:
             eng = raw if self.calibration is None else self.calibration.engineering(raw)
         except CalibrationError as e:
             return str(e)
+        if isinstance(eng, (str, bytes)):
+            return "%r is not a number" % (eng,)
         low, high = self.range
         if (low is not None and eng < low - _slack(low)) or (
             high is not None and eng > high + _slack(high)

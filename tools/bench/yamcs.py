@@ -36,8 +36,8 @@ SKIP = 77  # exit status when Yamcs cannot run here (tools/bench/smoke.py counts
 # the rates tried: doubling from START until a packet is lost, at most CEILING
 START, CEILING = 1000, 32000
 CEILING_NOTE = (
-    "%s lost nothing up to the ceiling of %d packets/s: its lossless rate is at least that,"
-    " and a ratio between figures at the ceiling says nothing"
+    "%s lost nothing at any rate tried, up to the ceiling of %d packets/s asked (it sent %d/s"
+    " at most): its lossless rate is at least that, and a ratio with it says nothing more"
 )
 
 
@@ -240,7 +240,7 @@ def main():
                 best = max(best, sent / seconds)
             results[impl] = best
             if not lost:
-                notes.append(CEILING_NOTE % (impl, CEILING))
+                notes.append(CEILING_NOTE % (impl, CEILING, best))
     finally:
         yamcs.stop()
         gateway.close()

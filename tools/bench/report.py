@@ -45,7 +45,7 @@ RUNS = {
     "reconfig": ("reconfig.py", {}, "Reconfiguration module logic (host)"),
     "board": ("board.py", {}, "Reconfiguration module CPU budget (Cortex-M, QEMU)"),
     "chain": ("chain.py", {}, "The end-to-end chain"),
-    "obc_start": ("obc_start.py", {}, "OBC cold start"),
+    "obc_start": ("obc_start.py", {}, "Start-up: the OBC cold start and a ground command"),
     "supervision": ("supervision.py", {}, "OBC recovery of a killed and a hung unit"),
     "yamcs": ("yamcs.py", {}, "Yamcs archiving rate"),
     "yamcs_fleet": ("yamcs_fleet.py", {}, "Several spacecraft on one Yamcs"),

@@ -279,8 +279,10 @@ class Soak:
         for path in glob.glob(os.path.join(self.snaps, "*.traced")):
             name = os.path.basename(path).rsplit("-", 1)[0]
             with open(path) as f:
-                points = [line.split() for line in f if line.strip()]
-            out.setdefault(name, []).extend((float(t), int(b)) for t, b in points)
+                for line in f:  # the last line may be half written: it is left out
+                    fields = line.split()
+                    if len(fields) == 2 and line.endswith("\n"):
+                        out.setdefault(name, []).append((float(fields[0]), int(fields[1])))
         return out
 
     def growers(self):

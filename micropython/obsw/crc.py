@@ -275,10 +275,11 @@ class FileChecksum:
         self.offset = 0
 
     def update(self, data):
-        if self.kind == CHECKSUM_MODULAR:
+        f = self._crc  # a CRC first: the usual kind, once per file data PDU
+        if f is not None:
+            self.value = f(data, self.value)
+        elif self.kind == CHECKSUM_MODULAR:
             self.value = modular(data, self.offset, self.value)
-        elif self._crc is not None:
-            self.value = self._crc(data, self.value)
         self.offset += len(data)
         return self
 

@@ -126,7 +126,9 @@ class Sender(Transaction):
     # -- building PDUs ---------------------------------------------------------------------
     def _read(self, offset, n):
         """``n`` octets of the file at ``offset``: cut from the last read-ahead chunk when it
-        holds them, else read (with CFDP_READ_AHEAD, a chunk that large from ``offset``)."""
+        holds them, else read (with CFDP_READ_AHEAD, a chunk that large from ``offset``, which
+        the running file checksum takes in whole when it continues it: EOF's checksum is over
+        the whole file, and one of a transfer cut short is computed again from the file)."""
         ra = self._ra
         if ra is not None:
             start = ra[0]
@@ -136,6 +138,8 @@ class Sender(Transaction):
             return self._file().read(offset, n)
         chunk = self._file().read(offset, CFDP_READ_AHEAD)
         self._ra = (offset, chunk)
+        if self.ck.offset == offset:  # the file checksum over the chunk at once, not per PDU
+            self.ck.update(chunk)
         return chunk[:n]
 
     def _file_data(self, offset, n):

@@ -58,12 +58,21 @@ def version():
         return "unknown"
 
 
+class _Version(argparse.Action):
+    """``--version``: the distribution's version is looked up only when asked for (reading
+    the package metadata costs every other command's start-up time)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print("obsw " + version())
+        parser.exit()
+
+
 def build_parser(only=None):
     """The parser; with ``only`` (a command name), only that command's module is imported."""
     parser = Parser(
         prog="obsw", description="Open onboard software for CubeSats: host tools, OBC and ground."
     )
-    parser.add_argument("--version", action="version", version="obsw " + version())
+    parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
     parser.add_argument(
         "--debug", action="store_true", help="show the traceback of an error (also anywhere)"
     )

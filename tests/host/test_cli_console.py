@@ -16,7 +16,7 @@ import time
 
 import pytest
 from obsw_host.cli import build_parser
-from obsw_host.commands.ground_console import GroundCompleter, _subcommands
+from obsw_host.commands.ground_tui import GroundCompleter, _subcommands
 from obsw_host.sample import load_sdb
 from prompt_toolkit.document import Document
 from test_cli_ground import BOUND, ENV, OBSW, obc, obsw, start, stop  # noqa: F401, F811

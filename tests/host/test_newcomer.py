@@ -106,7 +106,7 @@ def test_the_console_history_of_the_sample_stays_out_of_the_source_tree():
     history with it, in the user's state folder, never beside the mission in the checkout."""
     import argparse
 
-    from obsw_host.commands.ground_console import history_path
+    from obsw_host.commands.ground_tui import history_path
     from obsw_host.mission.ids import MissionIds
 
     path = history_path(argparse.Namespace(history=None), MissionIds.locate(SAMPLE))

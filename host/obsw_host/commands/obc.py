@@ -169,10 +169,12 @@ def serve(args):
 def _boot(args, config, topology, out):
     """The boot selector: run the platform manager on the software the boot record names
     (``obsw_host.update.slots``), and again after every update step that changes it."""
+    from obsw_host.obc import memtrace
     from obsw_host.obc.platform import PlatformManager, stop_on_signals
     from obsw_host.update.component import software_of
     from obsw_host.update.slots import FACTORY
 
+    memtrace.install("platform")  # only with $OBSW_TRACEMALLOC (the soak benchmark)
     done = stop_on_signals()  # between two runs too
     software = software_of(config)
     max_starts = int(topology.section("update")["max_starts"])
@@ -217,8 +219,10 @@ def _slot_topology(config, mission):
 def _serve_process(topology, args, out):
     """One process of the topology. One that cannot be built says why in one line: status 2
     for a configuration error (final: the platform manager does not restart it), else 1."""
+    from obsw_host.obc import memtrace
     from obsw_host.obc.assembly import ObcProcess
 
+    memtrace.install(args.process)  # only with $OBSW_TRACEMALLOC (the soak benchmark)
     try:
         process = ObcProcess(topology, args.process, out=out)
     except ConfigError as e:

@@ -422,6 +422,32 @@ def _figures(out, prefix):
     return [line for line in out.splitlines() if line.startswith(prefix)]
 
 
+HEAP_FIGURES = re.compile(r"heap low-water free (\d+)")
+
+
+def reconfig_heap(pty, passes=HEAP_PASSES):
+    """The reconfiguration application's session on the board at ``pty`` (the Pyboard's heap):
+    (ok, low-water free heap in bytes or None, the board's output)."""
+    code = (
+        "import obsw_heap; ok, low, total = obsw_heap.reconfig(%d); "
+        "print('reconfig', 'ok' if ok and low >= %r * total else 'FAILED')" % (passes, MIN_FREE)
+    )
+    rc, out = firmware.mpremote(pty, "exec", code, timeout=300)
+    m = HEAP_FIGURES.search(out)
+    return rc == 0 and "reconfig ok" in out, int(m.group(1)) if m else None, out
+
+
+def free_heap(passes=HEAP_PASSES):
+    """What the reconfiguration application leaves free on a Pyboard's heap (the low-water
+    mark of the heap stage's session): measured on a freshly booted board (FirmwareError when
+    the session fails)."""
+    with firmware.Qemu(firmware.build_qemu()) as q:
+        ok, low, out = reconfig_heap(q.pty, passes)
+    if not ok or low is None:
+        raise firmware.FirmwareError("the heap stage's session failed:\n" + out[-2000:])
+    return low
+
+
 def stage_heap():
     t0 = time.monotonic()
     try:
@@ -435,16 +461,11 @@ def stage_heap():
         "QEMU Cortex-M3 board, MICROPY_HEAP_SIZE %d (the Pyboard's _heap_end - _heap_start)" % heap
     )
     with firmware.Qemu(elf) as q:
-        code = (
-            "import obsw_heap; ok, low, total = obsw_heap.reconfig(%d); "
-            "print('reconfig', 'ok' if ok and low >= %r * total else 'FAILED')"
-            % (HEAP_PASSES, MIN_FREE)
-        )
         t1 = time.monotonic()
-        rc, out = firmware.mpremote(q.pty, "exec", code, timeout=300)
+        ok, _, out = reconfig_heap(q.pty)
         print("\n".join(_figures(out, ("heap", "passes", "reconfig", "Traceback", "MemoryError"))))
         print("reconfiguration session %.1f s" % (time.monotonic() - t1))
-        if rc == 0 and "reconfig ok" in out:
+        if ok:
             passed += 1
         else:
             failed += 1

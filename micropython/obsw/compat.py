@@ -13,6 +13,9 @@ except ImportError:
 
 
 MICROPYTHON = sys.implementation.name == "micropython"
+# bytes a CFDP sender reads from its file at once and cuts its file data PDUs from (one
+# filestore read per 64 KiB instead of one per PDU); none on a board, whose heap is ~100 KiB
+CFDP_READ_AHEAD = 0 if MICROPYTHON else 65536
 
 if MICROPYTHON:
     import micropython  # the hot paths say @micropython.native: compiled to machine code

@@ -93,7 +93,13 @@ def _fast(spec):
     def crc(data, previous=None):
         return fast(data, start if previous is None else previous)
 
+    _RUNNING[crc] = fast
     return crc
+
+
+# crc function -> its accelerator, which takes the previous value as it is: a running
+# checksum (FileChecksum.update, once per file data PDU) calls it without the wrapper
+_RUNNING = {}
 
 
 # Pure definitions: width, polynomial, initial register, reflected, final XOR, check value.
@@ -262,16 +268,18 @@ class FileChecksum:
         elif kind in _CFDP_CRCS:
             self._crc = _CFDP_CRCS[kind]
             self.value = self._crc(b"")
+            self._crc = _RUNNING.get(self._crc, self._crc)  # value is never None from here
         else:
             raise UnsupportedChecksumError(kind)
         self.kind = kind
         self.offset = 0
 
     def update(self, data):
-        if self.kind == CHECKSUM_MODULAR:
+        f = self._crc  # a CRC first: the usual kind, once per file data PDU
+        if f is not None:
+            self.value = f(data, self.value)
+        elif self.kind == CHECKSUM_MODULAR:
             self.value = modular(data, self.offset, self.value)
-        elif self._crc is not None:
-            self.value = self._crc(data, self.value)
         self.offset += len(data)
         return self
 

@@ -116,3 +116,46 @@ class TestClass1(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestFileDataFastPath(unittest.TestCase):
+    """The receiving entity takes file data PDUs whose header repeats the last one's straight
+    to their transaction; anything else goes the whole way (decoded, checked, routed)."""
+
+    def pdus(self):
+        a, b = make_pair(files_a={"src.bin": DATA}, mode=UNACKNOWLEDGED)
+        a.put(2, "src.bin", "dst.bin")
+        out = []
+        for _ in range(100):
+            sent = a.transmit(0.0)
+            if not sent:
+                break
+            out += [p for _, p in sent]
+        return b, out
+
+    def test_every_pdu_counted_and_the_file_whole(self):
+        b, pdus = self.pdus()
+        for p in pdus:
+            b.receive(p, 0.0)
+        self.assertEqual(b.stats["pdus_received"], len(pdus))
+        self.assertEqual(bytes(b.fs.files["dst.bin"]), DATA)
+
+    def test_another_destination_is_misrouted_after_the_fast_path_began(self):
+        b, pdus = self.pdus()
+        for p in pdus[:3]:  # metadata, then two file data PDUs: the fast path is set
+            b.receive(p, 0.0)
+        wrong = bytearray(pdus[3])
+        eid, seq = ((wrong[3] >> 4) & 7) + 1, (wrong[3] & 7) + 1
+        wrong[4 + eid + seq + eid - 1] = 9  # the destination entity id: not this entity's
+        b.receive(bytes(wrong), 0.0)
+        self.assertEqual(b.stats["misrouted"], 1)
+        self.assertEqual(b.stats["pdus_received"], 4)
+
+    def test_a_short_pdu_is_a_decode_error_not_a_write(self):
+        b, pdus = self.pdus()
+        for p in pdus[:3]:
+            b.receive(p, 0.0)
+        before = bytes(b.fs.files[list(b.fs.files)[0]])
+        b.receive(pdus[3][:-5], 0.0)  # its length field says more than came
+        self.assertEqual(b.stats["decode_errors"], 1)
+        self.assertEqual(bytes(b.fs.files[list(b.fs.files)[0]]), before)

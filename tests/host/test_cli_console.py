@@ -16,7 +16,7 @@ import time
 
 import pytest
 from obsw_host.cli import build_parser
-from obsw_host.commands.ground_console import GroundCompleter, _subcommands
+from obsw_host.commands.ground_tui import GroundCompleter, _subcommands
 from obsw_host.sample import load_sdb
 from prompt_toolkit.document import Document
 from test_cli_ground import BOUND, ENV, OBSW, obc, obsw, start, stop  # noqa: F401, F811
@@ -51,7 +51,8 @@ def test_watch_once_shows_values_units_and_limit_states(obc):  # noqa: F811 (the
 
 def test_watch_frames_show_events_and_verification_of_other_clients(obc):  # noqa: F811 (the fixture)
     port, _ = obc
-    watch, out, err = start("ground", "--port", port, "watch", "--count", 3, "--every", 1.5)
+    # frames until the test has seen what it waits for (stopped then), however slow the machine
+    watch, out, err = start("ground", "--port", port, "watch", "--count", 40, "--every", 1.5)
     try:
         out.until(lambda line: "commands" in line)  # the first frame is out
         assert obsw("ground", "--port", port, "function", "SolarPanel.deploy").returncode == 0

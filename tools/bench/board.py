@@ -15,12 +15,13 @@ per instruction is 3.2 ticks, so a tick difference t fixes the instruction count
 M3's DWT cycle counter reads 0.) Each operation starts on a freshly collected heap (not
 counted), so its figure holds its own allocation but no collection; "with gc" adds a whole
 collection of the case's heap, counted on the board (to 10,000 instructions: the collector's
-conservative stack scan reads a few words the REPL left at the host's pace), for every 38,880
-bytes it allocates (what the application leaves free on a Pyboard's heap, its low-water mark
-in the `heap` stage). The empty operation (the timer reads and a call) is subtracted. Each case
-runs on a freshly booted board (after a soft reset the heap was found a few bytes apart from
-one run to the next, and the counts with it), so no figure depends on which cases ran before;
-`--check` measures every case twice and compares every count.
+conservative stack scan reads a few words the REPL left at the host's pace), each time its
+allocations add up to the heap the application leaves free on a Pyboard (the low-water mark of
+the `heap` stage's session, which the benchmark runs itself on a freshly booted board and
+reports in its first row). The empty operation (the timer reads and a call) is subtracted.
+Each case runs on a freshly booted board (after a soft reset the heap was found a few bytes
+apart from one run to the next, and the counts with it), so no figure depends on which cases
+ran before; `--check` measures every case twice and compares every count.
 
 The counts are Thumb-2 instructions of the Cortex-M3 build; a Pyboard's Cortex-M4 runs the same
 interpreter code (its build adds the FPU, which the core's few float operations use). The CPU
@@ -41,6 +42,9 @@ import tempfile
 from obsw_host import firmware
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+
+import firmware_stages  # noqa: E402 (the heap stage's session)
 
 OPS_SCRIPT = os.path.join(ROOT, "tools", "bench", "board_ops.py")
 SHIFT = 7  # -icount shift: 2**SHIFT ns of virtual time per guest instruction
@@ -52,14 +56,16 @@ BUS_FRAMES = 8000  # SpaceCAN at 1 Mbit/s: about 8,000 frames per second
 BATCH = 16  # frames per poll in the batch cases (board_ops.BATCH)
 FRAMES_PER_PASS = 64  # the application's bound: 32 frames a bus per loop pass
 RESPONDER_SHARE = 0.5  # the responder's budget at full bus load
-# what the reconfiguration application leaves free on a Pyboard's heap (the heap stage's
-# low-water mark): a collection comes every so many bytes allocated. (The free heap of a case
-# itself is not used: a stale word in the C stack can keep a garbage block alive in one boot.)
-FREE_HEAP = 38880
+# What the reconfiguration application leaves free on a Pyboard's heap, the heap stage's
+# low-water mark, measured by its own session in each run (firmware_stages.free_heap): a
+# collection comes every so many bytes allocated. (The free heap of a case itself is not used:
+# a stale word in the C stack can keep a garbage block alive in one boot.)
+QUICK_HEAP_PASSES = 2000  # the heap stage's session runs HEAP_PASSES; --quick this many
 WATCHDOG_TARGET_MS = 330  # obsw.reconfig.watchdog: kick aimed at 330 ms after the last one
 WATCHDOG_TIMEOUT_MS = 1000  # the TPS3813 resets after 1000 ms without a kick
 WATCHDOG_MARGIN_MS = 10
 
+FREE_HEAP_CASE = "free heap the application leaves on a Pyboard (heap stage's low-water mark)"
 # (name, what, operations)
 CASES = (
     ("empty", "the timer reads alone", 8),
@@ -86,6 +92,8 @@ CASES = (
     ("pus_tm_encode", "PUS TM encode (TM[3,25], 16 bytes)", 8),
     ("pluto_statement", "PLUTO statement (`i := i + 1;` in a while loop)", 8),
     ("update_verify", "update package: its manifest's Ed25519 signature (collections in)", 1),
+    ("tm_frame_rs", "TM frame of 223 octets: Reed-Solomon (255,223), randomizer, ASM", 2),
+    ("tm_frame_concatenated", "TM frame of 223 octets: RS, randomizer, ASM, K=7 rate 1/2", 2),
 )
 # the bench's own rig (a SpaceCAN controller playing the OBC, the modelled EEPROMs and DS3231)
 # shares the board's heap with the application: it gets this much on top of the Pyboard's
@@ -152,7 +160,7 @@ def _counts(r):
     )
 
 
-def measure(elf, mpy, cases, check):
+def measure(elf, mpy, cases, check, free_heap):
     first = run_board(elf, mpy, cases)
     same = None
     if check:
@@ -183,8 +191,8 @@ def measure(elf, mpy, cases, check):
         for key in ("instructions", "min", "max"):
             gc_case[key] = round(gc_case[key], -4)
     for r in res.values():
-        # the collections its garbage costs: one of its heap for every FREE_HEAP bytes
-        r["with_gc"] = r["instructions"] + r["alloc"] * r["collect"] / FREE_HEAP
+        # the collections its garbage costs: one of its heap for every free_heap bytes
+        r["with_gc"] = r["instructions"] + r["alloc"] * r["collect"] / free_heap
     for kind in KINDS:
         b = res.get("batch_" + kind)
         if b is not None and "can_idle" in res:
@@ -225,13 +233,21 @@ def budget(res):
     return out
 
 
-def rows_of(cases, res, b):
+def rows_of(cases, res, b, free_heap):
     rows = []
 
-    def row(case, value, unit):
+    def row(case, value, unit, higher_is_better=False):
         rows.append(
-            {"case": case, "impl": "obsw", "value": value, "unit": unit, "higher_is_better": False}
+            {
+                "case": case,
+                "impl": "obsw",
+                "value": value,
+                "unit": unit,
+                "higher_is_better": higher_is_better,
+            }
         )
+
+    row(FREE_HEAP_CASE, free_heap, "bytes", True)
 
     for name, what, _ in cases:
         r = res[name]
@@ -279,14 +295,16 @@ def main(argv=None):
         with tempfile.TemporaryDirectory(prefix="obsw-board-") as tmp:
             mpy = os.path.join(tmp, "board_ops.mpy")
             compile_ops(mpy)
-            res, same = measure(str(elf), mpy, cases, args.check)
+            passes = QUICK_HEAP_PASSES if args.quick else firmware_stages.HEAP_PASSES
+            free_heap = firmware_stages.free_heap(passes)
+            res, same = measure(str(elf), mpy, cases, args.check, free_heap)
     b = budget(res)
     if args.json:
         print(
             json.dumps(
                 {
                     "bench": "board",
-                    "rows": rows_of(cases, res, b),
+                    "rows": rows_of(cases, res, b, free_heap),
                     "counter": "Thumb-2 instructions, QEMU mps2-an385 (Cortex-M3), -icount "
                     "shift=%d, CMSDK APB timer" % SHIFT,
                     "cpu": {"hz": CPU_HZ, "ipc": IPC, "bus_frames_per_s": BUS_FRAMES},
@@ -326,6 +344,7 @@ def main(argv=None):
                 b["watchdog_room_ms"],
             )  # fmt: skip
         )
+    print("free heap (the heap stage's low-water mark, %d passes): %d bytes" % (passes, free_heap))
     print(
         "Thumb-2 instructions (QEMU -icount, exact); shares at IPC %.1f and 168 MHz%s"
         % (IPC, "" if same is None else "; two boots count the same: %s" % same)

@@ -42,6 +42,7 @@ SEGMENT = 1024
 TIMER = 1.0
 RCVBUF = 1 << 22
 PEER = "cfdp-py"
+MISSION_DIR = os.path.join(ROOT, "examples", "sample")  # the entity `obsw cfdp serve` runs
 
 
 def _env():
@@ -86,6 +87,8 @@ class Obsw:
                 "-m",
                 "obsw_host.cfdp",
                 "serve",
+                "--mission",
+                MISSION_DIR,
                 "--id",
                 "2",
                 "--root",

@@ -7,7 +7,12 @@ measures, one request at a time:
 - a CPDU switch: TC[18,3] activating a PLUTO procedure that calls ``CpduN.set_state_bits``
   over SpaceCAN, to the procedure's ``obcp.finished`` event back through the TM frames;
 - the reference: the same ping over UDP straight to the PUS process.
-Rows: p50 and p99 in milliseconds.
+Rows: p50 and p99 in milliseconds. The chain's ping is also cut into its hops, from the ground
+station's two UART ends (timed where the station writes the TC's CLTU and reads the TM frames,
+in this process): the ground's uplink (the PUS user to the station over UDP, TC frame, SDLS,
+CLTU, onto the UART), the OBC (from the CLTU on the UART to the first TM frame back: frame
+processor, PUS process, TM frames) and the ground's downlink (from the first TM frame to the
+completion report at the PUS user); each hop's p50 is given next to the direct ping's.
 
     python tools/bench/chain.py [--quick] [--json]
 """
@@ -30,15 +35,44 @@ def percentiles(samples):
     return s[len(s) // 2], s[min(len(s) - 1, int(len(s) * 0.99))]
 
 
-def pings(ground, n):
-    out = []
+def pings(ground, n, marks=None):
+    """Seconds of ``n`` pings; with ``marks`` (a list the links append (kind, time) to), also
+    [(uplink, obc, downlink)] seconds of each."""
+    out, hops = [], []
     for _ in range(n):
+        if marks is not None:
+            del marks[:]
         t0 = time.perf_counter()
         tx = ground.ping(timeout=5.0)
-        out.append(time.perf_counter() - t0)
+        t1 = time.perf_counter()
+        out.append(t1 - t0)
         if not tx.ok:
             raise RuntimeError("ping failed: %s" % tx.verification())
-    return out
+        if marks is not None:
+            up = [t for kind, t in marks if kind == "w"]
+            down = [t for kind, t in marks if kind == "r" and t > up[0]] if up else []
+            if up and down:
+                hops.append((up[0] - t0, down[0] - up[0], t1 - down[0]))
+    return (out, hops) if marks is not None else out
+
+
+def mark_links(links, marks):
+    """Time-stamp each write (the TC's CLTU) and each read that brought data (TM frames) on
+    the station's UART ends."""
+    for link in links:
+        write, read = link.write, link.read
+
+        def w(data, write=write):
+            marks.append(("w", time.perf_counter()))
+            return write(data)
+
+        def r(read=read):
+            data = read()
+            if data:
+                marks.append(("r", time.perf_counter()))
+            return data
+
+        link.write, link.read = w, r
 
 
 def switches(chain, n):
@@ -70,7 +104,9 @@ def run(n_ping, n_switch):
         with Chain(work) as chain:
             chain.wait_up(60.0)
             pings(chain.ground, 20)  # warm up
-            frames = pings(chain.ground, n_ping)
+            marks = []
+            mark_links(chain.links, marks)
+            frames, hops = pings(chain.ground, n_ping, marks)
             switch = switches(chain, n_switch)
             direct_ground = Ground(chain.sdb, target=("127.0.0.1", chain.pus_port))
             try:
@@ -78,6 +114,9 @@ def run(n_ping, n_switch):
                 direct = pings(direct_ground, n_ping)
             finally:
                 direct_ground.close()
+    for case, samples in zip(HOPS, zip(*hops)):
+        rows.append(_row("ping, hop: %s, p50" % case, "obsw", percentiles(samples)[0]))
+        rows.append(_row("ping, hop: %s, p50" % case, "reference", percentiles(direct)[0]))
     for case, impl, samples in (
         ("ping through the chain (CLTU, frames, TM frames)", "obsw", frames),
         ("CPDU switch through the chain (18 -> PLUTO -> SpaceCAN)", "obsw", switch),
@@ -95,6 +134,23 @@ def run(n_ping, n_switch):
                 }
             )
     return rows
+
+
+HOPS = (
+    "ground uplink (PUS user, station, TC frame, SDLS, CLTU onto the UART)",
+    "OBC (CLTU on the UART to the first TM frame: frame processor, PUS process)",
+    "ground downlink (first TM frame to the completion report at the PUS user)",
+)
+
+
+def _row(case, impl, seconds):
+    return {
+        "case": case,
+        "impl": impl,
+        "value": round(seconds * 1000, 3),
+        "unit": "ms",
+        "higher_is_better": False,
+    }
 
 
 def main(argv=None):

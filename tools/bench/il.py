@@ -16,6 +16,7 @@ import argparse
 import gc
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -224,6 +225,7 @@ class ObswRemote:
     def close(self):
         self.transport.close()
         _stop(self.proc)
+        shutil.rmtree(self.dir, ignore_errors=True)
 
 
 # ------------------------------------------------------------------------------ ZeroMQ + JSON
@@ -392,6 +394,7 @@ class ZmqRemote:
         self.ctx.term()
         for p in (self.rep_proc, self.pub_proc):
             p.wait(10)
+        shutil.rmtree(self.dir, ignore_errors=True)
 
 
 # ------------------------------------------------------------------------------ main

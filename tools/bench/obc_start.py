@@ -1,15 +1,23 @@
-"""Benchmark of the OBC's cold start: `obsw obc serve` started to its first answered PUS ping.
+"""Benchmark of start-up: the OBC's cold start to its first answered PUS ping, with and without
+bytecode, and the whole `obsw ground ping` command against an empty Python start.
 
-Each run starts the platform manager of a mission (default: the sample spacecraft) in a fresh
-state folder, as `obsw obc serve` does, and sends TC[17,1] to the PUS process every 10 ms until
-TM[17,2] comes back; the figure is the time from the start of the command to that reply. The
-process is then stopped with SIGTERM. There is no peer for this figure: the reference row is
-the goal (1 s). The median of the runs is printed with their spread (fastest, slowest).
+Each cold-start run starts the platform manager of a mission (default: the sample spacecraft)
+in a fresh state folder, as `obsw obc serve` does, and sends TC[17,1] to the PUS process every
+10 ms until TM[17,2] comes back; the figure is the time from the start of the command to that
+reply. The process is then stopped with SIGTERM. There is no peer for this figure: the
+reference row is the goal (1 s). The median of the runs is printed with their spread.
 
-The OBC runs as installed, with its modules compiled to bytecode (pip compiles them at
-install): the bytecode goes to a cache folder of this run ($PYTHONPYCACHEPREFIX), written by a
-first run that is not counted, whatever $PYTHONDONTWRITEBYTECODE says in the caller's
-environment (with it, every process would compile every module at every start).
+  with bytecode     the OBC as installed, its modules compiled to bytecode (pip compiles them
+                    at install): the bytecode goes to a cache folder of this run
+                    ($PYTHONPYCACHEPREFIX), written by a first run that is not counted,
+                    whatever $PYTHONDONTWRITEBYTECODE says in the caller's environment
+  without bytecode  every module compiled from source at every start: an empty cache folder
+                    and $PYTHONDONTWRITEBYTECODE=1 (a source tree or an install that could not
+                    write its bytecode)
+
+`obsw ground ping` (with bytecode) runs against the OBC of the last cold start, in pairs back to
+back with `python -c pass` (the interpreter's own start, the reference): the ratio is the
+median of the pairs' ratios (goal: within 6 times). The two cold-start variants alternate too.
 
 Usage: python tools/bench/obc_start.py [MISSION] [--runs N] [--quick] [--json]
 """
@@ -45,11 +53,23 @@ def pus_address(mission):
     return (topology.config.host, topology.pus_port()), topology.pus_apid()
 
 
-def one_run(mission, address, apid, pycache):
-    """Seconds from the start of `obsw obc serve` to the first TM[17,2]."""
-    state = tempfile.mkdtemp(prefix="obsw-start-")
+PING_GOAL = 6.0  # `obsw ground ping` within 6 times `python -c pass` (issue 41)
+
+
+def start_env(pycache, bytecode=True):
+    """The environment of a start: bytecode in ``pycache``, or none written or read."""
     env = dict(os.environ, PYTHONPATH=python_path(), PYTHONPYCACHEPREFIX=pycache)
     env.pop("PYTHONDONTWRITEBYTECODE", None)
+    if not bytecode:
+        env["PYTHONDONTWRITEBYTECODE"] = "1"
+    return env
+
+
+def one_run(mission, address, apid, pycache, bytecode=True, then=None):
+    """Seconds from the start of `obsw obc serve` to the first TM[17,2]; ``then()`` runs
+    while the OBC still serves."""
+    state = tempfile.mkdtemp(prefix="obsw-start-")
+    env = start_env(pycache, bytecode)
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sock.bind((address[0], 0))
     sock.settimeout(0.01)
@@ -71,7 +91,10 @@ def one_run(mission, address, apid, pycache):
                     raw = sock.recv(65536)
                     tm = PusTm.unpack(raw)
                     if (tm.service, tm.subtype) == (17, 2):
-                        return time.perf_counter() - t0
+                        took = time.perf_counter() - t0
+                        if then is not None:
+                            then()
+                        return took
             except (socket.timeout, ConnectionRefusedError):
                 continue
             except ValueError:
@@ -88,51 +111,94 @@ def one_run(mission, address, apid, pycache):
         shutil.rmtree(state, ignore_errors=True)
 
 
+def timed(cmd, env):
+    t0 = time.perf_counter()
+    res = subprocess.run(cmd, env=env, stdin=subprocess.DEVNULL, capture_output=True)
+    took = time.perf_counter() - t0
+    if res.returncode != 0:
+        raise RuntimeError("%s: status %d\n%s" % (" ".join(cmd), res.returncode, res.stderr))
+    return took
+
+
+def ping_pairs(mission, pycache, pairs):
+    """[(`python -c pass` s, `obsw ground ping` s)] run back to back, with bytecode."""
+    env = start_env(pycache)
+    ping = [sys.executable, "-m", "obsw_host.cli", "ground", "--mission", mission, "ping"]
+    timed(ping, env)  # compiles the ground's bytecode: not counted
+    return [(timed([sys.executable, "-c", "pass"], env), timed(ping, env)) for _ in range(pairs)]
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument(
         "mission", nargs="?", help="mission folder or file (default: the sample spacecraft)"
     )
     p.add_argument("--runs", type=int, default=5, help="runs (default 5)")
-    p.add_argument("--quick", action="store_true", help="3 runs")
+    p.add_argument("--quick", action="store_true", help="3 runs, 5 ping pairs")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     args = p.parse_args(argv)
     args.mission = args.mission or MISSION_DIR  # named: the OBC uses no mission by default
     runs = 3 if args.quick else args.runs
     address, apid = pus_address(args.mission)
     pycache = tempfile.mkdtemp(prefix="obsw-start-pycache-")
+    empty = tempfile.mkdtemp(prefix="obsw-start-nocache-")
+    pairs = []
     try:
         one_run(args.mission, address, apid, pycache)  # compiles the bytecode: not counted
-        times = [one_run(args.mission, address, apid, pycache) for _ in range(runs)]
+        times = {"with bytecode": [], "without bytecode": []}
+        for i in range(runs):
+            for bytecode in (True, False) if i % 2 == 0 else (False, True):
+                then = None
+                if bytecode and i == runs - 1:  # while this OBC serves: the ground's start
+
+                    def then():
+                        pairs.extend(ping_pairs(args.mission, pycache, 5 if args.quick else 15))
+
+                took = one_run(args.mission, address, apid, pycache if bytecode else empty,
+                               bytecode, then)  # fmt: skip
+                times["with bytecode" if bytecode else "without bytecode"].append(took)
     finally:
         shutil.rmtree(pycache, ignore_errors=True)
-    median = statistics.median(times)
+        shutil.rmtree(empty, ignore_errors=True)
+    bare = statistics.median(p for p, _ in pairs)
+    ping = statistics.median(g for _, g in pairs)
+    ping_ratio = statistics.median(g / p for p, g in pairs)
+    rows = []
+    for what, values in times.items():
+        case = "cold start to first ping, %s" % what
+        rows.append(_row(case, "obsw", statistics.median(values), runs=values))
+        rows.append(_row(case, "reference", GOAL))
+    case = "`obsw ground ping`, whole command (reference: `python -c pass`)"
+    rows.append(
+        _row(case, "obsw", ping, ratio=round(1 / ping_ratio, 4), runs=[g for _, g in pairs])
+    )
+    rows.append(_row(case, "reference", bare, runs=[p for p, _ in pairs]))
     if args.json:
-        rows = [
-            {
-                "case": "cold start to first ping",
-                "impl": "obsw",
-                "value": median,
-                "unit": "s",
-                "higher_is_better": False,
-                "runs": times,
-            },  # fmt: skip
-            {
-                "case": "cold start to first ping",
-                "impl": "reference",
-                "value": GOAL,
-                "unit": "s",
-                "higher_is_better": False,
-            },  # fmt: skip
-        ]
-        print(json.dumps({"bench": "obc_start", "rows": rows}))
+        print(json.dumps({"bench": "obc_start", "rows": rows, "notes": [_ping_note(ping_ratio)]}))
         return 0
-    print("OBC cold start (obsw obc serve) to the first answered ping, %d runs" % runs)
-    print("%-28s %8s %8s %8s %7s" % ("case", "obsw", "goal", "ratio", "spread"))
-    spread = (min(times), max(times))
-    print("%-28s %7.2fs %7.2fs %7.2fx  %.2f-%.2f s" % (
-        "cold start to first ping", median, GOAL, median / GOAL, *spread))  # fmt: skip
+    print("start-up, %d runs each; `obsw ground ping`: %d pairs" % (runs, len(pairs)))
+    print("%-44s %8s %8s %8s  %s" % ("case", "obsw", "goal", "ratio", "spread"))
+    for what, values in times.items():
+        m = statistics.median(values)
+        line = ("cold start to first ping, " + what, m, GOAL, m / GOAL, min(values), max(values))
+        print("%-44s %7.2fs %7.2fs %7.2fx  %.2f-%.2f s" % line)
+    print("%-44s %7.3fs %7.3fs %7.2fx  (python -c pass; median of the pairs' ratios)" % (
+        "obsw ground ping", ping, bare, ping_ratio))  # fmt: skip
+    print(_ping_note(ping_ratio))
     return 0
+
+
+def _row(case, impl, value, **extra):
+    row = {"case": case, "impl": impl, "value": value, "unit": "s", "higher_is_better": False}
+    row.update(extra)
+    return row
+
+
+def _ping_note(ratio):
+    return (
+        "`obsw ground ping` took %.1f times `python -c pass` (median of the pairs; goal %g): %s"
+        % (ratio, PING_GOAL, "met" if ratio <= PING_GOAL else "MISSED")
+    )
 
 
 if __name__ == "__main__":

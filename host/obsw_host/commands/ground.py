@@ -454,7 +454,7 @@ def _sched_insert(args):
         else:
             from obsw.utc import parse_utc
 
-            from obsw_host.pus.onboard import tai_now
+            from obsw_host.pus.tai import tai_now
 
             at = parse_utc(args.at) if args.at else tai_now() + args.delay
             user = g.schedule

@@ -23,12 +23,10 @@ Times are UTC (YYYY-MM-DDTHH:MM:SS[.fff]Z); replies print by name, as tables.
 import argparse
 
 from obsw.pus.sdb import field_type
-from obsw.pus.services.schedule_user import embed
 from obsw.utc import parse_utc
 
 from obsw_host.commands import session
 from obsw_host.errors import UserError
-from obsw_host.pus.storage_ground import StorageGround
 
 
 def add_to_ground(s):
@@ -162,7 +160,7 @@ def _types(words):
 
 def _stats(args):
     def go(g):
-        sg = StorageGround(g)
+        sg = _storage(g)
         user = sg.statistics
         if args.what == "report":
             return sg.issue(user.report(g.apid, args.reset))
@@ -193,7 +191,7 @@ def _store(args):
         until = _utc(args.time)
 
     def go(g):
-        sg = StorageGround(g)
+        sg = _storage(g)
         what = args.what
         if what == "create":
             kw = {"kind": 1 if args.bounded else 0}
@@ -221,7 +219,7 @@ def _store(args):
 
 def _file(args):
     def go(g):
-        sg = StorageGround(g)
+        sg = _storage(g)
         files, apid = sg.files, g.apid
         if args.what == "copy":
             return sg.copy(args.source, args.target, move=args.move)[1]
@@ -257,8 +255,10 @@ def _large(args):
         raise UserError("part size %d" % args.part_size, expected="at least 1 octet")
 
     def go(g):
-        sg = StorageGround(g)
+        sg = _storage(g)
         sg.large.part_size = args.part_size
+        from obsw.pus.services.schedule_user import embed
+
         raw, inner = embed(g.proc, g.apid, args.service, args.subtype, data)
         for part in sg.large.uplink(g.apid, raw):
             sg.issue(part)
@@ -329,3 +329,10 @@ def _function(sdb, name):
         "no function or parameter assignment %r" % name,
         expected="one of `obsw ground list functions`, or PARAMETER=VALUE",
     )
+
+
+def _storage(g):
+    """The storage services' user (services 15, 23, ...), imported only for those commands."""
+    from obsw_host.pus.storage_ground import StorageGround
+
+    return StorageGround(g)

@@ -21,7 +21,6 @@ node << 16 | parameter id, a CPDU line node << 8 | output line (obsw.spacecan.de
 from obsw_host.commands import ground_data, session
 from obsw_host.errors import UserError
 from obsw_host.pus import text
-from obsw_host.pus.storage_ground import StorageGround
 
 _ON = {"on": True, "1": True, "enabled": True, "off": False, "0": False, "disabled": False}
 
@@ -70,6 +69,8 @@ def _issue(g, tx):
 
 
 def _storage(g):
+    from obsw_host.pus.storage_ground import StorageGround
+
     return StorageGround(g)
 
 

@@ -195,6 +195,16 @@ class _Checker:
         )
         frames = doc.get("frames") if isinstance(doc.get("frames"), dict) else {}
         self._exists(frames.get("keys"), ["frames", "keys"], "a key file of obsw frames keygen")
+        self._link(frames)
+
+    def _link(self, frames):
+        """The TM coding with the frame length: what the coder itself accepts."""
+        if any(p.path.startswith("$.frames") for p in self.problems):
+            return  # the schema already said what is wrong there
+        from obsw_host.frames.coding import LinkSettings
+
+        for path, text in LinkSettings(frames).problems():
+            self.add(self.file, path, text)
 
     # -------------------------------------------------------------------- the database
 

@@ -29,6 +29,7 @@ from obsw_host.mission.errors import ConfigError  # noqa: F401 (raised here, pub
 from obsw_host.mission.folder import locate
 from obsw_host.net import DEFAULT_HOST
 from obsw_host.obc.registry import KINDS, WITH_PUS
+from obsw_host.obc.state import default_state
 
 # component kinds that became plug-ins: the kind -> (component name, its entry)
 _LEGACY_KINDS = {"solar_panel": ("SolarPanel", {"module": "obsw_host.solar_panel"})}
@@ -57,7 +58,9 @@ class MissionConfig:
         self.name = str(doc.get("name", os.path.splitext(os.path.basename(path))[0]))
         self.host = str(doc.get("host", DEFAULT_HOST))
         self.sdb_path = self.resolve(self._str("sdb"))
-        self.state = self.resolve(doc.get("state", "state"))
+        # a mission file that names no state folder gets the user's state folder of its name,
+        # never a folder beside the mission (that may be the source tree)
+        self.state = self.resolve(doc["state"]) if "state" in doc else default_state(self.name)
         il = doc.get("il_directory")
         self.il_directory = self.resolve(il) if il else os.path.join(self.state, "il")
         self.processes = self._processes()

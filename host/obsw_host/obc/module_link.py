@@ -79,7 +79,7 @@ class ModuleLink:
 
     def _leap(self):
         """TAI - UTC now, from the host clock's pair (``obsw_host.pus.onboard.tai_now``)."""
-        from obsw_host.pus.onboard import tai_now
+        from obsw_host.pus.tai import tai_now
 
         return tai_now() - (time.time() - EPOCH_1958)
 

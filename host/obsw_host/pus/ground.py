@@ -46,7 +46,7 @@ from obsw_host.mission.ids import MissionIds
 from obsw_host.mission.ports import app_port
 from obsw_host.net import DEFAULT_HOST
 from obsw_host.pus import text
-from obsw_host.pus.onboard import tai_now
+from obsw_host.pus.tai import tai_now
 from obsw_host.pus.tm_fanout import SUBSCRIBE, UNSUBSCRIBE
 
 

@@ -15,7 +15,7 @@ from obsw.utc import format_utc
 
 from obsw_host.pus import text
 from obsw_host.pus.display import tm_seconds
-from obsw_host.pus.onboard import TAI_MINUS_UNIX
+from obsw_host.pus.tai import TAI_MINUS_UNIX
 
 _COLOURS = {"TC": "36", "fail": "31", "high": "31", "medium": "33", "low": "33", "ok": "32"}
 

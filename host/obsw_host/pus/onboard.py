@@ -18,6 +18,7 @@ calling thread until stopped (``obsw obc serve``).
 
 import asyncio
 import collections
+import socket
 import threading
 import time
 
@@ -51,15 +52,9 @@ from obsw.pus.services.s23_files import FileManagement
 from obsw_host.mission.ids import EVENT_COPY_COMPLETED, EVENT_COPY_FAILED, EVENT_OVERRUN, event_id
 from obsw_host.mission.ports import app_port
 from obsw_host.net import DEFAULT_HOST
+from obsw_host.pus.tai import TAI_MINUS_UNIX, tai_now  # noqa: F401 (names of this module too)
 from obsw_host.pus.tm_fanout import TmFanout
 from obsw_host.pus.tm_log import TmLog
-
-TAI_MINUS_UNIX = 378691200 + 37  # seconds from 1958-01-01 TAI to 1970-01-01 UTC, now
-
-
-def tai_now():
-    """On-board time: TAI seconds since 1958-01-01 from the host clock."""
-    return time.time() + TAI_MINUS_UNIX
 
 
 def copy_events(sdb):
@@ -155,18 +150,68 @@ def service_table(sdb, table=SERVICES):
     return tuple(table) + tuple(_mission_row(d) for d in sdb.services.values())
 
 
-class _Protocol(asyncio.DatagramProtocol):
-    def __init__(self, onboard):
-        self.onboard = onboard
+UDP_MAX = 65536  # bytes: more than any UDP datagram carries (65,507 over IPv4)
 
-    def connection_made(self, transport):
-        self.onboard._transport = transport
 
-    def datagram_received(self, data, addr):
-        self.onboard._received(data, addr)
+class _Udp:
+    """The process's UDP socket on the event loop: datagrams read straight into one buffer
+    (``loop.add_reader``), TM sent straight from the socket (issue 41: asyncio's datagram
+    transport read each datagram into a fresh 256 KiB buffer, an mmap, an mremap and a munmap
+    per TC, and its layers cost a TC round trip more than the work of its four reports). A
+    datagram the socket cannot take now (its buffer full) waits in order for it to drain."""
 
-    def error_received(self, exc):
-        self.onboard.app.count("udp_errors")
+    def __init__(self, loop, sock, received, count):
+        self.loop = loop
+        self.sock = sock
+        self.received = received  # received(data, address)
+        self.count = count  # count(counter name)
+        self.buf = bytearray(UDP_MAX)
+        self.view = memoryview(self.buf)
+        self.waiting = collections.deque()  # (data, address) for the socket to take
+        loop.add_reader(sock.fileno(), self._readable)
+
+    def _readable(self):
+        try:
+            n, address = self.sock.recvfrom_into(self.buf)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:  # an ICMP error for an earlier datagram (a ground gone)
+            self.count("udp_errors")
+            return
+        self.received(bytes(self.view[:n]), address)
+
+    def sendto(self, data, address):
+        if not self.waiting:
+            try:
+                self.sock.sendto(data, address)
+                return
+            except (BlockingIOError, InterruptedError):
+                self.loop.add_writer(self.sock.fileno(), self._writable)
+            except OSError:
+                self.count("udp_errors")
+                return
+        self.waiting.append((bytes(data), address))
+
+    def _writable(self):
+        while self.waiting:
+            data, address = self.waiting[0]
+            try:
+                self.sock.sendto(data, address)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                self.count("udp_errors")
+            self.waiting.popleft()
+        self.loop.remove_writer(self.sock.fileno())
+
+    def get_extra_info(self, name):
+        return self.sock.getsockname() if name == "sockname" else None
+
+    def close(self):
+        self.loop.remove_reader(self.sock.fileno())
+        if self.waiting:
+            self.loop.remove_writer(self.sock.fileno())
+        self.sock.close()
 
 
 def task_name(make):
@@ -209,6 +254,7 @@ class Onboard:
         self.address = None
         self.ground = None  # the sender of the last TC
         self.fanout = TmFanout([tm_to])
+        self._batch = None  # the TM of the TC being handled, sent once it is (_flush)
         self.tm_log = TmLog(sdb)
         self._transport = None
         self._loop = None
@@ -289,8 +335,27 @@ class Onboard:
         if t is None:
             raise OSError("not bound")
         self.tm_log.tm(raw)
+        if self._batch is not None:  # a TC being handled: its reports go out together
+            self._batch.append(raw)
+            return
         if not self.fanout.send(t.sendto, raw):
             self.app.count("tm_no_ground")
+
+    def _flush(self, batch):
+        """Send the TM a TC produced, back to back, once it is handled: each datagram wakes
+        the ground, and a ground woken between two reports (the work of the next one still to
+        do) took the CPU from this process on a loaded machine (issue 41)."""
+        t = self._transport
+        if t is None:
+            return
+        targets = self.fanout.targets()
+        if not targets:
+            self.app.count("tm_no_ground", len(batch))
+            return
+        sendto = t.sendto
+        for raw in batch:
+            for address in targets:
+                sendto(raw, address)
 
     def _playback(self, raw, vc):
         """The app's playback: a retrieved packet to the frame processor's ``vc`` input."""
@@ -308,21 +373,29 @@ class Onboard:
     def _received(self, data, addr):
         if self.fanout.heard(data, addr):
             self.ground = addr
-            self.app.receive(data)
+            self._batch = batch = []
+            try:
+                self.app.receive(data)
+            finally:
+                self._batch = None
+                if batch:
+                    self._flush(batch)
 
     async def main(self):
         """Bind, then serve TCs and run the activity loop until ``stop()``."""
         loop = asyncio.get_running_loop()
         self._loop = loop
         self._stopping = asyncio.Event()
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
-            transport, _ = await loop.create_datagram_endpoint(
-                lambda: _Protocol(self), local_addr=(self.host, self.port)
-            )
+            sock.setblocking(False)
+            sock.bind((self.host, self.port))
         except OSError as e:
+            sock.close()
             self._error = e
             self._ready.set()
             raise
+        transport = self._transport = _Udp(loop, sock, self._received, self.app.count)
         self.address = transport.get_extra_info("sockname")
         run = [("activity", lambda: self.app.run(self.period))]
         if self.node is not None:

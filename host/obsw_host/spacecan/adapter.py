@@ -97,6 +97,12 @@ class BusFaults:
         return not self.dead[bus]
 
 
+# the node's latest events kept in ``CanAdapter.events`` for whoever looks (tests, tools):
+# the older ones go, so that an OBC running for months holds a fixed amount (each
+# housekeeping report's event holds its values: 10,000 of them were megabytes)
+KEEP_EVENTS = 256
+
+
 class CanAdapter:
     """Moves frames between two python-can buses and one core node, and runs its deadlines."""
 
@@ -136,7 +142,7 @@ class CanAdapter:
                     )
                 )
         self.buses = list(buses)
-        self.events = collections.deque((), 10000)
+        self.events = collections.deque((), KEEP_EVENTS)  # the latest; listeners get all
         self.counters = {"rx": 0, "tx": 0, "tx_errors": 0, "loop_errors": 0}
         self._listeners = []
         self._waiters = {}

@@ -243,6 +243,14 @@ class Receiver(Transaction):
             self._fh = fs.open_write(self.part, not fs.exists(self.part))
         return self._fh
 
+    def on_file_data_pdu(self, offset, data, now):
+        """A file data PDU from the entity's fast path: what ``on_pdu`` does with one."""
+        if self.done:
+            return
+        if self.state_ == RECEIVING:
+            self.inactivity.start(now)
+        self.on_file_data(offset, data, now)
+
     def on_file_data(self, offset, data, now):
         if self.state_ != RECEIVING:
             return

@@ -28,6 +28,7 @@ from obsw.cfdp.pdu.prompt import PromptPdu
 from obsw.cfdp.timers import Timer
 from obsw.cfdp.tlv import pack_tlvs, unpack_tlvs
 from obsw.cfdp.transaction import Transaction
+from obsw.compat import CFDP_READ_AHEAD
 from obsw.crc import FileChecksum, crc16_ccitt
 
 # sender states
@@ -94,6 +95,7 @@ class Sender(Transaction):
         self.inactivity = Timer(remote.inactivity)
         self.timers = (self.ack, self.inactivity)
         self._prepare_fast_path()
+        self._ra = None  # (offset, bytes): the last read-ahead chunk of the file
 
     def _prepare_fast_path(self):
         h = self.header.copy(pdu_type=FILE_DATA)
@@ -110,6 +112,7 @@ class Sender(Transaction):
         return self._fh
 
     def release(self):
+        self._ra = None
         if self._fh is not None:
             self._fh.close()
             self._fh = None
@@ -121,8 +124,26 @@ class Sender(Transaction):
         return self.header.copy(pdu_type=FILE_DIRECTIVE)
 
     # -- building PDUs ---------------------------------------------------------------------
+    def _read(self, offset, n):
+        """``n`` octets of the file at ``offset``: cut from the last read-ahead chunk when it
+        holds them, else read (with CFDP_READ_AHEAD, a chunk that large from ``offset``, which
+        the running file checksum takes in whole when it continues it: EOF's checksum is over
+        the whole file, and one of a transfer cut short is computed again from the file)."""
+        ra = self._ra
+        if ra is not None:
+            start = ra[0]
+            if start <= offset and offset + n <= start + len(ra[1]):
+                return ra[1][offset - start : offset - start + n]
+        if CFDP_READ_AHEAD <= n:
+            return self._file().read(offset, n)
+        chunk = self._file().read(offset, CFDP_READ_AHEAD)
+        self._ra = (offset, chunk)
+        if self.ck.offset == offset:  # the file checksum over the chunk at once, not per PDU
+            self.ck.update(chunk)
+        return chunk[:n]
+
     def _file_data(self, offset, n):
-        data = self._file().read(offset, n)
+        data = self._read(offset, n)
         dl = self._fd_fss + len(data) + (2 if self._crc else 0)
         pdu = b"".join(
             (

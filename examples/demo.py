@@ -23,6 +23,11 @@ SECTIONS = (
         "demo",
     ),
     ("Mission control: Yamcs operates the sample spacecraft", "yamcs_demo", "run"),
+    (
+        "Space link: concatenated coding at 9,600 bit/s, BER 1e-3, into Yamcs",
+        "spacelink_demo",
+        "run",
+    ),
 )
 
 

@@ -31,15 +31,6 @@ TM_APID = 0x21
 FRAME_LENGTH = 128
 
 
-def _free_port_base(apid):
-    # Find a UDP port the application can bind so that port = base + APID holds.
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind((DEFAULT_HOST, 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port - apid, port
-
-
 def _tc_packet(seq, payload):
     n = len(payload)
     return bytes((0x18 | APID >> 8, APID & 0xFF, 0xC0 | seq >> 8, seq & 0xFF, 0, n - 1)) + payload
@@ -66,11 +57,12 @@ def _run(out, timeout, key_file):
     event_apid, event_ids = sdb_events(sdb_module.load(SDB_PATH))
     ctrl_a, dev_a = open_pty_pair()
     ctrl_b, dev_b = open_pty_pair()
-    base, app_port = _free_port_base(APID)
     app = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    app.bind((DEFAULT_HOST, app_port))
+    app.bind((DEFAULT_HOST, 0))
+    app_port = app.getsockname()[1]
     obc = FrameProcessorHost(
-        SerialLink(dev_a), SerialLink(dev_b), SCID, port_base=base, tm_port=0,
+        SerialLink(dev_a), SerialLink(dev_b), SCID, tm_port=0,
+        routes={APID: (DEFAULT_HOST, app_port)},
         tm_frame_length=FRAME_LENGTH, clcw_period=0.5, security=onboard_security,
         event_apid=event_apid, event_ids=event_ids,
     )  # fmt: skip
@@ -117,8 +109,8 @@ def _run(out, timeout, key_file):
         sa = ground_security.sa_for(0, ground.map_id)
         out("  TC security: SA %d on VC 0, HMAC-SHA-256 MAC of %d octets, keys in a temp file" % (
             sa.spi, sa.mac_length))  # fmt: skip
-        out("  links: A=%s B=%s, TC to UDP port %d+APID, TM from UDP %d" % (
-            dev_a, dev_b, base, obc.tm_port))  # fmt: skip
+        out("  links: A=%s B=%s, TC to APID %d on UDP %d, TM from UDP %d" % (
+            dev_a, dev_b, APID, app_port, obc.tm_port))  # fmt: skip
         ground.initiate(now())
         out("ground: Initiate AD with Unlock (BC frame %s)" % ground.sent_frames[-1].pack().hex())
         ok &= pump(lambda: ground.fop.state == F.ACTIVE)

@@ -130,7 +130,7 @@ class Segment:
         ctrl_a, dev_a = open_pty_pair()
         ctrl_b, dev_b = open_pty_pair()
         self.fp = FrameProcessorHost(
-            SerialLink(dev_a), SerialLink(dev_b), SCID, port_base=0, tm_port=0,
+            SerialLink(dev_a), SerialLink(dev_b), SCID, tm_port=0,
             tm_frame_length=frame_length, tm_plan=plan, clcw_period=0.5, **onboard_keys,
         )  # fmt: skip
         self.station = GroundStation(
@@ -149,7 +149,7 @@ class Segment:
         self.onboard.call(lambda: asyncio.ensure_future(self._cfdp_task()))
         host, port = self.onboard.address[:2]
         if self.fp is not None:
-            self.fp.port_base = port - self.onboard.apid  # TC packets to the process's port
+            self.fp.routes[self.onboard.apid] = (host, port)  # TC packets to the process
             self._stop = threading.Event()
             for name, target in (("frames", self.fp.run), ("station", self.station.run)):
                 t = threading.Thread(target=target, args=(self._stop,), name=name, daemon=True)

@@ -25,7 +25,9 @@ def _own_loopback():
     libc = ctypes.CDLL(None, use_errno=True)
     if ip is None or libc.unshare(0x40000000) != 0:  # CLONE_NEWNET
         return False
-    subprocess.run([ip, "link", "set", "lo", "up"], check=True)
+    # the loopback up, with multicast (the simulated SpaceCAN buses are UDP multicast groups)
+    subprocess.run([ip, "link", "set", "lo", "up", "multicast", "on"], check=True)
+    subprocess.run([ip, "route", "add", "224.0.0.0/4", "dev", "lo"], check=True)
     return True
 
 
@@ -53,6 +55,11 @@ sys.path.insert(0, EXAMPLES)
 if "OBSW_STATE" not in os.environ:
     os.environ["OBSW_STATE"] = tempfile.mkdtemp(prefix="obsw-test-state-")
     atexit.register(shutil.rmtree, os.environ["OBSW_STATE"], True)
+if os.environ.get("PYTEST_XDIST_WORKER"):  # each worker its own (an OBC locks its state folder)
+    os.environ["OBSW_STATE"] = os.path.join(
+        os.environ["OBSW_STATE"], os.environ["PYTEST_XDIST_WORKER"]
+    )
+    os.makedirs(os.environ["OBSW_STATE"], exist_ok=True)
 
 # The mission of every test that names none, as an operator would `export OBSW_MISSION=...`:
 # the sample spacecraft, named, never a silent default of the product. Tests of what happens

@@ -16,22 +16,24 @@ from obsw_host.errors import user_message
 # Each module has add_parser(subparsers); the chosen subcommand's function gets the parsed args
 # and returns the exit status. Only the chosen command's module is imported (the others get a
 # placeholder with their help line), so one area's extras stay optional and startup is quick.
+# in the order a team works: its mission, the OBC that flies it, the ground that operates it,
+# then files, procedures, links, mission control, the boards and updates, then the tools
 COMMANDS = {
-    "packet": "decode or encode space packets",
+    "mission": "check, create or upgrade a mission folder",
     "obc": "on-board processes",
     "ground": "send PUS requests to an on-board process, monitor its TM",
-    "obcp": "PLUTO OBCPs on board (PUS service 18)",
-    "il": "interaction layer: serve and use components",
-    "spacecan": "SpaceCAN bus tools",
-    "frames": "CCSDS TC/TM frames, CLTUs, frame processor",
     "cfdp": "CFDP file transfer (put, get, status, serve)",
+    "obcp": "PLUTO OBCPs on board (PUS service 18)",
     "pluto": "check or dry-run PLUTO procedures",
-    "board": "Pyboard firmware for the reconfiguration module",
     "yamcs": "mission control with Yamcs: XTCE, instance, server",
-    "pus": "PUS-C: the standard's message types the OBC serves",
-    "mission": "check, create or upgrade a mission folder",
+    "frames": "CCSDS TC/TM frames, CLTUs, frame processor",
     "keys": "SDLS keys: key files, OTAR, key and SA management over the link",
+    "board": "Pyboard firmware for the reconfiguration module",
     "update": "signed software updates of the OBC: build, push, activate, roll back",
+    "spacecan": "SpaceCAN bus tools",
+    "il": "interaction layer: serve and use components",
+    "pus": "PUS-C: the standard's message types the OBC serves",
+    "packet": "decode or encode space packets",
 }
 ANYWHERE = ("--json", "--debug")  # flags accepted at any position before "--"
 USAGE_ERROR = 2

@@ -19,8 +19,14 @@ def load_sdb(path=None):
     """The spacecraft database at ``path`` (default: the sample's); errors say which file."""
     from obsw.pus import sdb as sdb_module
 
+    from obsw_host.mission.folder import read_text
+
     path = path or SDB_PATH
     try:
-        return sdb_module.load(path)
+        text = read_text(path)  # bounded: a mission file never runs away
+        i = path.rfind("/")
+        return sdb_module.loads(text, path[:i] if i > 0 else ("/" if i == 0 else ""))
+    except UnicodeDecodeError as e:
+        raise sdb_module.SdbError("%s: not UTF-8 text (%s)" % (path, e)) from None
     except sdb_module.SdbError as e:
         raise sdb_module.SdbError("%s: %s" % (path, e)) from None

@@ -108,6 +108,19 @@ class TestLimits(unittest.TestCase):
         b.receive(EofPdu(h, 0, 0, 200).pack(), 0)
         self.assertEqual(b.stats["internal_errors"], 0)
 
+    def test_the_gap_bound_merges_the_closest_gaps(self):
+        """Over the bound, the two gaps with the fewest received octets between them merge
+        (merging the last two would ask again for everything received after the bound)."""
+        h = header(mode=UNACKNOWLEDGED)
+        chunks = ((10, 10), (30, 100), (140, 1), (150, 100))  # gaps [0,10) [20,30) .. [141,150)
+        b = receiver(max_gaps=4, mode=UNACKNOWLEDGED)
+        for offset, n in chunks:
+            b.receive(data_pdu(h, offset, b"x" * n), 0)
+        tx = b.tx[((1, 99), "R")]
+        self.assertEqual([g[:2] for g in tx.gaps], [[0, 10], [20, 30], [130, 140], [141, 150]])
+        b.receive(data_pdu(h, 260, b"x"), 0)  # a fifth gap [250, 260): one above the bound
+        self.assertEqual([g[:2] for g in tx.gaps], [[0, 10], [20, 30], [130, 150], [250, 260]])
+
     def test_concurrent_transactions_are_bounded(self):
         b = receiver()
         b.mib.max_transactions = 5

@@ -188,5 +188,24 @@ class TestClcwAndConfig(unittest.TestCase):
         self.assertEqual((f.state, f.vr, f.lockout, f.farm_b), (farm.OPEN, 0, False, 0))
 
 
+class TestBdFramesBounded(unittest.TestCase):
+    def test_a_full_buffer_discards_the_new_bd_frame_and_keeps_the_ad_count(self):
+        f = farm_in(farm.OPEN, buffer_size=2)
+        self.assertEqual(f.on_frame(ad(f.vr)), farm.ACCEPT)
+        room = f._capacity - 1
+        for _ in range(room):
+            self.assertEqual(f.on_frame(bd()), farm.ACCEPT)
+        self.assertEqual(f.on_frame(bd()), farm.DISCARD)  # one above: discarded, counted
+        self.assertEqual(f.bd_dropped, 1)
+        self.assertEqual(f._held, 1)
+        self.assertEqual(f.take().frame_type, ad(0).frame_type)  # the AD frame was kept
+        self.assertEqual(f._held, 0)
+        self.assertEqual(f.on_frame(bd()), farm.ACCEPT)  # room again
+        self.assertEqual(f.on_frame(ad(f.vr)), farm.ACCEPT)
+        self.assertEqual(f.on_frame(ad(f.vr)), farm.ACCEPT)  # two AD frames: buffer_size
+        self.assertEqual(f.on_frame(ad(f.vr)), farm.DISCARD)  # the third: Wait, as before
+        self.assertEqual(f.state, farm.WAIT)
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -139,6 +139,21 @@ class TestLock(unittest.TestCase):
                 self.assertEqual(fs.losses, 1)
                 self.assertEqual(datas[-1], frames[-1])
 
+    def test_early_asm_found_across_a_chunk_boundary(self):
+        # bits lost just before an ASM make it come early; the feed that ended where the ASM
+        # was due kept the bits it needs to look back at
+        frames = frames_of(6)
+        period = 8 * (LEN + 4)
+        for slip in (1, 2):
+            bits = stream(frames)
+            at = 16 + 3 * period - 8
+            bits = bits[:at] + bits[at + slip :]
+            for cut in range(16 + 3 * period - 4, 16 + 3 * period + 4):
+                fs = sync.FrameSync(LEN, slip=2)
+                got = fs.feed(bits[:cut]) + fs.feed(bits[cut:]) + fs.flush()
+                self.assertEqual([g.data for g in got][3:], frames[3:])
+                self.assertEqual((fs.slips, fs.losses), (1, 0))
+
     def test_verify_needs_consecutive_asms(self):
         frames = frames_of(4)
         fs = sync.FrameSync(LEN, verify=3)
@@ -206,6 +221,35 @@ class TestChains(unittest.TestCase):
         got += dec.flush()
         datas = [g.data for g in got]
         self.assertEqual(datas[-4:], frames[-4:])
+
+    def test_viterbi_corrections_counted(self):
+        rnd = Lcg(5)
+        frames = [rnd.data(30) for _ in range(8)]
+        enc = tm_coding.TmEncoder(30, "conv")
+        clean = sync.unpack_bits(b"".join(enc.encode(f) for f in frames))
+        for where in ((), (100,), range(200, 2000, 61)):
+            bits = flip(clean, where)
+            dec = tm_coding.TmDecoder(30, "conv", count_symbols=True)
+            got = []
+            for i in range(0, len(bits), 300):
+                got += dec.feed_soft([1 if b else -1 for b in bits[i : i + 300]])
+            got += dec.flush()
+            self.assertEqual([g.data for g in got], frames)
+            self.assertEqual(dec.symbol_errors, len(where))
+            self.assertEqual(dec.check.symbols, len(bits))
+        self.assertEqual(tm_coding.TmDecoder(30, "rs", count_symbols=True).symbol_errors, 0)
+
+    def test_viterbi_count_after_a_realignment(self):
+        rnd = Lcg(11)
+        frames = [rnd.data(30) for _ in range(12)]
+        enc = tm_coding.TmEncoder(30, "conv")
+        bits = sync.unpack_bits(b"".join(enc.encode(f) for f in frames))[1:]  # one symbol lost
+        bits = flip(bits, (3001,))
+        dec = tm_coding.TmDecoder(30, "conv", realign=2, count_symbols=True)
+        for i in range(0, len(bits), 500):
+            dec.feed_soft([1 if b else -1 for b in bits[i : i + 500]])
+        dec.flush()
+        self.assertEqual(dec.symbol_errors, 1)  # the flip after the realignment, nothing else
 
     def test_bad_coding_name(self):
         with self.assertRaises(ValueError):

@@ -140,3 +140,19 @@ class TestUnits(unittest.TestCase):
     def test_iso_round_trip(self):
         for text in ("1970-01-01T00:00:00.000Z", "2024-02-29T23:59:59.250Z"):
             self.assertEqual(units.iso(units.parse_iso(text)), text)
+
+
+class TestNotUnicode(unittest.TestCase):
+    def test_a_lone_surrogate_is_a_syntax_error_with_its_place(self):
+        try:
+            "\ud800".encode()
+        except UnicodeError:
+            pass
+        else:  # MicroPython's strings cannot hold one
+            return
+        from obsw.pluto.interp import load
+
+        for src, where in (("\ud800", (1, 1)), ("procedure\n  x \udfff", (2, 5))):
+            with self.assertRaises(PlutoSyntaxError) as cm:
+                load(src)
+            self.assertEqual((cm.exception.line, cm.exception.col), where)

@@ -70,6 +70,27 @@ class TestUplink(unittest.TestCase):
         self.assertEqual(tx.failure["code"], FAILURE_REFUSED)
         self.assertEqual(large.receptions, {})
 
+    def test_receptions_in_progress_are_bounded(self):
+        got = []
+        loop, large, user = make(deliver=got.append, max_receptions=3)
+        firsts = [user.send_part(APID, 0, tid, 1, b"a" * 100) for tid in (1, 2, 3, 4)]
+        loop.pump()
+        self.assertEqual([tx.ok for tx in firsts], [True, True, True, False])
+        self.assertEqual(firsts[3].failure["code"], FAILURE_REFUSED)
+        self.assertEqual(sorted(large.receptions), [1, 2, 3])
+        self.assertEqual(large.refused, 1)
+        tx = user.send_part(APID, 0, 2, 1, b"b")  # a first part again restarts its own
+        loop.pump()
+        self.assertTrue(tx.ok)
+        tx = user.send_part(APID, 2, 1, 2, b"z")  # one ends: room for a new one
+        loop.pump()
+        self.assertTrue(tx.ok)
+        self.assertEqual(got, [b"a" * 100 + b"z"])
+        tx = user.send_part(APID, 0, 4, 1, b"c")
+        loop.pump()
+        self.assertTrue(tx.ok)
+        self.assertEqual(sorted(large.receptions), [2, 3, 4])
+
     def test_reception_timeout(self):
         loop, large, user = make(timeout=5.0, deliver=lambda m: None)
         user.send_part(APID, 0, 8, 1, b"first")

@@ -153,3 +153,16 @@ class TestRecords(unittest.TestCase):
         self.assertTrue(resets > 1000)
         self.assertTrue(olds > 100 and news > 100)
         self.assertTrue(i2c.flipped > 100)
+
+
+class TestDecodeLengths(unittest.TestCase):
+    def test_bytes_of_the_wrong_length_are_a_record_error(self):
+        _, _, devices = rig()
+        sg = Safeguard(devices)
+        n = sg.blocks * ecc.CODED
+        for raw in (b"", b"\x00" * (n - 1), b"\x00" * (n + 1)):
+            with self.assertRaises(RecordError):
+                sg.decode(0, raw)
+        self.assertIsNone(sg.decode(0, b"\xff" * n))  # the right length, no valid copy
+        good = sg.encode(0, 5, b"abc")
+        self.assertEqual(sg.decode(0, good)[:2], (5, b"abc"))

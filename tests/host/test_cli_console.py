@@ -51,7 +51,8 @@ def test_watch_once_shows_values_units_and_limit_states(obc):  # noqa: F811 (the
 
 def test_watch_frames_show_events_and_verification_of_other_clients(obc):  # noqa: F811 (the fixture)
     port, _ = obc
-    watch, out, err = start("ground", "--port", port, "watch", "--count", 3, "--every", 1.5)
+    # frames until the test has seen what it waits for (stopped then), however slow the machine
+    watch, out, err = start("ground", "--port", port, "watch", "--count", 40, "--every", 1.5)
     try:
         out.until(lambda line: "commands" in line)  # the first frame is out
         assert obsw("ground", "--port", port, "function", "SolarPanel.deploy").returncode == 0

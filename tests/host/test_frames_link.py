@@ -11,6 +11,7 @@ from obsw.frames.tc import Segment, TcFrame
 from obsw_host.frames.ground import Ground
 from obsw_host.frames.links import FdLink, SerialLink, open_pty_pair
 from obsw_host.frames.processor import FrameProcessorHost
+from obsw_host.net import DEFAULT_HOST
 
 SCID = 0x33
 APID = 0x40
@@ -34,7 +35,7 @@ def rig():
         SerialLink(dev_a),
         SerialLink(dev_b),
         SCID,
-        port_base=port - APID,
+        routes={APID: (DEFAULT_HOST, port)},
         tm_port=0,
         tm_frame_length=LENGTH,
         clcw_period=0.2,

@@ -17,6 +17,7 @@ from obsw_host.frames import keys
 from obsw_host.frames.ground import Ground
 from obsw_host.frames.links import FdLink, SerialLink, open_pty_pair
 from obsw_host.frames.processor import FrameProcessorHost, sdb_events, security_options
+from obsw_host.net import DEFAULT_HOST
 from obsw_host.sample import SDB_PATH
 
 SCID = 0x33
@@ -50,7 +51,7 @@ def rig(tmp_path, request):
         SerialLink(dev_a),
         SerialLink(dev_b),
         SCID,
-        port_base=port - APID,
+        routes={APID: (DEFAULT_HOST, port)},
         tm_port=0,
         tm_frame_length=LENGTH,
         clcw_period=0.2,

@@ -273,7 +273,9 @@ def test_tm_frames_carry_the_missions_scid_and_vcs(mission):
     sender = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     try:
         fp = unit.fp
-        assert fp.tm_port == BASE - 1 and fp.port_base == BASE
+        assert fp.tm_port == BASE - 1
+        assert fp.routes[APIDS["pus"]] == ("127.0.0.1", BASE + APIDS["pus"])
+        assert fp.default_route(0x77) == ("127.0.0.1", BASE + 0x77)
         assert fp.vc_ports == {TM_VCS["playback"]: BASE}
         pus_tm = SpacePacket(0, APIDS["pus"], b"\x20\x11\x02" + bytes(12), seq_count=1).pack()
         cfdp_tm = SpacePacket(0, APIDS["cfdp"], b"\x04" + bytes(10), seq_count=1).pack()

@@ -99,3 +99,40 @@ def test_watch_shows_loss_of_signal_when_the_obc_dies(tmp_path):
                        capture_output=True, text=True, timeout=BOUND)  # fmt: skip
     assert r.returncode == 1
     assert "no TM from 127.0.0.1:%d" % (base + 10) in r.stderr
+
+
+def test_the_console_history_of_the_sample_stays_out_of_the_source_tree():
+    """A mission file that names no state folder (the sample) keeps its state, the console's
+    history with it, in the user's state folder, never beside the mission in the checkout."""
+    import argparse
+
+    from obsw_host.commands.ground_tui import history_path
+    from obsw_host.mission.ids import MissionIds
+
+    path = history_path(argparse.Namespace(history=None), MissionIds.locate(SAMPLE))
+    assert not os.path.abspath(path).startswith(ROOT + os.sep), path
+
+
+def test_obsw_help_lists_commands_in_the_order_a_team_works():
+    """`obsw --help` starts with the mission, then the OBC, then the ground."""
+    text = obsw("--help").stdout
+    at = [text.index("\n    %s " % name) for name in ("mission", "obc", "ground")]
+    assert at == sorted(at), text
+
+
+def test_fly_your_own_spacecraft_is_where_a_newcomer_looks():
+    for page in ("README.md", "docs/index.md", "docs/getting-started.md"):
+        with open(os.path.join(ROOT, page), encoding="utf-8") as f:
+            assert "fly-your-own-spacecraft.md" in f.read(), page
+
+
+def test_obcp_status_with_no_obc_names_where_it_asked():
+    base = free_base()
+    r = subprocess.run(OBSW + ["obcp", "--timeout", "0.3", "status"],
+                       env=dict(ENV, OBSW_PORT_BASE=str(base)), capture_output=True, text=True,
+                       timeout=BOUND)  # fmt: skip
+    assert r.returncode == 1
+    assert (
+        "no report from 127.0.0.1:%d within 0.3s: is `obsw obc serve` running" % (base + 10)
+        in r.stdout
+    )

@@ -10,6 +10,7 @@ import select
 import socket
 import time
 
+from obsw.cfdp.defs import DIR_NAK
 from obsw.cfdp.entity import CfdpEntity
 from obsw.cfdp.mib import Mib, RemoteEntity
 from obsw.spp import TYPE_TC, TYPE_TM, SpacePacket, SppError
@@ -34,6 +35,13 @@ def parse_peer(text):
     return eid, (host or DEFAULT_HOST, port)
 
 
+PACE_START = 16e6  # octets/s of file data a paced sender starts at
+PACE_MIN = 64e3
+PACE_MAX = 1e9
+PACE_STEP = 0.25  # seconds between increases; and between two halvings
+PACE_RUN = 8  # segments in a row asked again: the receiver overflowed, not the link
+
+
 class PeerError(ValueError):
     """A peer given in a form other than ID=HOST:PORT."""
 
@@ -42,7 +50,15 @@ class UdpEntity:
     """Moves PDUs between a CfdpEntity and a UDP socket, in space packets of APID ``apid``.
 
     ``loss`` drops that fraction of outgoing PDUs (for demonstrations); ``rate`` caps the
-    outgoing file data in octets per second (None: as fast as the socket takes them).
+    outgoing file data in octets per second (None: paced by the link, see below).
+
+    Pacing against the link (``pace``, on unless ``rate`` is given): UDP has no flow control,
+    and a sender that outruns its receiver loses whole runs of datagrams in the receiver's
+    socket buffer, which come back as NAKs for long ranges, which are sent again as fast, and
+    so on (a retransmission storm). Random loss on a link loses single segments; a NAK that
+    asks for a run of ``PACE_RUN`` segments or more is the receiver overflowing. Then the
+    file data rate is halved (not below ``PACE_MIN``), and it grows again by a tenth every
+    ``PACE_STEP`` seconds without such a NAK (additive increase, multiplicative decrease).
     """
 
     def __init__(
@@ -57,6 +73,7 @@ class UdpEntity:
         seed=1,
         rate=None,
         drop=None,
+        pace=None,
     ):
         self.entity = entity
         self.peers = dict(peers)
@@ -78,6 +95,12 @@ class UdpEntity:
         self._budget = 0.0
         self._last = time.monotonic()
         self.on_indication = None
+        self.pace = rate is None if pace is None else pace
+        self.rate_changes = 0
+        self._runs = set()  # starts of the runs already slowed down for
+        if self.pace:
+            self.rate = PACE_START
+        self._grow_at = self._last + PACE_STEP
 
     def close(self):
         self.sock.close()
@@ -117,8 +140,49 @@ class UdpEntity:
                 self.bad_packets += 1
                 continue
             self.received += 1
-            self.entity.receive(pkt.data, now)
+            pdu = self.entity.receive(pkt.data, now)
+            if self.pace and pdu is not None and getattr(pdu, "CODE", None) == DIR_NAK:
+                self._paced_by(pdu, now)
             n += 1
+
+    def _paced_by(self, nak, now):
+        seg = max(1, max((r.max_segment for r in self.entity.mib.remotes.values()), default=1))
+        # a run asked for again (the NAK timer repeats what is still missing) is no news
+        runs = [s for s, e in nak.segments if e - s >= PACE_RUN * seg and s not in self._runs]
+        if runs:
+            if len(self._runs) > 4096:
+                self._runs.clear()
+            self._runs.update(runs)
+            if now >= self._slow_until:  # one halving per round trip of NAKs
+                actual = self._measure(now)  # what it really sent, unless it mostly paused
+                basis = actual if self.rate / 4 <= actual < self.rate else self.rate
+                self.rate = max(PACE_MIN, basis / 2)
+                self._budget = min(self._budget, 0.0)
+                self._slow_until = now + PACE_STEP
+                self.rate_changes += 1
+            self._grow_at = now + PACE_STEP
+
+    _slow_until = 0.0
+
+    def _measure(self, now):
+        """The file data rate actually sent since the last look (octets/s)."""
+        dt = now - self._window_start
+        if dt >= PACE_STEP / 2:
+            self._actual = self._window_bytes / dt
+            self._window_bytes = 0
+            self._window_start = now
+        return self._actual
+
+    _actual = PACE_START
+    _window_bytes = 0
+    _window_start = 0.0
+
+    def _grow(self, now):
+        if self.pace and now >= self._grow_at:
+            # only a rate the sender reaches grows (one it cannot reach says nothing)
+            if self._measure(now) >= 0.8 * self.rate:
+                self.rate = min(PACE_MAX, self.rate * 1.1)
+            self._grow_at = now + PACE_STEP
 
     def step(self, max_wait=0.05):
         """Wait for traffic or the next deadline (at most ``max_wait`` s), then do all work."""
@@ -139,6 +203,7 @@ class UdpEntity:
             self.sock.setblocking(True)
         ent.poll(now)
         limit = 64
+        self._grow(now)
         if self.rate is not None:
             self._budget = min(self.rate * 0.1, self._budget + (now - self._last) * self.rate)
             self._last = now
@@ -148,6 +213,7 @@ class UdpEntity:
         for dest, pdu in out:
             if self.rate is not None and pdu[0] & 0x10:
                 self._budget -= len(pdu)
+                self._window_bytes += len(pdu)
             self._send(dest, pdu)
         inds = ent.pop_indications()
         if self.on_indication is not None:
@@ -165,6 +231,10 @@ class UdpEntity:
         return True
 
 
+MAX_GAPS = 1 << 16  # missing ranges a host receiver tracks (a few MB; the MIB's default is
+# a board's): a 50 MB file at 10 % loss has about 5,000, and merging gaps re-asks for data
+
+
 def make_entity(
     local_id,
     peers,
@@ -178,9 +248,12 @@ def make_entity(
     limit=10,
     inactivity=60.0,
     keep_alive=0.5,
+    state=None,
+    max_gaps=MAX_GAPS,
 ):
     """A CfdpEntity with one MIB entry per peer and timer values suited to a UDP link (a
-    receiver reports its progress in a keep-alive PDU every ``keep_alive`` seconds)."""
+    receiver reports its progress in a keep-alive PDU every ``keep_alive`` seconds).
+    ``state``: the folder of the persisted state, outside the filestore (None: inside it)."""
     remotes = [
         RemoteEntity(
             eid,
@@ -193,10 +266,15 @@ def make_entity(
             inactivity=inactivity,
             check_interval=ack_interval,
             keep_alive_interval=keep_alive,
+            max_gaps=max_gaps,
         )
         for eid in peers
     ]
-    return CfdpEntity(Mib(local_id, remotes), filestore, persist=persist)
+    if state is not None:
+        from obsw_host.cfdp.filestore import RootedFilestore
+
+        state = RootedFilestore(state)
+    return CfdpEntity(Mib(local_id, remotes), filestore, persist=persist, state=state)
 
 
 def packet_type_for(onboard):

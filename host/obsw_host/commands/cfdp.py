@@ -130,7 +130,14 @@ def _setup(args, onboard=False):
     ends = Endpoints(args, onboard=onboard)
     peers = ends.peers
     fs = RootedFilestore(args.root)
-    ent = make_entity(ends.id, peers, fs, mode=2 - args.cls, segment=args.segment, persist=onboard)
+    state = None
+    if onboard:  # the entity's own state: outside the filestore, where PDUs cannot write
+        from obsw_host.cfdp.client import state_dir
+
+        state = os.path.join(state_dir(), "cfdp-serve-%d" % ends.id)
+    ent = make_entity(
+        ends.id, peers, fs, mode=2 - args.cls, segment=args.segment, persist=onboard, state=state
+    )
     udp = UdpEntity(
         ent,
         (getattr(args, "host", DEFAULT_HOST), ends.port),

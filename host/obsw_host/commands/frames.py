@@ -36,12 +36,31 @@ def add_parser(sub):
         proc.add_argument(
             "--%s-vc" % role, type=int, help="TM VC of %s TM (default: the mission's)" % role
         )
-    proc.add_argument("--frame-length", type=int, default=256, help="TM frame length")
+    proc.add_argument("--frame-length", type=int, help="TM frame length (the mission's)")
     proc.add_argument("--essential-map", type=int, default=None, help="MAP ID of HPCs")
     proc.add_argument("--duration", type=float, default=None, help="stop after N seconds")
     proc.add_argument("--keys", help="SDLS key file: authenticate every TC frame")
     proc.add_argument("--key-state", help="sequence number state file (default KEYS.state)")
     proc.set_defaults(func=processor)
+
+    st = s.add_parser(
+        "station", help="a ground station on radio interfaces (KISS, GNU Radio UDP, serial)",
+        description="Decodes the TM the links give (the mission's frames.tm_coding) and hands "
+        "its packets to the ground tools on UDP (--port; they find the station by sending a "
+        "TC), whose TCs go up through FOP-1 as CLTUs; with --yamcs, hands the decoded frames "
+        "to Yamcs' TM frame link instead and sends up the CLTUs Yamcs sends to --port.",
+    )  # fmt: skip
+    st.add_argument("--link", action="append", required=True, metavar="SPEC",
+                    help="kiss-serial:DEV[@BAUD], kiss-tcp:HOST:PORT, kiss-listen:HOST:PORT, "
+                    "udp:PORT[:octets|bits|int8|float32][@HOST:PORT] or a serial device path "
+                    "(repeat for the second link)")  # fmt: skip
+    mission_ids.add_arguments(st)
+    st.add_argument("--host", default=DEFAULT_HOST, help="address of --port (%(default)s)")
+    st.add_argument("--port", type=int, default=0, help="UDP port of the ground tools (0: free)")
+    st.add_argument("--yamcs", type=int, metavar="PORT", help="Yamcs' TM frame link UDP port")
+    st.add_argument("--report", type=float, default=10.0, help="seconds between counter lines")
+    st.add_argument("--duration", type=float, default=None, help="stop after N seconds")
+    st.set_defaults(func=station)
 
     kg = s.add_parser("keygen", help="write a new SDLS key file (outside any repository)")
     kg.add_argument("file")
@@ -142,12 +161,26 @@ def processor(args):
         given = getattr(args, "%s_vc" % role)
         if given is not None:
             plan[role] = given
-    port_base = args.port_base if args.port_base is not None else ports.pus - ids.pus_apid
+    if args.port_base is not None:  # every TC packet to base + APID, names fixed or not
+        routes, route_to = {}, "base %d + APID" % args.port_base
+        default_route = lambda apid: (args.host, args.port_base + apid)  # noqa: E731
+    else:
+        routes, default_route = ports.routes(args.host), ports.route(args.host)
+        route_to = ", ".join("%d:%d" % (a, p) for a, (_, p) in sorted(routes.items()))
     tm_port = args.tm_port if args.tm_port is not None else ports.tm
     playback = args.playback_port
     if playback is None:
         playback = tm_port + 1 if args.tm_port is not None else ports.playback
     scid = args.scid if args.scid is not None else ids.scid
+    from obsw_host.frames.coding import LinkSettings
+
+    section = dict(ids.config.section("frames")) if ids.config is not None else {}
+    if args.frame_length is not None:
+        section["tm_frame_length"] = args.frame_length
+    space = LinkSettings(section)
+    problems = space.problems()
+    if problems:
+        raise UserError("processor: frames.tm_coding", expected=problems[0][1])
     security = {}
     if args.keys:
         from obsw_host.frames.processor import security_options
@@ -162,10 +195,14 @@ def processor(args):
             args.uart_b,
             scid,
             host=args.host,
-            port_base=port_base,
+            routes=routes,
+            default_route=default_route,
             tm_port=tm_port,
             vc_ports={plan["playback"]: playback},
-            tm_frame_length=args.frame_length,
+            tm_frame_length=space.frame_length,
+            tm_coding=space.encoder(),
+            downlink_bps=space.downlink_bps,
+            tm_spill=space.tm_spill,
             essential_map=args.essential_map,
             tm_plan=plan,
             tm_channels=ids.tm_channels() if plan == ids.tm_vcs else None,
@@ -177,10 +214,11 @@ def processor(args):
         raise _mistake("processor", e) from None
     for link in host.links:
         link.port.baudrate = args.baudrate
-    print("frame processor: %s + %s, TC to UDP %s:%d+APID, TM on UDP %d (VC %d), playback "
-          "TM on UDP %d (VC %d)" % (
-        args.uart_a, args.uart_b, args.host, port_base, host.tm_port, plan["realtime"],
+    print("frame processor: %s + %s, TC to UDP %s (APID:port %s), TM on UDP %d (VC %d), "
+          "playback TM on UDP %d (VC %d)" % (
+        args.uart_a, args.uart_b, args.host, route_to, host.tm_port, plan["realtime"],
         host.playback_port, plan["playback"]))  # fmt: skip
+    print("space link: %s" % space.describe())
     if args.keys:
         print("TC security: %d SA(s) from %s, events on APID %d" % (
             len(security["security"].sas), args.keys, security["event_apid"]))  # fmt: skip
@@ -194,6 +232,63 @@ def processor(args):
             print(json.dumps(host.core.security.counters))
         host.close()
     return 0
+
+
+def station(args):
+    import threading
+    import time
+
+    from obsw_host.frames.coding import LinkSettings
+    from obsw_host.frames.radio import open_link
+
+    ids = mission_ids.from_args(args)
+    link = LinkSettings.of(ids.config)
+    links = []
+    try:
+        for spec in args.link:
+            links.append(open_link(spec))
+    except OSError as e:
+        for opened in links:
+            opened.close()
+        raise UserError("station: %s" % e, expected="a radio interface that opens") from None
+    if args.yamcs is not None:
+        from obsw_host.frames.relay import FrameRelay
+
+        node = FrameRelay(links, link.decoder, (args.host, args.yamcs), args.host, args.port)
+        where = "frames to Yamcs on UDP %d, its CLTUs on UDP %s:%d" % (
+            args.yamcs, args.host, node.cltu_address[1])  # fmt: skip
+    else:
+        from obsw_host.frames.station import GroundStation
+
+        node = GroundStation.for_mission(ids, links, host=args.host, port=args.port)
+        where = "ground tools on UDP %s:%d" % node.address[:2]
+    print("station: %s; %s; %s" % (", ".join(x.name for x in links), link.describe(), where),
+          flush=True)  # fmt: skip
+    stop = threading.Event()
+    worker = threading.Thread(target=node.run, args=(stop,), daemon=True)
+    worker.start()
+    end = None if args.duration is None else time.monotonic() + args.duration
+    try:
+        while worker.is_alive() and (end is None or time.monotonic() < end):
+            wait = args.report if end is None else min(args.report, end - time.monotonic())
+            stop.wait(max(0.0, wait))
+            print("station: %s" % json.dumps(_station_counters(node)), flush=True)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        stop.set()
+        worker.join(2)
+        node.close()
+    return 0
+
+
+def _station_counters(node):
+    out = node.coding()
+    if hasattr(node, "ground"):
+        out.update(uplinked=node.uplinked, downlinked=len(node.downlinked))
+    else:
+        out.update(frames_to_yamcs=node.frames, cltus=node.cltus)
+    return out
 
 
 def keygen(args):

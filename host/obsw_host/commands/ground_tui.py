@@ -36,7 +36,10 @@ CONSOLE_KEYS = ("func", "action", "history", "once", "count", "every", "seconds"
 
 def render(picture, los_after=LOS_AFTER):
     """The picture as rich tables: values, events, commands; at loss of signal the values are
-    dimmed and their limit column says so."""
+    dimmed and their limit column says so. What came from the spacecraft is escaped: no
+    control character and no rich markup of its own reaches the terminal."""
+    from rich.markup import escape as markup
+
     signal, lost = picture.signal(los_after)
     title = "current values (%s)" % signal
     values = Table(title=title, expand=True, title_justify="left")
@@ -47,13 +50,15 @@ def render(picture, los_after=LOS_AFTER):
         style = "dim" if lost else _LIMIT_STYLES.get(limit, "")
         value = number(v["value"])
         limit = "stale (%s)" % (limit or "-") if lost else (limit or "-")
-        values.add_row(name, value, v["unit"], limit, v["time"], style=style or None)
+        values.add_row(markup(name), markup(value), v["unit"], limit, v["time"],
+                       style=style or None)  # fmt: skip
     events = Table(title="latest events", expand=True, title_justify="left")
     for column in ("time (UTC)", "event", "severity", "data"):
         events.add_column(column)
     for e in picture.events:
         style = _SEVERITY_STYLES.get(e["severity"], "") or None
-        events.add_row(e["time"], e["event"], str(e["severity"]), e["data"], style=style)
+        events.add_row(e["time"], markup(e["event"]), markup(str(e["severity"])),
+                       markup(e["data"]), style=style)  # fmt: skip
     commands = Table(title="commands", expand=True, title_justify="left")
     for column in ("request", "apid", "seq", "verification"):
         commands.add_column(column)

@@ -73,7 +73,7 @@ def new_cmd(args):
         for folder in folders:
             ids = _ids(folder)  # the mission file's base ($OBSW_PORT_BASE moves a run, not it)
             print("%s: mission %s, spacecraft id %s, port base %d"
-                  % (folder, ids.name, ids.sdb.scid, ids.config.doc["ports"]["base"]))  # fmt: skip
+                  % (folder, ids.name, ids.scid, ids.config.doc["ports"]["base"]))  # fmt: skip
         return 0
     if args.template or args.scid is not None or args.port_base is not None:
         folder = new.copy(args.template or new.TEMPLATE_DIR, args.name, args.dir or args.name,

@@ -23,7 +23,7 @@ from obsw_host.mission.config import ConfigError
 from obsw_host.mission.config import load as load_config
 from obsw_host.mission.folder import locate
 from obsw_host.obc import service
-from obsw_host.obc.state import StateLock, StateLocked, default_state
+from obsw_host.obc.state import StateLock, StateLocked
 from obsw_host.obc.state import reset as reset_state
 from obsw_host.obc.topology import Topology
 
@@ -78,10 +78,6 @@ def load(args):
     if getattr(args, "state", None):
         config.state = os.path.abspath(args.state)
         config.il_directory = os.path.join(config.state, "il")
-    elif "state" not in config.doc:
-        config.state = default_state(config.name)
-        if "il_directory" not in config.doc:
-            config.il_directory = os.path.join(config.state, "il")
     if getattr(args, "il_dir", None):
         config.il_directory = os.path.abspath(args.il_dir)
     return config
@@ -145,14 +141,6 @@ def serve(args):
         if args.process:
             return _serve_process(topology, args, out)
         topology.check()  # component modules import, before anything starts
-        taken = ports_in_use(topology)
-        if taken:
-            raise UserError(
-                "UDP port%s %s on %s in use (another OBC of this mission?)"
-                % ("s" if len(taken) > 1 else "", ", ".join(taken), config.host),
-                expected="free ports: stop the other OBC, or move this one's with "
-                "$OBSW_PORT_BASE or the mission's `ports`",
-            )
     except (ConfigError, UserError) as e:
         return _refuse(e)
     try:
@@ -160,6 +148,17 @@ def serve(args):
     except StateLocked as e:
         return _refuse(e)
     try:
+        taken = ports_in_use(topology)  # after the lock: another OBC of this state is named
+        if taken:
+            return _refuse(
+                UserError(
+                    "UDP port%s %s on %s in use (another program, or an OBC of this mission with "
+                    "another state folder?)"
+                    % ("s" if len(taken) > 1 else "", ", ".join(taken), config.host),
+                    expected="free ports: stop it, or move this OBC's with $OBSW_PORT_BASE or "
+                    "the mission's `ports`",
+                )
+            )
         return _boot(args, config, topology, out)
     except KeyboardInterrupt:
         return 0

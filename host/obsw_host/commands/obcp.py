@@ -26,6 +26,7 @@ import os
 import sys
 import threading
 
+from obsw_host.commands import session
 from obsw_host.mission import ids as mission_ids
 from obsw_host.net import DEFAULT_HOST
 
@@ -139,7 +140,7 @@ def _port(args, ids, apid):
     """``--port``, else the mission's UDP port of process ``apid``."""
     if args.port is not None:
         return args.port
-    return ids.ports.pus if apid == ids.apid("pus") else ids.ports.app(apid)
+    return ids.ports.for_apid(apid)
 
 
 def _client(args):
@@ -203,7 +204,10 @@ def _run(args, fn):
         result["explained"] = explain(tx)
         print(json.dumps(result))
     else:
-        for line in explain(tx):
+        lines = explain(tx)
+        if not tx.done:  # the same line as every `obsw ground` command: who did not answer
+            lines[-1] = session.no_answer(args, tx, ground.target)
+        for line in lines:
             print("  " + line)
         for reply in tx.replies:
             _print_reply(reply)
@@ -213,7 +217,6 @@ def _run(args, fn):
 def _session(ground, args):
     """Sequence counts that differ from an earlier run's (unique request IDs), and the
     session log of ``--log`` (also `obsw ground --log .. obcp`)."""
-    from obsw_host.commands import session
     from obsw_host.pus.monitor import SessionLog
 
     session.fresh(ground)

@@ -35,7 +35,7 @@ def pus_port(args, ids, apid):
     """The on-board UDP port: ``--port``, else the mission's port of process ``apid``."""
     if args.port is not None:
         return args.port
-    return ids.ports.pus if apid == ids.apid("pus") else ids.ports.app(apid)
+    return ids.ports.for_apid(apid)
 
 
 def run(args, fn):

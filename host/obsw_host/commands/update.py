@@ -2,7 +2,7 @@
 
     obsw update keygen ~/keys/update.key        Ed25519 pair; put update.key.pub in the mission
     obsw update build 1.1 -o v1.1.obsw --key ~/keys/update.key [--base v1.0.obsw]
-    obsw update show v1.1.obsw                  its manifest, its signature checked
+    obsw update show v1.1.obsw                  its manifest; its signature and files checked
     obsw update push v1.1.obsw                  CFDP class 2 to the OBC, then stage it there
     obsw update status                          the version running, staged, on trial
     obsw update activate                        the staged version on trial: restart from it
@@ -43,6 +43,9 @@ def add_parser(sub):
     b.add_argument("-o", "--out", required=True, help="the package file to write")
     b.add_argument("--key", required=True, help="the private key (obsw update keygen)")
     b.add_argument("--base", help="an earlier package of the mission: make a delta to it")
+    b.add_argument("--downgrade", action="store_true",
+                   help="the package may replace a newer version on board (signed in its "
+                   "manifest; without it the OBC refuses an older version)")  # fmt: skip
     b.add_argument("--target", choices=("obc", "reconfig"), default="obc",
                    help="the OBC's software (default), or the reconfiguration module's "
                    "application (compiled, for obsw board update)")  # fmt: skip
@@ -102,17 +105,23 @@ def keygen(args):
     return 0
 
 
-def _open(path, key, ids):
-    """The manifest of package ``path``, its signature checked (either target)."""
+def _open(path, key, ids, whole=False):
+    """The manifest of package ``path``, its signature checked (either target); ``whole``:
+    every file's size and hash checked too, and nothing after the last."""
     from obsw.update.package import Reader, WrongTarget
     from obsw.update.signature import verify
 
+    def read(target):
+        with open(path, "rb") as f:
+            reader = Reader(f, verify, key, ids.config.name, target)
+            if whole:
+                reader.files(lambda p, chunk: None)
+            return reader.manifest
+
     try:
-        with open(path, "rb") as f:
-            return Reader(f, verify, key, ids.config.name, "obc").manifest
+        return read("obc")
     except WrongTarget:
-        with open(path, "rb") as f:
-            return Reader(f, verify, key, ids.config.name, "reconfig").manifest
+        return read("reconfig")
 
 
 def build(args):
@@ -128,7 +137,8 @@ def build(args):
         return _build_reconfig(args, ids, key)
     base = _open(args.base, public or bytes.fromhex(b.public_hex(key)), ids) if args.base else None
     manifest = b.build(args.out, b.sources(folder, ids.config.state), mission=ids.config.name,
-                       version=args.version, key=key, base=base)  # fmt: skip
+                       version=args.version, key=key, base=base,
+                       downgrade=args.downgrade)  # fmt: skip
     print("%s: %s, %d bytes" % (args.out, b.describe(manifest), os.path.getsize(args.out)))
     return 0
 
@@ -159,11 +169,16 @@ def show(args):
     ids, _, public = _mission(args)
     if public is None:
         raise UserError("the mission names no update.public_key to check the package with")
-    manifest = _open(args.package, public, ids)
+    from obsw.update.package import PackageError
+
+    try:
+        manifest = _open(args.package, public, ids, whole=True)
+    except PackageError as e:
+        raise UserError("%s: %s (%s)" % (args.package, e, e.code)) from None
     if args.json:
         print(dump(manifest))
     else:
-        print("%s: %s, signature good" % (args.package, describe(manifest)))
+        print("%s: %s, signature and every file good" % (args.package, describe(manifest)))
     return 0
 
 

@@ -207,7 +207,7 @@ def config(args):
         for ids, name in zip(missions, names):
             print(
                 "  %s: spacecraft id %s, links on ports %s, mission database mdb/%s.xml"
-                % (name, ids.sdb.scid, _link_ports(ids, args.mode), name)
+                % (name, ids.scid, _link_ports(ids, args.mode), name)
             )
         return 0
     ids = missions[0]

@@ -12,6 +12,36 @@ from obsw.frames.tc import Segment
 from obsw.frames.tm import TmFrame
 from obsw.frames.tm_demux import TmDemultiplexer
 
+CODING_COUNTERS = ("frames", "corrected", "symbol_errors", "uncorrectable", "locks", "losses",
+                   "slips")  # fmt: skip
+
+
+class CodedInput:
+    """A TmDecoder with a CaduDecoder's ``feed``: frames whose codeblock could be decoded."""
+
+    def __init__(self, decoder, soft):
+        self.decoder = decoder
+        self.feed_input = decoder.feed_soft if soft else decoder.feed_octets
+
+    def feed(self, data):
+        return [f.data for f in self.feed_input(data) if f.data is not None]
+
+    def counters(self):
+        d, s = self.decoder, self.decoder.sync
+        return {"frames": d.frames - d.uncorrectable, "corrected": d.corrected,
+                "symbol_errors": d.symbol_errors, "uncorrectable": d.uncorrectable,
+                "locks": s.locks, "losses": s.losses, "slips": s.slips}  # fmt: skip
+
+
+def coding_counters(decoders):
+    """The counters of the ``CodedInput`` among ``decoders``, summed."""
+    out = dict.fromkeys(CODING_COUNTERS, 0)
+    for d in decoders:
+        if isinstance(d, CodedInput):
+            for name, value in d.counters().items():
+                out[name] += value
+    return out
+
 
 class Ground:
     """Sends telecommand packets through FOP-1 as CLTUs on every link and decodes telemetry.
@@ -22,6 +52,13 @@ class Ground:
     channel's SA before FOP-1 (ApplySecurity in virtual channel generation), and ``state`` (a
     ``keys.StateFile``) saves the sequence numbers after each one. With ``tm_security`` (an
     ``obsw.frames.sdls_gcm.TmSecurity``) TM frames of secured VCs are verified and decrypted.
+
+    With ``tm_decoder`` (a function returning an ``obsw.frames.tm_coding.TmDecoder``, e.g.
+    ``LinkSettings.decoder`` of ``obsw_host.frames.coding``) each link's TM is channel decoded
+    (Reed-Solomon, Viterbi, frame synchronization with bit errors and slips); a link whose
+    ``soft`` is true gives soft symbols (``obsw_host.frames.radio``), the others octets.
+    ``coding()`` sums the decoders' counters (frames, RS symbols corrected, channel symbols the
+    Viterbi decoder corrected, uncorrectable codeblocks, locks, losses of lock, slips).
     """
 
     def __init__(
@@ -33,13 +70,14 @@ class Ground:
         tm_frame_length=256,
         tc_randomize=False,
         tm_randomize=True,
-        window=10,
+        window=5,  # FOP-1's K: at most FARM-1's positive window (W/2 of the OBC's W=10)
         t1=2.0,
         transmission_limit=5,
         corrupt=None,
         security=None,
         state=None,
         tm_security=None,
+        tm_decoder=None,
     ):
         self.links = list(links)
         self.scid = scid
@@ -50,7 +88,11 @@ class Ground:
         self.tc_randomize = tc_randomize
         self.fop = F.Fop1(scid, vcid, window, t1, transmission_limit)
         self.corrupt = corrupt
-        self.decoders = [CaduDecoder(tm_frame_length, tm_randomize) for _ in self.links]
+        if tm_decoder is None:
+            self.decoders = [CaduDecoder(tm_frame_length, tm_randomize) for _ in self.links]
+        else:
+            self.decoders = [CodedInput(tm_decoder(), getattr(link, "soft", False))
+                             for link in self.links]  # fmt: skip
         self.dedup = Deduplicator(5.0)
         self.demux = TmDemultiplexer(scid, security=tm_security)
         self.queue = deque()
@@ -114,6 +156,10 @@ class Ground:
         self._flush(now)
         self.packets.extend(got)
         return got
+
+    def coding(self):
+        """The channel decoders' counters summed over the links (zeros without coding)."""
+        return coding_counters(self.decoders)
 
     @property
     def idle(self):

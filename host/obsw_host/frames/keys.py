@@ -10,6 +10,7 @@ import json
 import os
 import stat
 
+from obsw import jsonsafe
 from obsw.frames.sdls import SecurityAssociation
 from obsw.frames.sdls_gcm import GCM, GcmSecurityAssociation
 from obsw.frames.sdls_keys import HMAC, KeyFileError, dump_sas, load_security, load_tm_security
@@ -114,13 +115,45 @@ def _write_secret(path, text, replace):
         with os.fdopen(fd, "w") as f:
             f.write(text)
         return
+    _replace_private(path, text.encode())
+
+
+def _replace_private(path, data):
+    """Write ``data`` over ``path`` atomically, readable by its owner only: a leftover
+    temporary file (of any mode, any owner's making) is removed, never reused."""
     tmp = path + ".tmp"
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-    with os.fdopen(fd, "w") as f:
-        f.write(text)
-        f.flush()
-        os.fsync(f.fileno())
+    try:
+        os.unlink(tmp)
+    except FileNotFoundError:
+        pass
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    try:
+        os.fchmod(fd, 0o600)  # whatever the umask
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
     os.replace(tmp, path)
+    _sync_dir(path)
+
+
+def _sync_dir(path):
+    try:
+        fd = os.open(os.path.dirname(os.path.abspath(path)), os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
 
 
 def state_path(key_path):
@@ -156,7 +189,7 @@ def load_all(path, state=None, segment_header=True):
     tm = load_tm_security(text)
     if state is False:
         return security, tm, None
-    keeper = StateFile(state or state_path(path), security, tm)
+    keeper = StateFile(state or state_path(path), security, tm, key_path=path)
     keeper.load()
     security.on_reserve = keeper.save
     if tm is not None:
@@ -165,41 +198,87 @@ def load_all(path, state=None, segment_header=True):
 
 
 class StateFile:
-    """Saves ``security.context()`` (sequence numbers) with an atomic replace."""
+    """Saves ``security.context()`` (sequence numbers) with an atomic replace; with
+    ``key_path``, first the highest number each SA may have sent into the key file itself
+    (its ``sent`` fields): the counter is kept with the key, so deleting or resetting the
+    state file cannot make a number (an IV) be sent twice under one key."""
 
-    def __init__(self, path, security, tm=None):
+    def __init__(self, path, security, tm=None, key_path=None):
         self.path = path
         self.security = security
         self.tm = tm
+        self.key_path = key_path
         self.saves = 0
+        self._floors = {}  # SPI -> the ``sent`` the key file holds
+
+    def _sending(self):
+        sas = list(self.security.sas.values())
+        if self.tm is not None:
+            sas += list(self.tm.sas.values())
+        return sas
+
+    def save_floors(self):
+        """The key file's ``sent`` fields brought up to every SA's reservation (only the
+        fields change: the file is read, changed and replaced atomically, mode 600)."""
+        if self.key_path is None:
+            return False
+        want = {}
+        for sa in self._sending():
+            top = max(sa.sn_sent, sa.sn_reserved)
+            if top > self._floors.get(sa.spi, 0):
+                want[sa.spi] = top
+        if not want:
+            return False
+        doc = json.loads(read_key_file(self.key_path))
+        for entry in doc.get("sas", ()):
+            spi = entry.get("spi")
+            if spi in want and want[spi] > entry.get("sent", 0):
+                entry["sent"] = want[spi]
+        _replace_private(self.key_path, (json.dumps(doc) + "\n").encode())
+        self._floors.update(want)
+        return True
 
     def load(self):
+        """Take back the saved numbers; False when there is no state file. One that cannot be
+        read is set aside (``PATH.bad``, ``rejected`` says why) and the SAs go on from the
+        numbers kept with their keys: sending never repeats one, receiving takes up the
+        sender's numbers (see docs/security.md)."""
+        self._floors = {sa.spi: sa.sn_sent for sa in self._sending()}
         try:
-            with open(self.path) as f:
-                ctx = json.load(f)
+            with open(self.path, "rb") as f:
+                text = f.read(1 << 20)
         except FileNotFoundError:
             return False
-        except ValueError as e:
-            raise KeyFileError("%s is not a state file: %s" % (self.path, e)) from None
         try:
+            ctx = jsonsafe.loads(text)
+            if not isinstance(ctx, list):
+                raise ValueError("expected a list of [spi, sent, top]")
+            for entry in ctx:
+                if not isinstance(entry, list) or len(entry) != 3:
+                    raise ValueError("expected [spi, sent, top], got %r" % (entry,))
+                for v in entry:
+                    if not isinstance(v, int) or isinstance(v, bool) or v < 0:
+                        raise ValueError("expected integers >= 0, got %r" % (entry,))
             self.security.restore(ctx)
             if self.tm is not None:
                 self.tm.restore(ctx)
         except (ValueError, TypeError, IndexError) as e:
-            raise KeyFileError("%s is not a state file: %s" % (self.path, e)) from None
+            self.rejected = "%s is not a state file: %s" % (self.path, e)
+            try:
+                os.replace(self.path, self.path + ".bad")
+            except OSError:
+                pass
+            return False
         return True
 
+    rejected = None
+
     def save(self):
-        tmp = self.path + ".tmp"
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-        with os.fdopen(fd, "w") as f:
-            ctx = self.security.context()
-            if self.tm is not None:
-                ctx = ctx + self.tm.context()
-            json.dump(ctx, f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, self.path)
+        self.save_floors()  # the key's own counter first: it alone holds if this file goes
+        ctx = self.security.context()
+        if self.tm is not None:
+            ctx = ctx + self.tm.context()
+        _replace_private(self.path, json.dumps(ctx).encode())
         self.saves += 1
 
 

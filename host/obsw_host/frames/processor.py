@@ -1,13 +1,14 @@
 """The frame processor process: two serial links to the COM module, UDP to the applications.
 
-Telecommand packets go to UDP port ``port_base + APID`` (default: the base of
-``obsw_host.mission.ports``), sent from the ``tm_port`` socket, so an application answering the
-sender reaches the TM input; telemetry packets sent to ``tm_port`` (default: the ports module's
-``tm``, base - 1) leave as TM frames on both links, on the VC of their APID (the real-time VC
-unless mapped). Each entry of ``vc_ports`` (VC ID -> UDP port) is one more input whose packets all
-go on that VC, unchanged: by default the playback VC of the plan on ``tm_port + 1`` (the ports
-module's ``playback``), where the PUS application process sends what service 15 retrieves
-from its packet stores.
+Telecommand packets go to the UDP address their APID has in ``routes`` (APID -> (host, port),
+e.g. a mission's ``Ports.routes``), else to ``default_route(apid)`` (default: the run's
+``Ports.for_apid`` on ``host``), sent from the ``tm_port`` socket, so an application answering
+the sender reaches the TM input; a packet with no route is counted (``unrouted``); telemetry
+packets sent to ``tm_port`` (default: the ports module's ``tm``, base - 1) leave as TM frames
+on both links, on the VC of their APID (the real-time VC unless mapped). Each entry of
+``vc_ports`` (VC ID -> UDP port) is one more input whose packets all go on that VC, unchanged:
+by default the playback VC of the plan on ``tm_port + 1`` (the ports module's ``playback``),
+where the PUS application process sends what service 15 retrieves from its packet stores.
 
 TC security: with ``security`` (an ``obsw.frames.sdls.TcSecurity``, see
 ``obsw_host.frames.keys``) every TC frame is authenticated before FARM-1. A rejected frame is
@@ -16,6 +17,11 @@ severity, aux: VC ID u8, SPI u16, sequence number u64) of the frame processor's 
 process, which also serves TCs to that APID (e.g. TC[5,6] to disable an event). At most
 ``event_limit`` such reports go out per second; the others are counted (``events_limited``).
 ``state`` (a ``keys.StateFile``) saves the sequence numbers each time a frame is accepted.
+
+The downlink (``tm_coding``, ``downlink_bps``, ``tm_spill``: see ``obsw.frames.processor``):
+a TM packet that finds its virtual channel and the spill store full is reported, with
+``overflow_event`` (an event ID), as a PUS event of that APID (TM[5,3], aux: VC ID u8, packet
+length u16), within the same ``event_limit``; it is counted (``tm_dropped``) in every case.
 """
 
 import os
@@ -91,7 +97,8 @@ class FrameProcessorHost:
         link_b,
         scid,
         host=DEFAULT_HOST,
-        port_base=None,
+        routes=None,
+        default_route=None,
         tm_port=None,
         essential_port=None,
         vc_ports=None,
@@ -101,6 +108,7 @@ class FrameProcessorHost:
         event_apid=None,
         event_ids=EVENT_IDS,
         event_limit=10,
+        overflow_event=None,
         **options,
     ):
         self.links = [
@@ -108,7 +116,9 @@ class FrameProcessorHost:
         ]
         self.host = host
         ports = Ports()
-        self.port_base = ports.base if port_base is None else port_base
+        self.routes = dict(routes or {})
+        self.default_route = ports.route(host) if default_route is None else default_route
+        self.unrouted = 0  # TC packets whose APID has no route
         tm_port = ports.tm if tm_port is None else tm_port
         self.essential_port = essential_port
         self.clock = clock
@@ -124,8 +134,12 @@ class FrameProcessorHost:
         self.pus = None
         if event_apid is not None:
             self.pus = ApplicationProcess(event_apid, self.core.send_packet, _Clock(clock))
-            self.pus.register(EventReporting(known=[i for i in event_ids if i]))
+            known = [i for i in event_ids if i] + ([overflow_event] if overflow_event else [])
+            self.pus.register(EventReporting(known=known))
         self.core.rejected_listeners.append(self._rejected)
+        self.overflow_event = overflow_event
+        self._overflowing = False
+        self.core.overflow_listeners.append(self._overflow)
         self._accepted = 0
         if vc_ports is None:
             pb = self.core.playback_vcid
@@ -162,7 +176,19 @@ class FrameProcessorHost:
         return s
 
     def _rejected(self, outcome, vcid, spi, sn):
-        if self.pus is None:
+        self._event(self.event_ids[outcome], struct.pack(">BHQ", vcid, spi, sn))
+
+    def _overflow(self, vcid, packet):
+        if self._overflowing:  # the report itself found no room: counted, not reported again
+            return
+        self._overflowing = True
+        try:
+            self._event(self.overflow_event, struct.pack(">BH", vcid, len(packet)))
+        finally:
+            self._overflowing = False
+
+    def _event(self, event_id, aux):
+        if self.pus is None or not event_id:
             return
         second = int(self.clock())
         start, n = self._event_window
@@ -172,15 +198,20 @@ class FrameProcessorHost:
             self.events_limited += 1
             return
         self._event_window = (start, n + 1)
-        aux = struct.pack(">BHQ", vcid, spi, sn)
-        self.pus.event(self.event_ids[outcome], 3, aux)
+        self.pus.event(event_id, 3, aux)
 
     def _route(self, apid, packet):
         if self.pus is not None and apid == self.pus.apid:
             self.pus.receive(packet)
             return
+        address = self.routes.get(apid)
+        if address is None and self.default_route:
+            address = self.default_route(apid)
+        if address is None:
+            self.unrouted += 1
+            return
         try:
-            self.out.sendto(packet, (self.host, self.port_base + apid))
+            self.out.sendto(packet, address)
         except OSError:
             pass  # nobody listening: UDP drops it, as the thesis' processes expect
 

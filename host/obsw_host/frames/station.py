@@ -5,6 +5,10 @@ TC packets that arrive on the station's UDP socket go up through FOP-1 (AD servi
 packets go, unchanged, to the mission control process (``mcs``, or whoever sent the last TC)
 on UDP. ``downlinked`` keeps (VC ID, packet) of the packets forwarded, so a test or the demo
 can tell real-time telemetry from playback.
+
+``GroundStation.for_mission(ids, links)`` configures it from a mission (SCID, TC VC and MAP,
+TM frame length and coding); the links may be any of ``obsw_host.frames.radio`` (KISS over a
+serial port or TCP, UDP bits or soft symbols) or a serial link (``links``).
 """
 
 import socket
@@ -36,6 +40,23 @@ class GroundStation:
         self.uplinked = 0
         self.refused = 0  # packets that could not go up (too long, or no operational SA)
         self._initiated = False
+
+    @classmethod
+    def for_mission(cls, ids, links, **options):
+        """A station for mission ``ids`` (``MissionIds``) on ``links``: its SCID, TC VC and
+        packets MAP, TM frame length and channel coding (``frames`` section)."""
+        from obsw_host.frames.coding import LinkSettings
+
+        link = LinkSettings.of(ids.config)
+        options.setdefault("vcid", ids.tc_vc)
+        options.setdefault("map_id", ids.maps["packets"])
+        options.setdefault("tm_frame_length", link.frame_length)
+        options.setdefault("tm_decoder", link.decoder)
+        return cls(links, ids.scid, **options)
+
+    def coding(self):
+        """The channel decoders' counters (``Ground.coding``)."""
+        return self.ground.coding()
 
     def now(self):
         return self.clock() - self._t0

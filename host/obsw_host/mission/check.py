@@ -21,7 +21,7 @@ from obsw.spacecan.nodedef import NodeDefinition, NodeDefinitionError
 from obsw_host.mission import defaults
 from obsw_host.mission.config import ConfigError, MissionConfig
 from obsw_host.mission.errors import MissionError, Problem, did_you_mean, short
-from obsw_host.mission.folder import locate
+from obsw_host.mission.folder import MAX_PROCEDURE, locate, read_text
 from obsw_host.mission.schema import json_type, read_json, validate
 from obsw_host.obc.onboard_time import ONBOARD_TIME
 from obsw_host.obc.plugins import Component, PluginError
@@ -97,7 +97,7 @@ class _Checker:
     # -------------------------------------------------------------------- the mission file
 
     def mission(self):
-        doc, problems = read_json(self.file)
+        doc, problems = read_json(self.file, self.folder)
         self.problems += problems
         if doc is None:
             return None
@@ -195,6 +195,16 @@ class _Checker:
         )
         frames = doc.get("frames") if isinstance(doc.get("frames"), dict) else {}
         self._exists(frames.get("keys"), ["frames", "keys"], "a key file of obsw frames keygen")
+        self._link(frames)
+
+    def _link(self, frames):
+        """The TM coding with the frame length: what the coder itself accepts."""
+        if any(p.path.startswith("$.frames") for p in self.problems):
+            return  # the schema already said what is wrong there
+        from obsw_host.frames.coding import LinkSettings
+
+        for path, text in LinkSettings(frames).problems():
+            self.add(self.file, path, text)
 
     # -------------------------------------------------------------------- the database
 
@@ -202,7 +212,7 @@ class _Checker:
         if self.sdb_file is None:
             return None
         f = self.sdb_file
-        doc, problems = read_json(f)
+        doc, problems = read_json(f, self.folder)
         self.problems += problems
         if doc is None:
             return None
@@ -436,7 +446,7 @@ class _Checker:
                 self.add(where, path + ["definition"], "file %s not found; expected a SpaceCAN "
                          "node definition (nodes/NAME.json)" % short(rel))  # fmt: skip
                 continue
-            ndoc, problems = read_json(full)
+            ndoc, problems = read_json(full, self.folder)
             self.problems += problems
             if ndoc is None:
                 continue
@@ -666,9 +676,11 @@ class _Checker:
         resolver = _Resolver(catalog)
         for path in sorted(glob.glob(os.path.join(self.procedures, "*.plt"))):
             try:
-                with open(path, encoding="utf-8") as fh:
-                    text = fh.read()
+                text = read_text(path, MAX_PROCEDURE, self.folder)
                 load_procedure(text, resolver)
+            except OSError as e:
+                self.add(path, "line 1", "cannot read (%s); expected a PLUTO procedure"
+                         % e.strerror)  # fmt: skip
             except UnicodeDecodeError as e:
                 self.add(path, "line 1", "not UTF-8 text (%s); expected a PLUTO procedure" % e)
             except PlutoError as e:

@@ -22,7 +22,6 @@ was expected. ``obsw_host.mission.check`` checks the whole mission folder before
 JSON Schema of the file (``obsw_host/mission/schema``) states every key.
 """
 
-import json
 import os
 
 from obsw_host.mission.defaults import PLATFORM as _PLATFORM
@@ -30,6 +29,7 @@ from obsw_host.mission.errors import ConfigError  # noqa: F401 (raised here, pub
 from obsw_host.mission.folder import locate
 from obsw_host.net import DEFAULT_HOST
 from obsw_host.obc.registry import KINDS, WITH_PUS
+from obsw_host.obc.state import default_state
 
 # component kinds that became plug-ins: the kind -> (component name, its entry)
 _LEGACY_KINDS = {"solar_panel": ("SolarPanel", {"module": "obsw_host.solar_panel"})}
@@ -37,8 +37,10 @@ _LEGACY_KINDS = {"solar_panel": ("SolarPanel", {"module": "obsw_host.solar_panel
 
 def parse_json(text, where):
     """The one place a configuration's JSON is parsed."""
+    from obsw_host.mission.folder import loads_json
+
     try:
-        return json.loads(text)
+        return loads_json(text)
     except ValueError as e:
         raise ConfigError(where, "not valid JSON (%s)" % e) from None
 
@@ -56,7 +58,9 @@ class MissionConfig:
         self.name = str(doc.get("name", os.path.splitext(os.path.basename(path))[0]))
         self.host = str(doc.get("host", DEFAULT_HOST))
         self.sdb_path = self.resolve(self._str("sdb"))
-        self.state = self.resolve(doc.get("state", "state"))
+        # a mission file that names no state folder gets the user's state folder of its name,
+        # never a folder beside the mission (that may be the source tree)
+        self.state = self.resolve(doc["state"]) if "state" in doc else default_state(self.name)
         il = doc.get("il_directory")
         self.il_directory = self.resolve(il) if il else os.path.join(self.state, "il")
         self.processes = self._processes()
@@ -135,10 +139,13 @@ class MissionConfig:
 def load(path=None):
     """The configuration of mission ``path`` (a folder or its file), else of the one
     ``obsw_host.mission.locate`` finds ($OBSW_MISSION, a mission.json here or above)."""
+    from obsw_host.mission.folder import read_text
+
     path = locate(path)
     try:
-        with open(path) as f:
-            text = f.read()
+        text = read_text(path, root=os.path.dirname(os.path.abspath(path)))
+    except UnicodeDecodeError as e:
+        raise ConfigError(path, "not UTF-8 text (%s)" % e) from None
     except OSError as e:
         raise ConfigError(path, "cannot read (%s)" % e.strerror) from None
     return MissionConfig(parse_json(text, path), path)

@@ -82,6 +82,26 @@ FRAMES = {
     "clcw_period": 0.5,
     "uart_queue": 64,  # frames waiting for a UART; beyond, the oldest is dropped (counted)
     "tc_security": "sdls",  # TC frames authenticated; "none" only when the mission says so
+    # the space link (obsw_host.frames.coding): CCSDS 131.0-B TM coding at both ends
+    "tm_coding": {
+        "scheme": "none",  # none | rs | conv | concatenated
+        "rs_e": 16,  # (255,223); 8: (255,239)
+        "interleave": 1,  # 1, 2, 3, 4, 5 or 8
+        "randomize": True,
+        "sync": {"search_errors": 3, "lock_errors": 6, "verify": 2, "flywheel": 3, "slip": 2},
+    },
+    "downlink_bps": None,  # the radio's rate: frames paced to it; None: the UART's speed
+    "uplink_bps": None,
+    "tm_spill": 262144,  # octets of TM packets kept while their VC is full
+    # the simulation's radio model (obsw_sim.radio)
+    "radio": {
+        "ber": 0.0,
+        "ebn0_db": None,  # AWGN on soft symbols instead of ber
+        "burst_rate": 0.0,
+        "burst_length": 8,
+        "slip_rate": 0.0,
+        "seed": 1,
+    },
 }
 PLATFORM = {
     "heartbeat": 0.5,  # seconds between heartbeats

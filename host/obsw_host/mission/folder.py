@@ -47,3 +47,58 @@ def locate(path=None):
         expected="a mission folder: give DIR (or --mission DIR), set $%s, or work in a folder "
         "with a %s (`obsw mission new NAME` writes one)" % (ENV, MISSION_FILE),
     )
+
+
+MAX_JSON_FILE = 8 << 20  # octets of a mission's JSON file: mission.json, sdb.json, a node
+MAX_PROCEDURE = 1 << 20  # octets of a PLUTO procedure
+MAX_DEPTH = 64  # nesting of a mission's JSON (obsw.jsonsafe)
+
+
+class MissionFileError(OSError):
+    """A mission file that is not read: a link out of its mission folder, not a regular file,
+    or larger than its limit (an ``OSError``: callers report it as a file they cannot read)."""
+
+    def __init__(self, code, text, path):
+        super().__init__(code, text, path)
+
+
+def read_text(path, limit=MAX_JSON_FILE, root=None):
+    """The UTF-8 text of mission file ``path``, read with a size limit. ``root``: its mission
+    folder; a name inside it that a symbolic link takes out of it is refused. Devices, pipes
+    and folders are refused before a byte is read (a link to /dev/zero never runs away)."""
+    import errno
+    import stat
+
+    if root is not None:
+        top = os.path.abspath(root)
+        lexical = os.path.abspath(path)
+        real_top = os.path.realpath(top)
+        if lexical.startswith(top + os.sep):
+            real = os.path.realpath(lexical)
+            if not real.startswith(real_top + os.sep):
+                raise MissionFileError(
+                    errno.EACCES, "a symbolic link out of the mission folder %s" % top, path
+                )
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise MissionFileError(errno.EINVAL, "not a regular file", path)
+        if st.st_size > limit:
+            raise MissionFileError(
+                errno.EFBIG, "%d octets, more than the %d a mission file may have"
+                % (st.st_size, limit), path)  # fmt: skip
+        with os.fdopen(fd, "rb", closefd=False) as f:
+            data = f.read(limit + 1)
+    finally:
+        os.close(fd)
+    if len(data) > limit:
+        raise MissionFileError(errno.EFBIG, "more than %d octets" % limit, path)
+    return data.decode("utf-8")
+
+
+def loads_json(text):
+    """``json.loads`` of a mission file's text with its nesting bounded (a ValueError)."""
+    from obsw import jsonsafe
+
+    return jsonsafe.loads(text, MAX_DEPTH)

@@ -49,8 +49,14 @@ def event_id(sdb, name):
 def load_sdb(path):
     """The spacecraft database at ``path``; its errors as one line naming the file (a file
     that cannot be read raises its OSError, which ``obsw`` prints as one line too)."""
+    from obsw_host.mission.folder import read_text
+
     try:
-        return sdb_module.load(path)
+        text = read_text(path)  # bounded: a mission file never runs away
+        i = path.rfind("/")
+        return sdb_module.loads(text, path[:i] if i > 0 else ("/" if i == 0 else ""))
+    except UnicodeDecodeError as e:
+        raise UserError("%s: not UTF-8 text (%s)" % (path, e)) from None
     except sdb_module.SdbError as e:
         raise UserError("%s: %s" % (path, e)) from None
 

@@ -7,7 +7,7 @@ port sits at a fixed offset from the same base, so moving the base moves the who
 ========================  ======================  ===================================
 name                      port (base 5000)        what listens
 ========================  ======================  ===================================
-``app(apid)``             base + APID             an application process (PUS: 5010)
+``for_apid(apid)``        base + APID             an application process (PUS: 5010)
 ``pus``                   base + apids.pus        the PUS application process
 ``cfdp``                  base + apids.cfdp       the onboard CFDP entity (5100)
 ``cfdp_ground``           base + apids.cfdp + 1   the ground CFDP entity (5101)
@@ -23,6 +23,10 @@ name                      port (base 5000)        what listens
 The base is ``$OBSW_PORT_BASE`` if set (an operator's choice for this run), else the mission
 file's ``"ports": {"base": N}``, else 5000. The same ``ports`` section may fix any named port
 by itself (``"ports": {"base": 6000, "yamcs_http": 8080}``).
+
+An APID becomes a port in one place, ``Ports.for_apid``: the port fixed by name for the
+mission's ``pus`` or ``cfdp`` APID, else base + APID; ``Ports.routes`` is the table a frame
+processor or gateway routes TC packets with (APID -> (host, port)).
 """
 
 import os
@@ -95,9 +99,21 @@ class Ports:
         base = section.pop("base", None)
         return cls(base, apids, section, where)
 
-    def app(self, apid):
-        """The UDP port of the application process with APID ``apid``."""
+    def for_apid(self, apid):
+        """The UDP port of the application process with APID ``apid``: the port the mission
+        fixes by name for its ``pus`` or ``cfdp`` APID, else base + APID."""
+        for name, (apid_name, offset) in BY_APID.items():
+            if offset == 0 and self.apids.get(apid_name) == apid:
+                return self.get(name)
         return self.base + apid
+
+    def routes(self, host):
+        """APID -> (``host``, port) for every APID of the mission (see ``for_apid``)."""
+        return {apid: (host, self.for_apid(apid)) for apid in sorted(set(self.apids.values()))}
+
+    def route(self, host):
+        """A function APID -> (``host``, port) for any APID (``for_apid``)."""
+        return lambda apid: (host, self.for_apid(apid))
 
     def get(self, name):
         """The port named ``name`` (one of ``NAMES``)."""
@@ -157,7 +173,7 @@ class Ports:
 
 def app_port(apid):
     """The UDP port of application process ``apid`` for the base of this run."""
-    return Ports().app(apid)
+    return Ports().for_apid(apid)
 
 
 def default():

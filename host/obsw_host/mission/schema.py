@@ -22,14 +22,23 @@ _REQUIRED = re.compile(r"^'(.*)' is a required property")
 _validators = {}
 
 
-def read_json(path):
+def read_json(path, root=None):
     """(document, problems) of JSON file ``path``: a file that cannot be read, bad JSON or a
     key given twice in one object is a problem (the document is then None)."""
+    from obsw_host.mission.folder import MAX_DEPTH, read_text
+
     try:
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
+        text = read_text(path, root=root)
+    except UnicodeDecodeError as e:
+        return None, [Problem(path, "$", "not UTF-8 text (%s); expected a JSON file" % e)]
     except OSError as e:
         return None, [Problem(path, "$", "cannot read (%s); expected a JSON file" % e.strerror)]
+    from obsw import jsonsafe
+
+    try:
+        jsonsafe.check_depth(text, MAX_DEPTH)
+    except ValueError as e:
+        return None, [Problem(path, "$", "%s; expected a JSON document" % e)]
     repeated = []
 
     def pairs(items):

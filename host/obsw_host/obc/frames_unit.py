@@ -9,9 +9,11 @@ import tty
 from obsw.il.node import Node
 
 from obsw_host.frames import policy
+from obsw_host.frames.coding import LinkSettings
 from obsw_host.frames.links import FdLink, SerialLink
-from obsw_host.frames.processor import FrameProcessorHost, security_options
+from obsw_host.frames.processor import FrameProcessorHost, sdb_events, security_options
 from obsw_host.il.transport import SocketTransport
+from obsw_host.mission.ids import event_id
 from obsw_host.obc.topology import FRAME_PROCESSOR
 
 
@@ -74,6 +76,7 @@ class FramesUnit:
                 self.paths[side] = dev
         ids = topology.ids
         ports = ids.ports
+        link = LinkSettings.of(config)  # the TM coding and the radio's rate
         security = {}
         key_path = policy.check(config)  # secure by default: keys, or "tc_security": "none"
         if key_path is None:
@@ -81,12 +84,18 @@ class FramesUnit:
         else:  # TC (and TM, where the file has SAs for it) protected with SDLS
             state = os.path.join(config.state, "frames.keys.state")
             security = security_options(key_path, sdb, state)
+        if "event_apid" not in security:  # no SDLS: the overflow event still has its APID
+            try:
+                security["event_apid"], security["event_ids"] = sdb_events(sdb)
+            except KeyError:
+                pass
         self.fp = FrameProcessorHost(
             links[0],
             links[1],
             ids.scid,
             host=config.host,
-            port_base=ports.pus - ids.pus_apid,
+            routes=ports.routes(config.host),
+            default_route=ports.route(config.host),
             tm_port=ports.tm,
             vc_ports={ids.playback_vc: ports.playback},
             tm_plan=ids.tm_vcs,
@@ -95,6 +104,10 @@ class FramesUnit:
             tc_vcids=(ids.tc_vc,),
             tm_frame_length=int(opts["tm_frame_length"]),
             clcw_period=float(opts["clcw_period"]),
+            tm_coding=link.encoder(),
+            downlink_bps=link.downlink_bps,
+            tm_spill=link.tm_spill,
+            overflow_event=event_id(sdb, "frames.tm_overflow"),
             **security,
         )
         self.last_step = time.monotonic()

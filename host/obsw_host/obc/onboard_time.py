@@ -13,8 +13,10 @@ scheduled TCs at their onboard time and stored packets keep increasing times.
 """
 
 import json
+import math
 import os
 
+from obsw import jsonsafe
 from obsw.il.interface import DATA, INFO, Attribute, Event, Interface, Operation
 
 ONBOARD_TIME = Interface(
@@ -46,12 +48,21 @@ class OnboardTime:
         self.corrections = 0
         self.il = None
         try:
-            with open(path) as f:
-                saved = json.load(f)
-            self.offset, self.drift, self.t0 = (float(saved[k]) for k in ("offset", "drift", "t0"))
+            with open(path, "rb") as f:
+                saved = jsonsafe.loads(f.read(4096))
+            values = [float(saved[k]) for k in ("offset", "drift", "t0")]
+            if not all(math.isfinite(v) for v in values) or abs(values[1]) >= 1.0:
+                raise ValueError("correction out of range: %r" % (values,))
+            self.offset, self.drift, self.t0 = values
             self.corrections = int(saved.get("corrections", 0))
-        except (OSError, ValueError, KeyError, TypeError):
-            pass  # no correction yet (or an unreadable file): the raw clock
+        except OSError:
+            pass  # no correction yet: the raw clock
+        except (ValueError, KeyError, TypeError, AttributeError):
+            self.offset, self.drift, self.t0 = 0.0, 0.0, 0.0  # unreadable: the raw clock
+            try:
+                os.replace(path, path + ".bad")
+            except OSError:
+                pass
         # the attributes PUS reads: the correction in the units it was uplinked in
         self.offset_ms = round(self.offset * 1000)
         self.drift_ppb = round(self.drift * 1e9)

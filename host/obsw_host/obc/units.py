@@ -33,6 +33,9 @@ from obsw_host.pus.onboard import Onboard, tai_now
 from obsw_host.update.component import SOFTWARE
 from obsw_host.update.component import build as software_component
 
+TASK_DEATHS = 5  # task deaths within TASK_WINDOW seconds that make the process unhealthy
+TASK_WINDOW = 60.0
+
 
 class PlatformEvents:
     """The PUS process's side of ``PLATFORM``: events raised on its application process."""
@@ -197,7 +200,8 @@ class PusUnit:
             peers[int(eid)] = (host, int(port))
         if not peers:  # the ground entity of the filestores, on its port of the mission
             peers[ground] = (self.config.host, ids.ports.cfdp_ground)
-        entity = make_entity(local, list(peers), self.files)
+        # the entity's state beside the filestore, not in it: the ground cannot write there
+        entity = make_entity(local, list(peers), self.files, state=self.config.state)
         self.cfdp = UdpEntity(
             entity,
             (self.config.host, ids.ports.cfdp),
@@ -207,7 +211,7 @@ class PusUnit:
         )
         self.copy = RemoteCopy(entity)
         self.node.provide(REMOTE_COPY, self.copy)
-        self.cfdp.on_indication = self.copy.indication
+        self.cfdp.on_indication = self._indication
         entity.restore(time.monotonic())
 
     def _obcp(self, opts):
@@ -230,13 +234,33 @@ class PusUnit:
     # -------------------------------------------------------------------------- running
 
     async def _cfdp_task(self):
+        # an error here ends the task: the loop's supervision reports it and restarts it
         while self._running:
-            try:
-                self.cfdp.step(0)
-                self.copy.poll(time.monotonic())
-            except OSError:
-                return
+            self.cfdp.step(0)
+            self.copy.poll(time.monotonic())
             await asyncio.sleep(0.005)
+
+    def _indication(self, ind):
+        """CFDP indications: a state file set aside becomes an event, the rest go to the
+        remote copy provider."""
+        if ind.kind == "state_rejected":
+            self.out("CFDP state file %s set aside: %s" % (ind.info["name"], ind.info["reason"]))
+            self.unit_event("platform.state_rejected", {"unit": "cfdp/" + ind.info["name"]})
+        self.copy.indication(ind)
+
+    def unit_event(self, name, values):
+        """Raise the database's event ``name`` (counted, not raised, if it has none)."""
+        try:
+            e = self.sdb.event(name)
+        except KeyError:
+            self.app.count("platform_events_unknown")
+            return None
+        return self.app.event(e.id, e.severity, e.pack(values))
+
+    def _task_died(self, name, why, restarts):
+        self.out("task %s stopped (%s): restarted (%d)" % (name, why, restarts))
+        n = min(restarts, 65535)
+        self.unit_event("platform.task_restarted", {"task": name, "restarts": n})
 
     async def _health_task(self):
         while self._running:
@@ -257,17 +281,23 @@ class PusUnit:
                     self.app.count("engine_errors")
             await asyncio.sleep(self.step_period)
 
+    async def _transport_task(self):
+        await drive_transport(self.transport, self.node)
+
+    async def _module_task(self):
+        await self.module.run(self.onboard.period, lambda: self._running)
+
     def start(self):
         self._running = True
-        self.onboard.tasks.append(lambda: drive_transport(self.transport, self.node))
+        self.onboard.on_task_death = self._task_died
+        self.onboard.tasks.append(self._transport_task)
         self.onboard.tasks.append(self._health_task)
         if self.cfdp is not None:
             self.onboard.tasks.append(self._cfdp_task)
         if self.engine is not None:
             self.onboard.tasks.append(self._engine_task)
         if self.module is not None:
-            beat = self.onboard.period
-            self.onboard.tasks.append(lambda: self.module.run(beat, lambda: self._running))
+            self.onboard.tasks.append(self._module_task)
         self.onboard.start()
         self.out(
             "PUS application process APID %d on udp %s:%d, services %s"
@@ -286,6 +316,10 @@ class PusUnit:
     def alive(self):
         last = self.app.last_cycle
         if last is None or time.monotonic() - last >= max(2.0, 20 * self.onboard.period):
+            return False
+        # a task that keeps dying is a crash loop: the platform manager restarts the process
+        # (and counts it towards the power cycle) rather than this process spinning
+        if self.onboard.deaths_within(TASK_WINDOW) >= TASK_DEATHS:
             return False
         return _components_alive(self.components)
 

@@ -61,6 +61,16 @@ class PusTimeout(TimeoutError):
         self.transaction = tx
 
 
+def _address(address):
+    """(IP, port) of a (host, port) pair: what ``recvfrom`` gives for datagrams from it."""
+    host, port = address[0], int(address[1])
+    try:
+        host = socket.getaddrinfo(host, port, socket.AF_INET, socket.SOCK_DGRAM)[0][4][0]
+    except (OSError, IndexError):
+        pass
+    return (host, port)
+
+
 class Ground:
     """Service users of the ground segment on one UDP socket (see the module text)."""
 
@@ -76,6 +86,7 @@ class Ground:
         log=None,
         session=None,
         config=None,
+        accept=(),
     ):
         self.sdb = sdb
         self.session = session  # a SessionLog, or None
@@ -87,6 +98,11 @@ class Ground:
         self.log = log  # callable(str) shown every packet, or None
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind((self.target[0], 0))
+        # TM is taken from the on-board process's address only (and from ``accept``, the
+        # addresses of other TM sources the operator named): a datagram from anywhere else
+        # is counted in ``foreign`` and dropped, never decoded
+        self.accept = {_address(self.target)} | {_address(a) for a in accept}
+        self.foreign = 0
         if source_id is None:  # the database's (pus.source_id or apids.ground), else 0; the
             # ground tools pass MissionIds.source_id, which refuses a database without one
             ids = MissionIds(sdb, None) if sdb is not None else None
@@ -160,9 +176,13 @@ class Ground:
             if not r:
                 return n
             try:
-                data = self.sock.recv(65536)
+                data, sender = self.sock.recvfrom(65536)
             except OSError:
                 return n
+            if sender not in self.accept:
+                self.foreign += 1
+                wait = 0
+                continue
             result = self.proc.receive(data)
             if self.session is not None:
                 decoded = result[1] if result else None

@@ -230,6 +230,12 @@ class _Udp:
         self.sock.close()
 
 
+def task_name(make):
+    """A task's name for reports: its function's name without underscores or ``_task``."""
+    name = getattr(make, "task_name", None) or getattr(make, "__name__", "task")
+    return name.strip("_").replace("_task", "") or "task"
+
+
 class Onboard:
     """The PUS application process of ``sdb`` served on UDP (see the module text)."""
 
@@ -286,6 +292,13 @@ class Onboard:
             config=config if config is not None else from_sdb(sdb),
         )
         self.tasks = []  # more coroutine functions to run on the process's loop
+        # supervision of every task of the loop (``_supervised``): a task that ends or raises
+        # while the process runs is restarted after ``task_backoff`` s and reported through
+        # ``on_task_death(name, why, restarts)``; ``task_deaths`` keeps when they died
+        self.task_backoff = 0.2
+        self.task_deaths = collections.deque((), 64)
+        self.task_restarts = {}
+        self.on_task_death = None
         self.providers = [self.node.provide(itf, impl) for itf, impl in components]
         self.pool = ParameterPool(sdb, self.node)
         if store is not None:  # values set through service 20 survive a restart
@@ -397,12 +410,13 @@ class Onboard:
             raise
         transport = self._transport = _Udp(loop, sock, self._received, self.app.count)
         self.address = transport.get_extra_info("sockname")
-        tasks = [asyncio.ensure_future(self.app.run(self.period))]
+        run = [("activity", lambda: self.app.run(self.period))]
         if self.node is not None:
-            tasks.append(asyncio.ensure_future(self.node.serve()))
-            tasks.append(asyncio.ensure_future(self.pool.follow(self.follow_period)))
+            run.append(("il", self.node.serve))
+            run.append(("parameters", lambda: self.pool.follow(self.follow_period)))
         for make in self.tasks:
-            tasks.append(asyncio.ensure_future(make()))
+            run.append((task_name(make), make))
+        tasks = [asyncio.ensure_future(self._supervised(name, make)) for name, make in run]
         self._ready.set()
         try:
             await self._stopping.wait()
@@ -418,6 +432,34 @@ class Onboard:
                 task.cancel()
             transport.close()
             self._transport = None
+
+    async def _supervised(self, name, make):
+        """Run task ``make()`` until the process stops; restart it whenever it ends or raises
+        before that: nothing on the loop dies silently."""
+        while True:
+            try:
+                await make()
+                why = "ended"
+            except asyncio.CancelledError:
+                raise
+            except Exception as e:
+                why = "%s: %s" % (type(e).__name__, e)
+            if self._stopping.is_set():
+                return
+            n = self.task_restarts[name] = self.task_restarts.get(name, 0) + 1
+            self.task_deaths.append((time.monotonic(), name))
+            self.app.count("task_restarts")
+            if self.on_task_death is not None:
+                try:
+                    self.on_task_death(name, why, n)
+                except Exception:
+                    self.app.count("task_report_errors")
+            await asyncio.sleep(self.task_backoff)
+
+    def deaths_within(self, seconds):
+        """How many task deaths the last ``seconds`` saw (the unit's crash-loop guard)."""
+        since = time.monotonic() - seconds
+        return sum(1 for t, _ in self.task_deaths if t >= since)
 
     def serve(self):
         """Serve in the calling thread until ``stop()`` (from another thread) or Ctrl-C."""

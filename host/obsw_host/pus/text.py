@@ -163,8 +163,33 @@ def name(service, subtype):
     return NAMES.get((service, subtype), "")
 
 
+_UNSAFE = set(range(0x20)) | set(range(0x7F, 0xA0)) | {0x200E, 0x200F, 0x2028, 0x2029}
+_UNSAFE |= set(range(0x202A, 0x202F)) | set(range(0x2066, 0x206A))  # bidirectional overrides
+
+
+def escape(s):
+    """A string that came from the spacecraft, safe to print on one line: control characters
+    (terminal escape sequences, carriage returns, new lines) and bidirectional overrides as
+    ``\\xNN`` / ``\\uNNNN``, so no TM can move the cursor, recolour or fake a line."""
+    if not any(ord(c) in _UNSAFE or c == "\\" for c in s):
+        return s
+    out = []
+    for c in s:
+        o = ord(c)
+        if c == "\\":
+            out.append("\\\\")
+        elif o in _UNSAFE:
+            out.append("\\x%02x" % o if o < 0x100 else "\\u%04x" % o)
+        else:
+            out.append(c)
+    return "".join(out)
+
+
 def plain(value):
-    """``value`` with RequestIds, bytes and tuples turned into JSON-able forms."""
+    """``value`` with RequestIds, bytes and tuples turned into JSON-able forms; strings with
+    their control characters escaped (``escape``)."""
+    if isinstance(value, str):
+        return escape(value)
     if isinstance(value, dict):
         return {str(k): plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -190,6 +215,8 @@ def pairs(decoded):
             v = "[%s]" % ", ".join(
                 ("{%s}" % pairs(x)) if isinstance(x, dict) else str(plain(x)) for x in v
             )
+        else:
+            v = plain(v)
         parts.append("%s=%s" % (k, v))
     return ", ".join(parts)
 
@@ -300,7 +327,7 @@ def _event_name(sdb, eid):
 
 
 def _number(x):
-    return "%.6g" % x if isinstance(x, float) else str(x)
+    return "%.6g" % x if isinstance(x, float) else str(plain(x))
 
 
 def _parameter(sdb, key):

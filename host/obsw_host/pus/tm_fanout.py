@@ -5,6 +5,12 @@ datagram ``SUBSCRIBE`` (a listener that sends no TC repeats it every ``linger / 
 A client silent for ``linger`` seconds is dropped; ``UNSUBSCRIBE`` drops it at once. Addresses
 given as ``static`` (the frame processor's TM input, a configured ground station) always
 receive TM. Neither control datagram can be a space packet (those are at least 7 bytes long).
+
+At most ``limit`` subscribers (``MAX_SUBSCRIBERS``) are kept. When the set is full, silent ones
+are dropped first; then a new address that only sends ``SUBSCRIBE`` is refused (counted in
+``refused``), while one that sends a TC takes the place of the client heard least recently (it
+gets its replies). A flood of datagrams from many ports neither grows the set nor keeps an
+operator who sends a TC from being answered.
 """
 
 import time
@@ -12,31 +18,47 @@ import time
 SUBSCRIBE = b"sub"
 UNSUBSCRIBE = b"unsub"
 LINGER = 60.0  # seconds a silent client keeps receiving TM
+MAX_SUBSCRIBERS = 16  # ground clients receiving TM at once (docs/hardening.md)
 
 
 class TmFanout:
     """Who receives TM: static addresses and live subscribers (see the module text)."""
 
-    def __init__(self, static=(), linger=LINGER, clock=time.monotonic):
+    def __init__(self, static=(), linger=LINGER, clock=time.monotonic, limit=MAX_SUBSCRIBERS):
         self.static = [tuple(a) for a in static if a is not None]
         self.linger = linger
         self.clock = clock
+        self.limit = limit
         self.subscribers = {}  # address -> last time heard
+        self.refused = 0  # new subscribers refused while the set was full
 
     def heard(self, data, address):
         """Note a datagram from ``address``; True if it is a TC for the process to handle."""
         if data == UNSUBSCRIBE:
             self.subscribers.pop(address, None)
             return False
-        self.subscribers[address] = self.clock()
-        return data != SUBSCRIBE
-
-    def targets(self):
-        """The addresses TM goes to now (silent subscribers dropped)."""
+        subs = self.subscribers
         now = self.clock()
+        tc = data != SUBSCRIBE
+        if address not in subs and len(subs) >= self.limit:
+            self._prune(now)
+            if len(subs) >= self.limit:
+                self.refused += 1
+                if not tc:
+                    return False
+                oldest = min(subs, key=subs.get)
+                del subs[oldest]
+        subs[address] = now
+        return tc
+
+    def _prune(self, now):
         for address, last in list(self.subscribers.items()):
             if now - last > self.linger:
                 del self.subscribers[address]
+
+    def targets(self):
+        """The addresses TM goes to now (silent subscribers dropped)."""
+        self._prune(self.clock())
         out = list(self.static)
         out.extend(a for a in self.subscribers if a not in out)
         return out

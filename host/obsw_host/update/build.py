@@ -151,11 +151,12 @@ def base_manifest(path, public, mission, target):
         return Reader(f, verify, public, mission, target).manifest
 
 
-def build(out, files, *, mission, version, key, target="obc", base=None):
+def build(out, files, *, mission, version, key, target="obc", base=None, downgrade=False):
     """Write the package ``out`` of ``files`` ({package path: file path}, in the order they
     are carried), signed with
     ``key`` (an Ed25519 private key); ``base``: the manifest of the package it is a delta
-    to. Returns the manifest. The package is written whole or not at all."""
+    to; ``downgrade``: the package may replace a newer version on board (anti-rollback).
+    Returns the manifest. The package is written whole or not at all."""
     if target not in TARGETS:
         raise UserError("target %r" % target, "one of %s" % ", ".join(TARGETS))
     tree = {p: _sha256_file(src) for p, src in files.items()}
@@ -174,6 +175,8 @@ def build(out, files, *, mission, version, key, target="obc", base=None):
         ],
         "tree": tree,
     }
+    if downgrade:
+        manifest["downgrade"] = True
     body = canonical(manifest)
     part = out + ".part"
     with open(part, "wb") as f:

@@ -91,10 +91,15 @@ class SoftwareComponent:
     def stage(self, file):
         if self.key is None:
             raise ComponentError("NO_KEY", "the mission names no update key: updates refused")
+        # only a package in the update folder: a refused one is removed, so any other file of
+        # the filestore (an image, data) must never be taken
+        inbox = os.path.realpath(os.path.join(self.files, INBOX))
         path = os.path.join(self.files, *str(file).strip("/").split("/"))
-        if not os.path.realpath(path).startswith(os.path.realpath(self.files) + os.sep):
-            raise ComponentError("BAD_FILE", "%s is outside the onboard filestore" % file)
-        if not os.path.isfile(path):
+        if not os.path.realpath(path).startswith(inbox + os.sep):
+            raise ComponentError(
+                "BAD_FILE", "%s is not in the update folder %s/ of the filestore" % (file, INBOX)
+            )
+        if os.path.islink(path) or not os.path.isfile(path):
             raise ComponentError("NO_FILE", "no file %s in the onboard filestore" % file)
         try:
             manifest = self.software.stage(path, self.verify, self.key, self.mission)

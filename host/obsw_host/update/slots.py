@@ -29,7 +29,16 @@ import json
 import os
 import shutil
 
-from obsw.update.package import BadManifest, HashMismatch, PackageError, Reader, sha256_hex
+from obsw import jsonsafe
+from obsw.update.package import (
+    BadManifest,
+    HashMismatch,
+    PackageError,
+    Reader,
+    check_floor,
+    sha256_hex,
+    version_key,
+)
 
 FACTORY = "factory"
 SLOTS = ("a", "b")
@@ -47,6 +56,33 @@ class UpdateRefused(Exception):
 def _fresh():
     return {"active": FACTORY, "previous": None, "staged": None, "trial": None,
             "seq": 0, "reported": 0, "log": []}  # fmt: skip
+
+
+_MAX_RECORD = 1 << 20  # octets: the log is trimmed far below this
+
+
+def _check_record(record):
+    """ValueError unless ``record`` is a boot record every step can read."""
+    if not isinstance(record, dict):
+        raise ValueError("expected an object")
+    slots = (None, FACTORY) + tuple(SLOTS)
+    if record.get("active") not in slots[1:]:
+        raise ValueError("active: %r" % (record.get("active"),))
+    for k in ("previous", "staged"):
+        if record.get(k) not in slots:
+            raise ValueError("%s: %r" % (k, record.get(k)))
+    trial = record.get("trial")
+    if trial is not None and not (
+        isinstance(trial, dict)
+        and trial.get("slot") in SLOTS
+        and isinstance(trial.get("starts"), int)
+    ):
+        raise ValueError("trial: %r" % (trial,))
+    for k in ("seq", "reported"):
+        if not isinstance(record.get(k), int) or isinstance(record.get(k), bool):
+            raise ValueError("%s: %r" % (k, record.get(k)))
+    if not isinstance(record.get("log"), list):
+        raise ValueError("log: expected a list")
 
 
 def _write_atomic(path, data):
@@ -81,13 +117,22 @@ class Software:
 
     def read(self):
         try:
-            with open(self.path) as f:
-                record = json.load(f)
+            with open(self.path, "rb") as f:
+                text = f.read(_MAX_RECORD + 1)
         except OSError:
             return _fresh()
-        except ValueError:  # cannot happen with atomic writes; if it does, boot the factory
+        try:
+            if len(text) > _MAX_RECORD:
+                raise ValueError("larger than %d bytes" % _MAX_RECORD)
+            record = jsonsafe.loads(text.decode())
+            _check_record(record)
+        except ValueError as e:  # cannot happen with atomic writes; if it does: the factory
+            try:  # the bad record kept aside for the ground to look at, never read again
+                os.replace(self.path, self.path + ".bad")
+            except OSError:
+                pass
             record = _fresh()
-            self._log(record, "rolled_back", self.factory, "boot record unreadable")
+            self._log(record, "rolled_back", self.factory, "boot record unreadable: %s" % e)
         return record
 
     def _lock(self):
@@ -198,10 +243,30 @@ class Software:
         self._change(staged)
         return manifest
 
+    # ---------------------------------------------------------------------- anti-rollback
+
+    def floor(self):
+        """The oldest version this OBC takes: the newest it has confirmed (kept in
+        ``floor``, written before the boot record says so), never below the factory's."""
+        best = self.factory
+        try:
+            with open(os.path.join(self.root, "floor"), "rb") as f:
+                text = f.read(256).decode().strip()
+            if text and version_key(text) > version_key(best):
+                best = text
+        except (OSError, ValueError):
+            pass
+        return best
+
+    def _raise_floor(self, version):
+        if version and version_key(version) > version_key(self.floor()):
+            _write_atomic(os.path.join(self.root, "floor"), version.encode())
+            _sync_dir(self.root)
+
     def _unpack(self, package, part, active, verify, key, mission):
         with open(package, "rb") as stream:
             reader = Reader(stream, verify, key, mission, "obc")
-            m = reader.manifest
+            m = check_floor(reader.manifest, self.floor())
             if m["base"] is not None and m["base"] != self.version(active):
                 raise BadManifest("a delta to version %s, the OBC runs %s" % (
                     m["base"], self.version(active)))  # fmt: skip
@@ -310,6 +375,7 @@ class Software:
             trial = record["trial"]
             if not trial:
                 return None
+            self._raise_floor(self.version(trial["slot"]))  # no going below it from now on
             record["previous"], record["active"] = record["active"], trial["slot"]
             record["trial"] = None
             self._log(record, "confirmed", self.version(trial["slot"]))

@@ -54,7 +54,7 @@ def problems(missions, http_port=None):
             )
             continue
         names[instance] = name
-        scid = ids.sdb.scid
+        scid = ids.scid
         if scid is not None:
             if scid in scids:
                 found.append(

@@ -1,14 +1,15 @@
 """The packet gateway: Yamcs' TCP packet links on one side, the OBC's UDP processes on the other.
 
 In packet mode it stands where the frame processor stands in frame mode, with the same UDP
-conventions: telecommand packets from Yamcs go to UDP ``port_base + APID`` (or to the address
-``routes`` gives that APID), sent from the ``tm_port`` socket, so an application that answers
-the sender reaches the TM input; every packet arriving on ``tm_port`` goes to Yamcs over TCP,
-on the connection of its stream (``apids``: stream name -> APIDs, the rest on ``pus``).
-Yamcs connects to the gateway (``TcpTcTmDataLink``, ``TcpTmDataLink``); every socket is bound
-to 127.0.0.1 unless told otherwise (``host``; ``udp_host`` for the UDP socket alone, the one
-that faces OBCs on other machines). Packets for a stream with no connection are dropped and
-counted, as a radio link without a ground station would lose them.
+conventions: telecommand packets from Yamcs go to the address ``routes`` gives their APID, else
+to the run's ``Ports.for_apid`` (``port_base + APID`` when ``port_base`` is given), sent from
+the ``tm_port`` socket, so an application that answers the sender reaches the TM input; every
+packet arriving on ``tm_port`` goes to Yamcs over TCP, on the connection of its stream
+(``apids``: stream name -> APIDs, the rest on ``pus``). Yamcs connects to the gateway
+(``TcpTcTmDataLink``, ``TcpTmDataLink``); every socket is bound to 127.0.0.1 unless told
+otherwise (``host``; ``udp_host`` for the UDP socket alone, the one that faces OBCs on other
+machines). Packets for a stream with no connection are dropped and counted, as a radio link
+without a ground station would lose them.
 """
 
 import select
@@ -35,7 +36,9 @@ class PacketGateway:
     ):
         self.host = host
         ports = Ports()  # the defaults of this run (obsw_host.mission.ports)
-        self.port_base = ports.base if port_base is None else port_base
+        self.default_route = (
+            ports.route(host) if port_base is None else (lambda apid: (host, port_base + apid))
+        )
         tm_port = ports.tm if tm_port is None else tm_port
         self.routes = dict(routes or {})
         self.apids = {a: name for name, group in (apids or {}).items() for a in group}
@@ -96,7 +99,7 @@ class PacketGateway:
         self._buffers[conn] = buf[len(buf) - leftover :] if leftover else b""
         for p in packets:
             apid = ((p[0] & 7) << 8) | p[1]
-            address = self.routes.get(apid, (self.host, self.port_base + apid))
+            address = self.routes.get(apid) or self.default_route(apid)
             try:
                 self.udp.sendto(p, address)
                 self.counters["tc"] += 1

@@ -7,7 +7,10 @@ with the sample solar panel (``obsw_host.pus.onboard.Onboard``), the on-board CF
 - ``frames``: the frame processor (``obsw_host.frames.processor.FrameProcessorHost``) with
   link A on UDP: CLTUs from Yamcs in, TM frames out to Yamcs' frame link (link B idle); TC
   frames without segment header (the MAP service), TM frames not randomized; with ``keys``
-  (an SDLS key file) TC and TM frames are protected as its SAs say.
+  (an SDLS key file) TC and TM frames are protected as its SAs say. With ``coding`` (a
+  ``obsw_host.frames.coding.LinkSettings``) the TM leaves channel coded and paced to its
+  downlink rate, unchanged on UDP to ``tm_frames_port`` (a radio, then a
+  ``obsw_host.frames.relay.FrameRelay`` in front of Yamcs).
 ``ports()`` gives the ground ports to write into the Yamcs instance. Everything listens on
 127.0.0.1 only; ports are chosen by the system unless ``ports`` gives them (``pus``,
 ``cfdp``: the gateway's TCP ports; ``cltu``: the frame processor's UDP port for CLTUs).
@@ -41,11 +44,13 @@ class UdpFrameLink:
 
     ``drop(data)`` (optional) returns True for a datagram to lose on the way in, to show
     COP-1 recovering a lost frame. What goes out is a CADU less its attached sync marker: the
-    ground station's frame synchroniser hands Yamcs one transfer frame per datagram.
+    ground station's frame synchroniser hands Yamcs one transfer frame per datagram. With
+    ``raw`` what goes out is unchanged (channel-coded octets for a radio and a ``FrameRelay``).
     """
 
-    def __init__(self, peer, port=0, drop=None):
+    def __init__(self, peer, port=0, drop=None, raw=False):
         self.name = "udp"
+        self.skip = 0 if raw else len(ASM)
         self.peer = peer
         self.drop = drop
         self.enabled = True
@@ -71,7 +76,7 @@ class UdpFrameLink:
     def write(self, data):
         if self.enabled and self.peer is not None:
             try:
-                self.sock.sendto(data[len(ASM) :], self.peer)
+                self.sock.sendto(data[self.skip :], self.peer)
             except OSError:
                 pass  # nobody listening yet: the frame is lost, as on a radio link
 
@@ -96,6 +101,7 @@ class SampleSpacecraft:
         ids=None,
         keys=None,
         key_state=None,
+        coding=None,
     ):
         ports = ports or {}
         self.mode = mode
@@ -137,14 +143,22 @@ class SampleSpacecraft:
                 cfdp_vc = ids.cfdp_vc
                 channels = plan_channels(plan) + [TmVirtualChannel(cfdp_vc, 0, 1 << 20, "cfdp")]
                 peer = (LOOPBACK, tm_frames_port) if tm_frames_port else None
-                self.link_a = UdpFrameLink(peer, ports.get("cltu", 0), drop=drop)
+                self.link_a = UdpFrameLink(
+                    peer, ports.get("cltu", 0), drop=drop, raw=coding is not None
+                )
                 self.link_b = UdpFrameLink(None)
                 self.link_b.enabled = False
-                security = {}
+                options = {}
                 if keys is not None:  # SDLS on TC and TM (AES-GCM SAs of the key file)
                     from obsw_host.frames.processor import security_options
 
-                    security = security_options(keys, self.sdb, key_state, segment_header=False)
+                    options = security_options(keys, self.sdb, key_state, segment_header=False)
+                if coding is not None:
+                    options.update(
+                        tm_coding=coding.encoder(),
+                        downlink_bps=coding.downlink_bps,
+                        tm_spill=coding.tm_spill,
+                    )
                 self.processor = FrameProcessorHost(
                     self.link_a,
                     self.link_b,
@@ -158,7 +172,7 @@ class SampleSpacecraft:
                     tm_randomize=False,
                     segment_header=False,
                     clcw_period=0.2,
-                    **security,
+                    **options,
                 )
                 tm_input = (LOOPBACK, self.processor.tm_port)
             else:
@@ -231,19 +245,7 @@ class SampleSpacecraft:
         return fut.result(timeout)
 
     def _route_frames(self, routes):
-        proc = self.processor
-        base = proc._route
-
-        def route(apid, packet):
-            address = routes.get(apid)
-            if address is None:
-                return base(apid, packet)
-            try:
-                proc.out.sendto(packet, address)
-            except OSError:
-                pass
-
-        proc.core.route = route
+        self.processor.routes.update(routes)
 
     def set_tm_frames_peer(self, port):
         """Where TM frames go (Yamcs' frame link UDP port)."""

@@ -1,6 +1,7 @@
 metadata(
     version="0.1.0",
-    description="TC/TM space data links (232.0-B, 132.0-B), CLTU, FARM-1, SDLS, frame processor",
+    description="TC/TM space data links (232.0-B, 132.0-B), CLTU, FARM-1, SDLS, frame processor, "
+    "TM coding and pacing, KISS",
 )
 
 require("obsw-base", library="obsw")
@@ -16,9 +17,11 @@ package(
         "cltu.py",
         "conv.py",
         "dedup.py",
+        "downlink.py",
         "errors.py",
         "farm.py",
         "gcm.py",
+        "kiss.py",
         "processor.py",
         "randomizer.py",
         "rs.py",

@@ -57,17 +57,26 @@ _STAT_KEYS = (
     "oversize",
     "refused",
     "internal_errors",
+    "filestore_errors",
+    "state_rejected",
 )
 
 
 class CfdpEntity:
     """One CFDP entity: any number of concurrent sending and receiving transactions."""
 
-    def __init__(self, mib, filestore, *, persist=False, work_dir=".cfdp", checkpoint=262144):
+    def __init__(
+        self, mib, filestore, *, persist=False, work_dir=".cfdp", checkpoint=262144, state=None
+    ):
         self.mib = mib
         self.fs = filestore
         self.persist = persist
-        self.work_dir = work_dir
+        self.work_dir = work_dir  # partial files and listings, in the filestore
+        # the persisted state (transactions, sequence number, remote copies): in ``state``, a
+        # filestore of its own that the ground cannot write to, else beside the work files
+        self.state_fs = filestore if state is None else state
+        self.state_dir = work_dir if state is None else "cfdp"
+        self._state_ready = False
         self.checkpoint_bytes = checkpoint
         self.tx = {}  # (tid, role) -> Transaction
         self.done = {}  # (tid, role) -> (mode, condition) of finished ones, for late PDUs
@@ -93,8 +102,31 @@ class CfdpEntity:
             self._work_ready = True
         return self.work_dir + "/" + name
 
+    def state_path(self, name):
+        """The name of the state file ``name`` in the state filestore (its folder made)."""
+        if not self._state_ready:
+            if not self.state_fs.is_dir(self.state_dir):
+                self.state_fs.mkdir(self.state_dir)
+            self._state_ready = True
+        return self.state_dir + "/" + name
+
     def state_name(self, tid, role):
-        return self.work_name("%s-%d-%d.json" % (role, tid[0], tid[1]))
+        return self.state_path("%s-%d-%d.json" % (role, tid[0], tid[1]))
+
+    def set_aside(self, name, why):
+        """A state file that cannot be used: renamed ``bad-NAME`` (kept for the ground to look
+        at, never read again) with a ``state_rejected`` indication; the unit starts clean."""
+        fs = self.state_fs
+        path = self.state_dir + "/" + name
+        try:
+            fs.rename(path, self.state_dir + "/bad-" + name)
+        except OSError:
+            try:
+                fs.delete(path)
+            except OSError:
+                pass
+        self.stats["state_rejected"] += 1
+        self.indicate("state_rejected", None, name=name, reason=why)
 
     # -- outputs ---------------------------------------------------------------------------
     def queue_pdu(self, dest, pdu):
@@ -117,7 +149,11 @@ class CfdpEntity:
         n = 0
         while senders and n < limit:
             for s in list(senders):
-                p = s.next_pdu(now)
+                try:
+                    p = s.next_pdu(now)
+                except Exception as e:  # the file went away or a defect: that transaction only
+                    self.failed(s, e, now)
+                    p = None
                 if p is None:
                     senders.remove(s)
                 else:
@@ -156,7 +192,7 @@ class CfdpEntity:
         if self.seq >> (8 * self.mib.seq_len):
             self.seq = 1
         if self.persist:
-            self.fs.write_atomic(self.work_name("seq"), str(self.seq).encode())
+            self.state_fs.write_atomic(self.state_path("seq"), str(self.seq).encode())
         return seq
 
     def put(
@@ -261,13 +297,9 @@ class CfdpEntity:
                     offset |= buf[hl + 3]
                     try:
                         tx.on_file_data_pdu(offset, memoryview(buf)[hl + 4 : end], now)
-                    except Exception:  # as below: a defect drops that transaction only
+                    except Exception as e:  # as below: that transaction only
                         self._fd_fast = None
-                        self.stats["internal_errors"] += 1
-                        try:
-                            tx.abandon(FILESTORE_REJECTION)
-                        except Exception:
-                            self.forget(tx)
+                        self.failed(tx, e, now)
                     return None
                 self._fd_fast = None
         try:
@@ -313,16 +345,32 @@ class CfdpEntity:
                 return None
         try:
             tx.on_pdu(pdu, now)
-        except Exception:  # a defect must not stop the entity: drop that transaction
-            self.stats["internal_errors"] += 1
-            try:
-                tx.abandon(FILESTORE_REJECTION)
-            except Exception:
-                self.forget(tx)
+        except Exception as e:  # must not stop the entity: that transaction only
+            self.failed(tx, e, now)
             return None
         if pdu.CODE is None and h.direction == TOWARD_RECEIVER:
             self._remember_file_data(buf, h, tid, tx)
         return pdu
+
+    def failed(self, tx, exc, now):
+        """A transaction's step raised: a filestore error (the file was deleted or cannot be
+        read) is the standard's filestore rejection fault, handled as the MIB says (cancel:
+        the peer is told); anything else is a defect and abandons it. Never raises."""
+        if isinstance(exc, OSError):
+            self.stats["filestore_errors"] += 1
+            try:
+                if not tx.done:
+                    tx.fault(FILESTORE_REJECTION, now)
+                return
+            except Exception:
+                pass  # the fault's own steps need the file too: abandon
+        else:
+            self.stats["internal_errors"] += 1
+        try:
+            if not tx.done:
+                tx.abandon(FILESTORE_REJECTION)
+        except Exception:
+            self.forget(tx)
 
     def _remember_file_data(self, buf, h, tid, tx):
         """Keep a file data PDU's header for the fast path of the next ones of its
@@ -349,7 +397,10 @@ class CfdpEntity:
     def poll(self, now):
         """Run the timers of every transaction."""
         for tx in list(self.tx.values()):
-            tx.poll(now)
+            try:
+                tx.poll(now)
+            except Exception as e:
+                self.failed(tx, e, now)
 
     # -- transaction ends ------------------------------------------------------------------
     def forget(self, tx):
@@ -361,10 +412,10 @@ class CfdpEntity:
         if len(self._done_order) > 64:
             self.done.pop(self._done_order.pop(0), None)
         if self.persist:
-            name = self.state_name(tx.tid, tx.role)
             try:
-                if self.fs.exists(name):
-                    self.fs.delete(name)
+                name = self.state_name(tx.tid, tx.role)
+                if self.state_fs.exists(name):
+                    self.state_fs.delete(name)
             except OSError:
                 pass
 
@@ -385,31 +436,35 @@ class CfdpEntity:
 
     # -- restart ---------------------------------------------------------------------------
     def restore(self, now):
-        """Reload transactions persisted before a restart; returns how many came back."""
-        fs = self.fs
-        if not fs.is_dir(self.work_dir):
+        """Reload transactions persisted before a restart; returns how many came back. A state
+        file that does not check (``obsw.cfdp.persist.check_state``) or does not rebuild is set
+        aside (``set_aside``): no content of a state file can stop the entity from starting."""
+        from obsw.cfdp.persist import StateError, check_state
+
+        fs = self.state_fs
+        if not fs.is_dir(self.state_dir):
             return 0
-        self._work_ready = True
+        self._state_ready = True
         self.load_seq()
         n = 0
-        for name in fs.listdir(self.work_dir):
+        for name in fs.listdir(self.state_dir):
             if not name.endswith(".json") or name[:2] not in ("S-", "R-"):
                 continue
             try:
-                st = json.loads(fs.read_bytes(self.work_dir + "/" + name).decode())
-            except (OSError, ValueError):
+                st = json.loads(fs.read_bytes(self.state_dir + "/" + name).decode())
+                check_state(st)
+                tid = (st["tid"][0], st["tid"][1])
+                role = st["role"]
+                if name != "%s-%d-%d.json" % (role, tid[0], tid[1]):
+                    raise StateError("its content is transaction %s-%d-%d" % ((role,) + tid))
+                remote = self.mib.remote(tid[0] if role == "R" else st["dest_id"])
+                if remote is None:
+                    raise StateError("no MIB entry for its remote entity")
+                cls = Receiver if role == "R" else Sender
+                tx = cls.restored(self, st, remote, now)
+            except Exception as e:  # bad JSON, a bad field, a file gone: set aside, go on
+                self.set_aside(name, "%s: %s" % (type(e).__name__, e))
                 continue
-            tid = tuple(st["tid"])
-            role = st["role"]
-            if role == "R":
-                remote = self.mib.remote(tid[0])
-                cls = Receiver
-            else:
-                remote = self.mib.remote(st["dest_id"])
-                cls = Sender
-            if remote is None:
-                continue
-            tx = cls.restored(self, st, remote, now)
             self.tx[(tid, role)] = tx
             self.indicate("restored", tid, role=role, progress=tx.progress_of())
             n += 1
@@ -417,12 +472,16 @@ class CfdpEntity:
 
     def load_seq(self):
         """Continue the transaction sequence numbers persisted by an earlier run."""
-        name = self.work_dir + "/seq"
+        name = self.state_dir + "/seq"
         try:
-            if self.fs.exists(name):
-                self.seq = int(self.fs.read_bytes(name).decode())
-        except (OSError, ValueError):
-            pass
+            if not self.state_fs.exists(name):
+                return
+            seq = int(self.state_fs.read_bytes(name).decode())
+            if not 0 < seq < 1 << (8 * self.mib.seq_len):
+                raise ValueError("sequence number %d out of range" % seq)
+            self.seq = seq
+        except (OSError, ValueError, UnicodeError) as e:
+            self.set_aside("seq", "%s: %s" % (type(e).__name__, e))
 
     def statuses(self):
         return [t.report() for t in self.tx.values()]

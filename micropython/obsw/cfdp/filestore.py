@@ -31,8 +31,8 @@ class Filestore:
     """What the entity needs from a filestore. Names are '/'-separated strings.
 
     Subclasses implement the methods that raise NotImplementedError; the others are built on them.
-    Read handles have ``read(offset, n)`` and ``close()``; write handles ``write(offset, data)``
-    and ``close()``.
+    Read handles have ``read(offset, n)`` and ``close()``; write handles ``write(offset, data)``,
+    ``close()`` and optionally ``sync()`` (the data on the medium before it returns).
     """
 
     def open_read(self, name):
@@ -120,6 +120,9 @@ class _MemHandle:
                 buf.extend(bytes(offset - size))
             buf[offset:] = data
 
+    def sync(self):
+        pass
+
     def close(self):
         pass
 
@@ -135,6 +138,8 @@ class MemoryFilestore(Filestore):
 
     @staticmethod
     def _n(name):
+        if "\0" in name:
+            raise FilestoreError("a NUL in the file name %r" % name, name)
         return name.strip("/")
 
     def _parent_ok(self, n):
@@ -229,6 +234,14 @@ class _FileHandle:
         f.write(data)
         self.pos = offset + len(data)
 
+    def sync(self):
+        """On the medium before this returns (``os.fsync`` where the interpreter has it)."""
+        f = self.f
+        f.flush()
+        fsync = getattr(os, "fsync", None)
+        if fsync is not None:
+            fsync(f.fileno())
+
     def close(self):
         self.f.close()
 
@@ -262,6 +275,8 @@ class OsFilestore(Filestore):
         self.root = root.rstrip("/") or "/"
 
     def path(self, name):
+        if "\0" in name:  # no file system takes one; refused as the standard's filestore error
+            raise FilestoreError("a NUL in the file name %r" % name, name)
         n = normalize(name)
         if n is None:
             raise FilestoreError("name escapes the filestore: %s" % name, name)

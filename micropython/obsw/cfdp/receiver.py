@@ -43,6 +43,19 @@ RECEIVING = "receiving"
 WAIT_FIN_ACK = "wait_finished_ack"
 
 
+def _merge_closest(gaps):
+    """Merge the two neighbouring gaps with the fewest received octets between them."""
+    best = 0
+    least = None
+    for i in range(len(gaps) - 1):
+        between = gaps[i + 1][0] - gaps[i][1]
+        if least is None or between < least:
+            least = between
+            best = i
+    g = gaps[best]
+    g[1] = gaps.pop(best + 1)[1]
+
+
 class Receiver(Transaction):
     """Receives one file (or only metadata) from a remote entity."""
 
@@ -128,7 +141,9 @@ class Receiver(Transaction):
             self.entity.stats["naks_sent"] += 1
             i += per
 
-    def _nak_all(self, now, only_new=False, upto=None):
+    def _nak_all(self, now, only_new=False, upto=None, settle=None):
+        """NAK the gaps (``only_new``: never asked for; ``upto``: below an offset;
+        ``settle``: not asked for within that many seconds, their data may be on its way)."""
         segs = []
         if self.meta is None:
             segs.append((0, 0))
@@ -136,6 +151,8 @@ class Receiver(Transaction):
             if upto is not None and g[0] >= upto:
                 break
             if only_new and g[2] is not None:
+                continue
+            if settle is not None and g[2] is not None and now - g[2] < settle:
                 continue
             g[2] = now
             segs.append((g[0], g[1]))
@@ -213,6 +230,13 @@ class Receiver(Transaction):
         self.save(force=True)
         self._check_done(now)
 
+    def sync_data(self):
+        fh = self._fh
+        if fh is not None:
+            sync = getattr(fh, "sync", None)
+            if sync is not None:
+                sync()
+
     def _file(self):
         if self._fh is None:
             fs = self.entity.fs
@@ -255,7 +279,7 @@ class Receiver(Transaction):
             gaps = self.gaps
             gaps.append([progress, offset, None])
             if len(gaps) > self.remote.max_gaps:
-                gaps[-2][1] = gaps.pop()[1]  # bounded: the octets between are asked again
+                _merge_closest(gaps)  # bounded: the fewest octets are asked again
             if self.mode == ACKNOWLEDGED and self.remote.immediate_nak and not self.suspended:
                 self.gaps[-1][2] = now
                 self._send_naks([(progress, offset)], progress, end)
@@ -342,8 +366,7 @@ class Receiver(Transaction):
         return ck.value == self.eof[0]
 
     def _complete(self, now):
-        if self._fh is not None and hasattr(self._fh, "flush"):
-            self._fh.flush()
+        self.sync_data()  # the whole file on the medium before it is renamed and reported
         if not self._verify():
             if not self.fault(FILE_CHECKSUM_FAILURE, now):
                 return
@@ -443,7 +466,9 @@ class Receiver(Transaction):
                 if self.nak.expire(now):
                     self.fault(NAK_LIMIT_REACHED, now)
                     return
-                self._nak_all(now)
+                # NAK pacing: a gap asked for less than an interval ago is not asked again yet
+                # (its data may still be coming): no retransmission of what is on its way
+                self._nak_all(now, settle=self.remote.nak_interval * 0.5)
             else:
                 self.nak.stop()
         if self.check.expired(now):

@@ -62,6 +62,10 @@ REMOTE_COPY = Interface(
 )
 
 
+_RECORD = {"transfer": str, "direction": str, "state": str, "bytes": int, "size": int,
+           "tid": list, "condition": int}  # fmt: skip
+
+
 def key_of(tid):
     return "%d:%d" % (tid[0], tid[1])
 
@@ -90,17 +94,26 @@ class RemoteCopy:
     # -------------------------------------------------------------------------- persistence
 
     def _path(self):
-        return self.entity.work_name(self.state_name)
+        return self.entity.state_path(self.state_name)
 
     def _load(self):
-        fs = self.entity.fs
-        name = self.entity.work_dir + "/" + self.state_name
+        ent = self.entity
+        fs = ent.state_fs
+        name = ent.state_dir + "/" + self.state_name
         try:
-            if fs.exists(name):
-                for r in json.loads(fs.read_bytes(name).decode()):
-                    self.records[r["transfer"]] = r
-        except (OSError, ValueError, KeyError, TypeError):
+            if not fs.exists(name):
+                return
+            recs = json.loads(fs.read_bytes(name).decode())
+            if not isinstance(recs, list):
+                raise ValueError("expected a list of records")
+            for r in recs:
+                for k in _RECORD:
+                    if not isinstance(r.get(k), _RECORD[k]):
+                        raise ValueError("record field %s: %r" % (k, r.get(k)))
+                self.records[r["transfer"]] = r
+        except Exception as e:  # bad JSON or a bad record: set aside, start clean
             self.records = {}
+            ent.set_aside(self.state_name, "%s: %s" % (type(e).__name__, e))
 
     def _save(self):
         recs = list(self.records.values())
@@ -109,7 +122,7 @@ class RemoteCopy:
             del self.records[r["transfer"]]
         try:
             data = json.dumps(list(self.records.values())).encode()
-            self.entity.fs.write_atomic(self._path(), data)
+            self.entity.state_fs.write_atomic(self._path(), data)
         except OSError:
             pass
 

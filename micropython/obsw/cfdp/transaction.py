@@ -109,10 +109,14 @@ class Transaction:
         return 0
 
     # -- persistence ----------------------------------------------------------------------
+    def sync_data(self):
+        """Put the data this transaction wrote on the medium (before its state claims it)."""
+
     def save(self, force=False):
         ent = self.entity
         if not ent.persist or self.done:
             return
+        self.sync_data()  # durability order: the data first, then the progress that claims it
         st = self.state()
         st["role"] = self.role
         st["tid"] = list(self.tid)
@@ -123,7 +127,7 @@ class Transaction:
         st["timers"] = [t.state() for t in self.timers]
         st["origin"] = list(self.origin) if self.origin else None
         st["proxy_put"] = self.proxy_put
-        ent.fs.write_atomic(ent.state_name(self.tid, self.role), json.dumps(st).encode())
+        ent.state_fs.write_atomic(ent.state_name(self.tid, self.role), json.dumps(st).encode())
 
     def restore_common(self, st, now):
         self.suspended = st["suspended"]

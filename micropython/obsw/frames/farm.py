@@ -12,6 +12,7 @@ WAIT = const(2)  # S2
 LOCKOUT = const(3)  # S3
 STATE_NAMES = ("", "Open", "Wait", "Lockout")
 
+BD_ROOM = const(64)  # buffer places for BD frames beyond the AD frames' buffer_size
 ACCEPT = const(1)
 DISCARD = const(2)
 
@@ -40,8 +41,10 @@ class Farm1:
         self.status = status
         self.no_rf = False
         self.no_bitlock = False
-        self.buffer = deque((), buffer_size + 64)
+        self._capacity = buffer_size + BD_ROOM
+        self.buffer = deque((), self._capacity)
         self._held = 0  # AD frames in the buffer (BD frames do not count towards Wait)
+        self.bd_dropped = 0  # BD frames discarded because the buffer was full
         self.reset()
 
     def reset(self):
@@ -114,6 +117,12 @@ class Farm1:
                 self.state = LOCKOUT
             return DISCARD
         if e == 6:
+            # BD frames bypass Wait, but the buffer is finite: a BD frame that finds it full is
+            # discarded and counted (never an older frame pushed out, which would lose an
+            # accepted AD frame and leave the AD count wrong; MicroPython's deque would raise)
+            if len(self.buffer) >= self._capacity:
+                self.bd_dropped += 1
+                return DISCARD
             self._accept(frame)
             self.farm_b = (self.farm_b + 1) & 0xFF
             return ACCEPT

@@ -31,6 +31,8 @@ COUNTERS = (
     "tm_unknown_vc",
     "tm_frames",
     "tc_rejected",
+    "tm_spilled",
+    "tm_idle_frames",
 )
 
 
@@ -69,6 +71,17 @@ class FrameProcessor:
     ``rejected_listeners`` is called with (outcome, VC ID, SPI, sequence number). With
     ``tm_security`` (an ``obsw.frames.sdls_gcm.TmSecurity``) the TM frames of the VCs it has
     SAs for are encrypted and authenticated (SDLS AES-GCM).
+
+    The downlink: with ``tm_coding`` (an ``obsw.frames.tm_coding.TmEncoder``) each frame leaves
+    channel coded, else as a CADU (ASM and pseudo-randomizer). With ``downlink_bps`` the link is
+    a radio of that rate, always transmitting: ``tm_output`` hands out only the frames the
+    radio has room for (``obsw.frames.downlink.Downlink``), full frames by VC priority, a
+    partly filled one of priority ``tm_urgent`` or higher at once (real-time and essential
+    telemetry keep their period), a lower one when the radio would otherwise send idle data,
+    and an idle frame only when nothing waits. With ``tm_spill`` (octets) a packet whose VC is
+    full waits in a spill store (``tm_spilled``) until the VC has room; when that is full too
+    the packet is dropped, counted (``tm_dropped``) and each of ``overflow_listeners`` is called
+    with (VC ID, packet), so the host reports it (an event): never a silent drop.
     """
 
     def __init__(
@@ -94,6 +107,10 @@ class FrameProcessor:
         ep=None,
         ep_map=62,
         ep_apid=None,
+        tm_coding=None,
+        downlink_bps=None,
+        tm_urgent=2,
+        tm_spill=0,
     ):
         self.scid = scid
         self.route = route
@@ -146,6 +163,20 @@ class FrameProcessor:
             self.counters[name] = 0
         self._report = True  # send a CLCW soon
         self._last_tm = None
+        self.tm_coding = tm_coding
+        self.downlink = None
+        if downlink_bps:
+            from obsw.frames.downlink import Downlink
+
+            octets = tm_coding.channel_length if tm_coding is not None else tm_frame_length + 4
+            self.downlink = Downlink(downlink_bps, octets)
+        self.tm_urgent = tm_urgent
+        self.spill = None
+        if tm_spill:
+            from obsw.frames.downlink import Spill
+
+            self.spill = Spill(tm_spill)
+        self.overflow_listeners = []  # callables(vcid, packet)
 
     def _count(self, name, n=1):
         self.counters[name] += n
@@ -282,10 +313,18 @@ class FrameProcessor:
         except KeyError:
             self._count("tm_unknown_vc")
             return False
-        if channel.push(packet):
+        spill = self.spill
+        if spill is not None and (spill.waiting(vcid) or channel.room() < len(packet)):
+            if spill.put(vcid, bytes(packet)):
+                self._count("tm_packets")
+                self._count("tm_spilled")
+                return True
+        elif channel.push(packet):
             self._count("tm_packets")
             return True
         self._count("tm_dropped")
+        for fn in self.overflow_listeners:
+            fn(vcid, packet)
         return False
 
     def send_playback(self, packet):
@@ -297,7 +336,10 @@ class FrameProcessor:
 
     def tm_output(self, now, flush=True):
         """CADUs to write to both links: full frames by priority, then (with ``flush``) the
-        rest padded with idle data, and an idle frame with the CLCW when one is due."""
+        rest padded with idle data, and an idle frame with the CLCW when one is due; with
+        ``downlink_bps``, what the radio has room for now (see the class)."""
+        if self.downlink is not None:
+            return self._paced(now)
         out = []
         while True:
             f = self.mux.frame(flush)
@@ -311,4 +353,28 @@ class FrameProcessor:
             self._report = False
             self._last_tm = now
         self._count("tm_frames", len(out))
-        return [cadu(f.pack(), self.tm_randomize) for f in out]
+        return [self._channel(f) for f in out]
+
+    def _channel(self, frame):
+        if self.tm_coding is not None:
+            return self.tm_coding.encode(frame.pack())
+        return cadu(frame.pack(), self.tm_randomize)
+
+    def _paced(self, now):
+        out = []
+        mux = self.mux
+        for _ in range(self.downlink.due(now)):
+            if self.spill is not None:
+                self.spill.refill(mux)
+            f = mux.frame(True, False, self.tm_urgent)
+            if f is None:
+                f = mux.frame(True)
+            if f is None:
+                f = mux.frame(False, True)
+                self._count("tm_idle_frames")
+            out.append(self._channel(f))
+        if out:
+            self._report = False
+            self._last_tm = now
+            self._count("tm_frames", len(out))
+        return out

@@ -11,6 +11,9 @@ IV as sequence number (``obsw.frames.sdls_gcm``; ``sn_length`` does not apply, `
 the IV block saved ahead, 64 by default). ``link``: "tc" (default) or "tm" (one SA per TM VC,
 GCM only). SPIs are unique across the file.
 
+``sent`` (optional): the highest sequence number (IV) this copy of the key may have sent;
+the next frame sends above it. The host keeps it up to date before each number is used.
+
 ``map_id`` null: the SA secures every MAP of its VC that has no SA of its own. ``window``: how
 far below the highest accepted sequence number a number not seen yet is still taken;
 ``ahead``: how far above it (null: any). ``state`` is
@@ -44,6 +47,7 @@ _STATES = {
     "expired": SA_EXPIRED,
 }
 _FIELDS = (
+    "sent",
     "spi",
     "vcid",
     "map_id",
@@ -137,6 +141,13 @@ def load_sas(text):
                 )
         except SdlsError as err:
             raise KeyFileError("%s: %s" % (where, err)) from None
+        # the highest number this copy of the key may have sent (reserved before use, see
+        # ``obsw_host.frames.keys``): kept with the key, so losing a state file cannot make
+        # the SA send a number (a GCM IV) again
+        sent = _number(e, "sent", 0, where)
+        if sent < 0:
+            raise KeyFileError("%s: sent must be 0 or more, got %d" % (where, sent))
+        sa.sn_sent = sa.sn_reserved = sent
         sa.link = link
         for other in out:
             if other.spi == sa.spi:
@@ -188,5 +199,8 @@ def dump_sas(sas):
             entry["reserve"] = sa.reserve_block
         if sa.link != "tc":
             entry["link"] = sa.link
+        sent = max(sa.sn_sent, sa.sn_reserved)
+        if sent:
+            entry["sent"] = sent
         entries.append(entry)
     return json.dumps({"format": FORMAT, "version": VERSION, "sas": entries})

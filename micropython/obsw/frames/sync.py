@@ -111,6 +111,7 @@ class FrameSync:
         self._buf = b""
         self._base = 0  # stream position of _buf[0]
         self._count = 0
+        self._kept = 0  # bits of _buf already consumed (held for a slip look-back)
 
     def _errors(self, buf, pos):
         # wrong bits of the ASM at pos, for the current polarity
@@ -154,7 +155,7 @@ class FrameSync:
         """Take bits (one per octet); return the SyncedFrames completed by them."""
         buf = self._buf + bytes(bits) if self._buf else bytes(bits)
         out = []
-        pos = 0
+        pos = self._kept  # the bits before it are kept to find an ASM that came early
         total = _ASM_BITS + 8 * self.length
         while True:
             if self.state == SEARCH:
@@ -217,8 +218,10 @@ class FrameSync:
             self.frames += 1
             self.asm_errors += e
             pos += total
-        self._buf = buf[pos:]
-        self._base += pos
+        keep = min(pos, self.slip) if self.state != SEARCH else 0
+        self._buf = buf[pos - keep :]
+        self._base += pos - keep
+        self._kept = keep
         return out
 
     def take_events(self):

@@ -29,6 +29,8 @@ class TmEncoder:
         self.rs = ReedSolomon(e, depth, frame_length) if self.has_rs else None
         self.conv = ConvEncoder() if self.has_conv else None
         self.cadu_length = self.rs.block_length + 4 if self.rs else frame_length + 4
+        # octets on the channel per frame (the convolutional code doubles them)
+        self.channel_length = self.cadu_length * 2 if self.conv else self.cadu_length
 
     def encode(self, frame):
         if len(frame) != self.frame_length:
@@ -52,17 +54,69 @@ class DecodedFrame:
         self.error = error
 
 
+class SymbolCheck:
+    """Channel symbols the Viterbi decoder corrected: its bits re-encoded and compared with
+    the hard decisions of the symbols that went in (``errors``, of ``symbols`` compared). Only
+    symbols decoded while the frame synchronizer holds lock count (without lock the symbol
+    pairing may be wrong); after a realignment the symbols in flight are forgotten and the
+    first K-1 bits are not counted."""
+
+    def __init__(self):
+        from obsw.frames.conv import branch_symbols
+
+        self._branch = branch_symbols
+        self.errors = 0
+        self.symbols = 0
+        self._hard = bytearray()
+        self._state = 0
+        self._warmup = 0
+        self._skip = False
+
+    def feed(self, soft, bits):
+        h = self._hard
+        start = 1 if self._skip and len(soft) else 0
+        if start:
+            self._skip = False
+        for i in range(start, len(soft)):
+            h.append(1 if soft[i] > 0 else 0)
+        branch = self._branch
+        st = self._state
+        e = 0
+        k = 0
+        for b in bits:
+            if k + 1 >= len(h):
+                break
+            if self._warmup:
+                self._warmup -= 1
+            else:
+                c1, c2 = branch(st, b)
+                e += (c1 != h[k]) + (c2 != h[k + 1])
+                self.symbols += 2
+            st = ((st << 1) | b) & 0x3F
+            k += 2
+        self._state = st
+        self._hard = h[k:]
+        self.errors += e
+
+    def realign(self, skipping):
+        self._hard = bytearray()
+        self._skip = skipping
+        self._warmup = 6
+
+
 class TmDecoder:
     """The ground side: ``feed_bits`` (hard bits, one per octet), ``feed_octets`` (hard
     octets) or ``feed_soft`` (soft symbols, positive means 1) give DecodedFrames.
 
-    Counters: ``frames``, ``corrected`` (RS symbols), ``uncorrectable`` (codeblocks), and
-    the synchronizer's (``sync.locks``, ``sync.losses``, ``sync.slips``). With the
-    convolutional code, a stream that finds no lock within ``realign`` CADUs is shifted by one
-    symbol (the pair alignment of a stream joined in the middle is unknown)."""
+    Counters: ``frames``, ``corrected`` (RS symbols), ``uncorrectable`` (codeblocks), with
+    ``count_symbols`` ``symbol_errors`` (channel symbols the Viterbi decoder corrected, see
+    ``SymbolCheck``; 0 without the convolutional code), and the synchronizer's (``sync.locks``,
+    ``sync.losses``, ``sync.slips``). With the convolutional code, a stream that finds no lock
+    within ``realign`` CADUs is shifted by one symbol (the pair alignment of a stream joined in
+    the middle is unknown)."""
 
     def __init__(self, frame_length, coding="none", e=16, depth=1, randomize=True,
-                 sync=None, realign=3):  # fmt: skip
+                 sync=None, realign=3, count_symbols=False):  # fmt: skip
         from obsw.frames.sync import FrameSync
 
         self.has_rs, self.has_conv = _check(coding)
@@ -76,6 +130,7 @@ class TmDecoder:
         self.corrected = 0
         self.uncorrectable = 0
         self.viterbi = None
+        self.check = SymbolCheck() if count_symbols and self.has_conv else None
         self._realign = realign * 8 * (length + 4)
         self._unlocked = 0
         if self.has_conv:
@@ -97,19 +152,34 @@ class TmDecoder:
         if not self.has_conv:
             return self.feed_bits(bytes(1 if s > 0 else 0 for s in soft))
         bits = self.viterbi.feed(soft)
+        check = self.check
+        if check is not None:
+            before = (check.errors, check.symbols)
+            check.feed(soft, bits)
         out = self.feed_bits(bits)
+        if check is not None and self.sync.state == 0:  # no lock: the pairing may be wrong
+            check.errors, check.symbols = before
         if self.sync.state == 0 and not out:
             self._unlocked += len(bits)
             if self._unlocked > self._realign:
                 self._unlocked = 0
                 self.viterbi.realign()
+                if self.check is not None:
+                    self.check.realign(self.viterbi.skipping)
         else:
             self._unlocked = 0
         return out
 
+    @property
+    def symbol_errors(self):
+        return self.check.errors if self.check is not None else 0
+
     def flush(self):
         """Decode what the Viterbi decoder and the synchronizer still hold (end of a pass)."""
-        out = self.feed_bits(self.viterbi.flush()) if self.viterbi is not None else []
+        bits = self.viterbi.flush() if self.viterbi is not None else b""
+        if self.check is not None:
+            self.check.feed((), bits)
+        out = self.feed_bits(bits) if self.viterbi is not None else []
         return out + self._frames(self.sync.flush())
 
     def feed_bits(self, bits):

@@ -39,6 +39,10 @@ class TmVirtualChannel:
     def pending(self):
         return len(self._buf)
 
+    def room(self):
+        """Octets a packet may have to be queued now."""
+        return self.capacity - len(self._buf)
+
     def pad(self, data_length):
         """Complete a partly filled frame with an idle packet (it may spill into the next)."""
         r = len(self._buf) % data_length
@@ -70,8 +74,8 @@ class TmMultiplexer:
     ``ocf`` is a callable returning the 4-byte operational control field (the CLCW) or None for
     frames without one. ``frame(flush, idle)`` returns the next TmFrame: a full frame from the
     highest-priority channel that has one; with ``flush`` a partly filled channel is padded
-    with an idle packet; with ``idle`` and nothing to send, an only-idle-data frame on
-    ``idle_vcid``. Otherwise None.
+    with an idle packet (with ``urgent`` only channels of that priority or higher are); with
+    ``idle`` and nothing to send, an only-idle-data frame on ``idle_vcid``. Otherwise None.
 
     With ``security`` (an ``obsw.frames.sdls_gcm.TmSecurity``) the frames of each VC that has
     an SA carry SDLS: the packets fill the data field less the security header and trailer,
@@ -118,11 +122,12 @@ class TmMultiplexer:
             return self.data_length
         return self.data_length - self.security.overhead(vcid)
 
-    def frame(self, flush=False, idle=False):
+    def frame(self, flush=False, idle=False, urgent=None):
         for c in self.channels:
             d = self._room(c.vcid)
             got = c.take(d)
-            if got is None and flush and c.pending():
+            pad = flush and (urgent is None or c.priority >= urgent)
+            if got is None and pad and c.pending():
                 c.pad(d)
                 got = c.take(d)
             if got is not None:

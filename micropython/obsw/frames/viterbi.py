@@ -66,6 +66,11 @@ class Viterbi27:
         self._skip = pending is None
         self._pending = pending or []
 
+    @property
+    def skipping(self):
+        """True while the next symbol fed is to be dropped (after ``realign``)."""
+        return self._skip
+
     def metric_spread(self):
         """Best path metric minus the mean: grows with clean symbols, a symbol-pair slip or
         noise keeps it low (used to choose the symbol alignment of a stream)."""

@@ -123,10 +123,29 @@ def _char_at(b, i):
         return "\\x%02x" % b[i]
 
 
+def _utf8(src):
+    """``src`` as UTF-8; a character UTF-8 cannot hold (a lone surrogate) is a syntax error
+    at its line and column, not a UnicodeError."""
+    try:
+        return src.encode()
+    except UnicodeError:
+        line, col = 1, 1
+        for c in src:
+            if 0xD800 <= ord(c) <= 0xDFFF:
+                break
+            if c == "\n":
+                line, col = line + 1, 1
+            else:
+                col += 1
+        raise PlutoSyntaxError(
+            "character %r is not Unicode text (a lone surrogate)" % c, line, col
+        ) from None
+
+
 def tokenize(src, compact=False):
     """List of (kind, value, pos) tuples ending with an EOF token (``compact``: a Tokens of
     them); raises PlutoSyntaxError. Columns count characters."""
-    b = src.encode() if isinstance(src, str) else bytes(src)
+    b = _utf8(src) if isinstance(src, str) else bytes(src)
     cls = _CLASS
     out = Tokens(len(b) // 4 + 8) if compact else []
     i, n = 0, len(b)

@@ -87,6 +87,9 @@ class ParameterPool:
         what it holds (see the module text); returns how many values it held."""
         self.store = store
         saved = store.load(STORE_NAME) or {}
+        if not isinstance(saved, dict):  # not what this writes: start clean, counted
+            self.rejected += 1
+            saved = {}
         for key, raw in saved.items():
             try:
                 pid = int(key)

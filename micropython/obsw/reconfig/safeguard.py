@@ -88,7 +88,11 @@ class Safeguard:
         return bytes(ecc.encode(plain))
 
     def decode(self, record, raw):
-        """(seq, payload, corrected bits) of a slot's bytes, or None if it holds no valid copy."""
+        """(seq, payload, corrected bits) of a slot's bytes, or None if it holds no valid copy;
+        RecordError for bytes that are not a slot's length (a read of the wrong size)."""
+        want = self.blocks * ecc.CODED
+        if len(raw) != want:
+            raise RecordError("slot of %d octets, expected %d" % (len(raw), want), record)
         try:
             plain, fixed = ecc.decode(raw, self.blocks)
         except ecc.EccError:
@@ -113,7 +117,7 @@ class Safeguard:
                 self.counters["retries"] += 1
             try:
                 got = self.decode(record, dev.read(addr, n))
-            except OSError:
+            except (OSError, RecordError):  # a failed or short transfer: try again
                 self.counters["device_errors"] += 1
                 continue
             if got is not None:
@@ -189,7 +193,7 @@ class Safeguard:
         got = None
         try:
             got = self.decode(record, dev.read(addr, len(raw)))
-        except OSError:
+        except (OSError, RecordError):
             self.counters["device_errors"] += 1
         if got is not None and got[0] == seq and got[1] == payload:
             seqs[slot] = seq

@@ -10,7 +10,8 @@ The manifest is UTF-8 JSON in canonical form (keys sorted, no spaces), signed wi
     {"format": 1, "mission": NAME, "target": "obc" | "reconfig", "version": TEXT,
      "base": null or the version the package applies to, "created": ISO-8601 UTC,
      "files": [{"path": P, "size": N, "sha256": HEX}, ..],   the bytes carried, in order
-     "tree": {P: HEX, ..}}                                     every file of the result
+     "tree": {P: HEX, ..},                                     every file of the result
+     "downgrade": true}              optional: this package may replace a newer version
 
 A full package carries every file of its tree; a delta (``base`` set) carries only the files
 that differ from its base's, and the receiver takes the others from the base, each checked
@@ -28,6 +29,7 @@ import hashlib
 import json
 import struct
 
+from obsw import jsonsafe
 from obsw.compat import const
 
 MAGIC = b"OBSWPKG1"
@@ -36,6 +38,7 @@ SIGNATURE_SIZE = const(64)
 TARGETS = ("obc", "reconfig")
 _MAX_MANIFEST = const(1 << 20)
 _CHUNK = const(1024)
+_MAX_DEPTH = const(8)  # a manifest nests 3 deep: object, "files" list, file object
 
 
 class PackageError(ValueError):
@@ -76,6 +79,12 @@ class BadPath(PackageError):
     code = "bad_path"
 
 
+class Rollback(PackageError):
+    """An older version than the one the OBC's floor allows, without a signed ``downgrade``."""
+
+    code = "rollback"
+
+
 REASONS = (
     "bad_package",
     "bad_magic",
@@ -86,7 +95,34 @@ REASONS = (
     "wrong_target",
     "hash_mismatch",
     "bad_path",
+    "rollback",
 )
+
+
+def version_key(text):
+    """A sort key of a version text: dot-separated parts, each compared by its leading number
+    and then by the rest ("1.10" > "1.9" > "1.9rc1" > "1"), so that any two versions order."""
+    out = []
+    for part in str(text).split("."):
+        i = 0
+        while i < len(part) and "0" <= part[i] <= "9":
+            i += 1
+        rest = part[i:]  # a suffix marks a pre-release: "9rc1" before "9"
+        out.append((int(part[:i]) if i else -1, 0 if rest else 1, rest))
+    return tuple(out)
+
+
+def check_floor(manifest, floor):
+    """Rollback unless ``manifest``'s version is ``floor`` or newer, or it allows a downgrade
+    (a field of the signed manifest, so only the key's holder can allow one)."""
+    if floor is None or manifest.get("downgrade") is True:
+        return manifest
+    if version_key(manifest["version"]) < version_key(floor):
+        raise Rollback(
+            "version %s is older than %s, the oldest this OBC takes (a package that may "
+            "downgrade says so in its signed manifest)" % (manifest["version"], floor)
+        )
+    return manifest
 
 
 def canonical(manifest):
@@ -105,7 +141,7 @@ def _json(v):
 
 def check_path(path):
     """``path`` if it is a relative POSIX path inside the package's root, else BadPath."""
-    if not isinstance(path, str) or not path or path[0] == "/" or "\\" in path:
+    if not isinstance(path, str) or not path or path[0] == "/" or "\\" in path or "\0" in path:
         raise BadPath("file path %r: not a relative POSIX path" % (path,))
     for part in path.split("/"):
         if part in ("", ".", ".."):
@@ -135,6 +171,8 @@ def check_manifest(m):
     for key in ("mission", "target", "version", "created"):
         if not isinstance(m.get(key), str) or not m[key]:
             raise BadManifest("manifest: %r missing or not text" % key)
+    if "downgrade" in m and not isinstance(m["downgrade"], bool):
+        raise BadManifest("manifest: 'downgrade' is neither true nor false")
     base = m.get("base")
     if base is not None and not isinstance(base, str):
         raise BadManifest("manifest: 'base' is neither null nor text")
@@ -174,9 +212,9 @@ class Reader:
         if not verify(key, self.signature, self.manifest_bytes):
             raise BadSignature("the manifest's signature does not verify with the mission's key")
         try:
-            m = json.loads(self.manifest_bytes)
-        except ValueError:
-            raise BadManifest("manifest: not JSON") from None
+            m = jsonsafe.loads(self.manifest_bytes, _MAX_DEPTH)
+        except ValueError as e:  # not JSON, not UTF-8, or nested deeper than a manifest is
+            raise BadManifest("manifest: not JSON (%s)" % e) from None
         self.manifest = check_manifest(m)
         if m["mission"] != mission:
             raise WrongMission("package for mission %r, this is %r" % (m["mission"], mission))

@@ -5,7 +5,9 @@ link takes) into TM[13,1] first, TM[13,2] intermediate and TM[13,3] last parts, 
 ``parts_per_cycle`` per application process cycle; ``abort_downlink`` stops one. Uplink:
 TC[13,9], [13,10] and [13,11] parts are put back together in sequence; a part out of
 sequence, a message above ``max_size``, or no part for ``timeout`` seconds aborts the
-reception with a TM[13,16] uplink abortion report. A complete message is handed to
+reception with a TM[13,16] uplink abortion report. At most ``max_receptions`` receptions
+are in progress at once (so at most that many times ``max_size`` octets are held); a first
+part beyond them is refused (service 1 failure, nothing kept). A complete message is handed to
 ``deliver`` (default: the application process, as the TC packet it holds).
 
 Each part carries the large message transaction ID, the part sequence number (the first part
@@ -62,6 +64,9 @@ def split(message, part_size):
     return parts
 
 
+MAX_RECEPTIONS = const(4)  # uplink receptions in progress at once (docs/hardening.md)
+
+
 class _Reception:
     __slots__ = ("tid", "seq", "parts", "size", "last", "source")
 
@@ -91,9 +96,17 @@ class LargePacketTransfer(Service):
     )
 
     def __init__(
-        self, part_size=256, timeout=10.0, max_size=65542, parts_per_cycle=8, deliver=None
+        self,
+        part_size=256,
+        timeout=10.0,
+        max_size=65542,
+        parts_per_cycle=8,
+        deliver=None,
+        max_receptions=MAX_RECEPTIONS,
     ):
         super().__init__()
+        self.max_receptions = max_receptions
+        self.refused = 0
         self.part_size = part_size
         self.timeout = timeout
         self.max_size = max_size
@@ -122,6 +135,14 @@ class LargePacketTransfer(Service):
         tid = tc["tid"]
         rx = self.receptions.get(tid)
         if kind == 0:
+            if rx is None and len(self.receptions) >= self.max_receptions:
+                self.refused += 1
+                raise PusFailure(
+                    FAILURE_REFUSED,
+                    "%d large packet receptions in progress already: at most %d"
+                    % (len(self.receptions), self.max_receptions),
+                    TRANSACTION_ID.pack(tid),
+                )
             rx = self.receptions[tid] = _Reception(tid, self._now(), req.source)
         if rx is None or tc["seq"] != rx.seq + 1:
             self._abort(tid, ABORT_SEQUENCE, req.source)

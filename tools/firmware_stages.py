@@ -36,6 +36,10 @@ TWO_ENDS = (
     "ground's user process, CFDP entities at both ends): beyond a 103 KiB heap"
 )
 FILE19K = "a 19 KB file held four times (the data, both RAM filestores, the expected copy)"
+CUTS20K = (
+    "a 20 KB file through eight power cuts in RAM filestores (the data, the partial file, its "
+    "state, the expected copy, both entities): beyond a 103 KiB heap"
+)
 TOKENS = "a 12 KB procedure text of 6,000 tokens (48 KB of token columns) in a 103 KiB heap"
 MEMORY = (
     "memory areas with their copies as files in a RAM filestore (10 KiB chunks), the PUS "
@@ -48,6 +52,8 @@ VITERBI = (
 CORTEX_M_SKIPS = {
     "test_frames_sync.py::TestChains::test_every_coding_round_trips": VITERBI,
     "test_frames_sync.py::TestChains::test_concatenated_inverted_and_noisy": VITERBI,
+    "test_frames_downlink.py::DownlinkTest::test_coded_frames_take_the_coded_length": VITERBI,
+    "test_cfdp_durability.py::TestReceiverCuts::test_cuts_through_a_transfer": CUTS20K,
     "test_pus_random_requests.py": TWO_ENDS,
     "test_pus_mission_services.py::TestProvider::"
     "test_random_application_data_gets_a_verdict_never_an_exception": TWO_ENDS,

@@ -108,6 +108,7 @@ class Store:
         self.saves = 0
         self.recovered = 0  # loads that found only the new file (a cut between remove and rename)
         self.damaged = 0  # files ignored because they were incomplete
+        self.rejected = []  # names set aside (``NAME.bad``) or refused by their service
         if hasattr(self.fs, "makedirs"):
             self.fs.makedirs(self.root)
 
@@ -180,7 +181,24 @@ class Store:
         if got is not None:
             self.recovered += 1
             return got[0]
+        if self.fs.exists(path):  # damaged, and no new copy: not a cut, set aside for good
+            self.set_aside(name)
         return default
+
+    def set_aside(self, name):
+        """Keep ``name``'s file as ``NAME.bad`` (never read again) and note it in
+        ``rejected``: the unit starts clean, the OBC reports it."""
+        path = self.path(name)
+        fs = self.fs
+        try:
+            if fs.exists(path + ".bad"):
+                fs.remove(path + ".bad")
+            if fs.exists(path):
+                fs.rename(path, path + ".bad")
+        except OSError:
+            pass
+        if name not in self.rejected:
+            self.rejected.append(name)
 
     def delete(self, name):
         path = self.path(name)

@@ -159,3 +159,11 @@ class TestFileDataFastPath(unittest.TestCase):
         b.receive(pdus[3][:-5], 0.0)  # its length field says more than came
         self.assertEqual(b.stats["decode_errors"], 1)
         self.assertEqual(bytes(b.fs.files[list(b.fs.files)[0]]), before)
+
+    def test_pdus_shorter_than_a_header_are_decode_errors(self):
+        b, pdus = self.pdus()
+        for p in pdus[:3]:
+            b.receive(p, 0.0)
+        for n in range(4):  # the first octets of a file data PDU, the fast path set
+            self.assertIsNone(b.receive(pdus[3][:n], 0.0))
+        self.assertEqual(b.stats["decode_errors"], 4)

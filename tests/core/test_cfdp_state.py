@@ -142,13 +142,15 @@ class TestFileGone(unittest.TestCase):
         tid = a.put(2, "src.bin", "dst.bin")
         link = Link(a, b)
         link.step()
-        del files.files["src.bin"]  # deleted before a handle was opened to read it
-        a.find(tid)._fh = None
+        del files.files["src.bin"]  # deleted under the transfer: what was not read yet is gone
+        tx = a.find(tid)
+        tx._fh = None
+        tx._ra = None  # nor read ahead
         self.assertTrue(link.run())
         conds = [i.info["condition"] for i in link.finished(0)]
         self.assertEqual(len(conds), 1)
         self.assertIn(conds[0], (FILESTORE_REJECTION, CANCEL_REQUEST_RECEIVED))
-        self.assertEqual(a.stats["filestore_errors"], 1)
+        self.assertEqual(a.stats["internal_errors"], 0)  # a fault, not a defect
         self.assertEqual(a.tx, {})
         self.assertEqual(b.tx, {})
         # nothing of it is left to restore, and the entity still sends files

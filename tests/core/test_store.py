@@ -74,6 +74,20 @@ class TestStore(unittest.TestCase):
             self.assertEqual(store.load("a", "none"), "none")
             self.assertEqual(store.damaged, 1)
 
+    def test_a_damaged_file_with_no_new_copy_is_set_aside(self):
+        fs = SimFs({"/ctx/a": b"junk\n{}", "/ctx/b": encode(OLD)})
+        store = Store("/ctx", fs)
+        self.assertEqual(store.load("a", "none"), "none")
+        self.assertEqual(store.rejected, ["a"])
+        self.assertEqual(fs.files["/ctx/a.bad"], b"junk\n{}")
+        self.assertTrue("/ctx/a" not in fs.files)
+        self.assertEqual(store.load("a", "none"), "none")  # starts clean: nothing to reject
+        self.assertEqual((store.damaged, store.rejected), (1, ["a"]))
+        self.assertEqual(store.load("b"), OLD)
+        store.set_aside("b")  # what a service refuses goes the same way
+        self.assertEqual(store.rejected, ["a", "b"])
+        self.assertIsNone(store.load("b"))
+
     def test_bad_names(self):
         store = Store("/ctx", SimFs())
         for name in ("", "a/b", ".new"):

@@ -1,13 +1,17 @@
 """tools/bench/smoke.py: what it takes for a benchmark's figures, and what it refuses."""
 
+import importlib.util
 import pathlib
 import subprocess
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tools" / "bench"))
-
-import smoke  # noqa: E402
+# loaded by its file: tools/bench on sys.path would shadow the peers (its spacecan.py)
+_spec = importlib.util.spec_from_file_location(
+    "bench_smoke", ROOT / "tools" / "bench" / "smoke.py"
+)
+smoke = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(smoke)
 
 ROW = {"case": "c", "impl": "obsw", "value": 1.5, "unit": "u", "higher_is_better": True}
 

@@ -189,11 +189,15 @@ def test_no_content_of_any_state_file_stops_a_start(obc):
     names = [os.path.relpath(f, obc.state) for f in files]
     assert {"context/parameters", "software/boot.json", "cfdp/seq"} <= set(names), names
     for content in SPOILED:
-        for path in state_files(obc.state):
+        spoiled = state_files(obc.state)
+        for path in spoiled:
             with open(path, "wb") as f:
                 f.write(content)
         obc.lines.clear()
         obc.start(wait=False)
         assert obc.wait_up() and obc.ping(), (content[:10], obc.text())
         assert not obc.said("Traceback"), obc.text()
+        if os.path.join(obc.state, "context", "parameters") in spoiled:  # set aside once
+            said = "context state parameters set aside"
+            assert wait_for(lambda s=said: obc.said(s)), (content[:10], obc.text())
         obc.stop()

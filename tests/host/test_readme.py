@@ -43,6 +43,9 @@ SKIP = {  # a piece of the line -> why it does not run here
     "tests/fuzz/run.py --inputs 1000000": "the long fuzz run takes hours",
     "mkdocs serve": "serves the site until Ctrl-C (tools/test builds it)",
 }
+EXPORT = re.compile(r"^export ([A-Z_][A-Z0-9_]*)=(\S+)$")  # a variable the terminal keeps
+# lines a SKIP piece names that run in seconds and change nothing: they run
+RUN_ANYWAY = ("tools/bench/report.py check",)
 TOP_FOLDER = "# from the top folder"  # a shell block that starts so runs from the top folder
 RAN_AT_LEAST = 100  # examples run over all pages
 # every skip names where it is covered or what it needs; most are the hardware guides' lines
@@ -68,6 +71,8 @@ def shell_lines(body):
         command, expected = _command(line)
         if command:
             reason = next((why for piece, why in SKIP.items() if piece in command), None)
+            if any(piece in command for piece in RUN_ANYWAY):
+                reason = None
             out.append((command, expected, reason))
     return out
 
@@ -194,6 +199,14 @@ def test_every_example_runs(page, tmp_path):
                     continue
                 for old, new in ports.items():
                     command = command.replace(old, new)
+                exported = EXPORT.match(command)
+                if exported:  # the terminal keeps it for the lines that follow
+                    name, value = exported.groups()
+                    echo = ["bash", "-c", 'printf %%s "%s"' % value]
+                    env[name] = subprocess.run(echo, env=env, cwd=cwd, capture_output=True,
+                                               text=True).stdout  # fmt: skip
+                    ran += 1
+                    continue
                 if command.endswith("&"):
                     server = Server(command[:-1].strip(), env, cwd)
                     servers.append(server)

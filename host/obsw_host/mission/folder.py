@@ -82,6 +82,8 @@ def read_text(path, limit=MAX_JSON_FILE, root=None):
     fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     try:
         st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):  # said as for any file the user names (obsw_host.errors)
+            raise IsADirectoryError(errno.EISDIR, os.strerror(errno.EISDIR), path)
         if not stat.S_ISREG(st.st_mode):
             raise MissionFileError(errno.EINVAL, "not a regular file", path)
         if st.st_size > limit:

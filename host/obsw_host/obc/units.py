@@ -262,7 +262,18 @@ class PusUnit:
         n = min(restarts, 65535)
         self.unit_event("platform.task_restarted", {"task": name, "restarts": n})
 
+    def _report_rejected(self):
+        """Context store entries set aside at start: one event each, raised once."""
+        store = self.app.store
+        for name in getattr(store, "rejected", ())[self._rejected_reported :]:
+            self.out("context state %s set aside (%s.bad): its unit starts clean" % (name, name))
+            self.unit_event("platform.state_rejected", {"unit": "context/" + name})
+        self._rejected_reported = len(getattr(store, "rejected", ()))
+
+    _rejected_reported = 0
+
     async def _health_task(self):
+        self._report_rejected()
         while self._running:
             self.health.sample()
             await asyncio.sleep(self.health_period)

@@ -1,7 +1,7 @@
 metadata(
     version="0.1.0",
-    description="the package and what every part needs: clocks, CRCs, space packets, time codes",
+    description="what every part needs: clocks, CRCs, bounded JSON, space packets, time codes",
 )
 
-for _m in ("__init__.py", "compat.py", "crc.py", "spp.py", "utc.py", "timecode.py"):
+for _m in ("__init__.py", "compat.py", "crc.py", "jsonsafe.py", "spp.py", "utc.py", "timecode.py"):
     module("obsw/" + _m, base_path="../../../micropython")

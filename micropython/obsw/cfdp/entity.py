@@ -284,7 +284,7 @@ class CfdpEntity:
         """Take one PDU from the link. Malformed or misrouted PDUs are counted, never raised.
         Returns the decoded PDU, or None (also for the file data taken on the fast path)."""
         fast = self._fd_fast
-        if fast is not None and buf[0] == fast[0]:
+        if fast is not None and len(buf) > fast[2] + 4 and buf[0] == fast[0]:
             hl = fast[2]
             end = hl + ((buf[1] << 8) | buf[2])
             if hl + 4 < end <= len(buf) and buf[3:hl] == fast[1]:

@@ -182,7 +182,15 @@ class Sender(Transaction):
 
     def _send_eof(self, condition, now, fault_location=None):
         size = self.size if condition == NO_ERROR else self.progress
-        checksum = self._checksum_upto(size) if self.source_name else 0
+        checksum = 0
+        if self.source_name:
+            try:
+                checksum = self._checksum_upto(size)
+            except OSError:
+                if condition == NO_ERROR:
+                    raise
+                # the file went away (the fault being reported): the EOF (cancel) still goes
+                # out so the receiver is told; it does not check a cancelled file's checksum
         hdr = self.directive_header()
         self.eof = EofPdu(hdr, condition, checksum, size, fault_location).pack()
         self.indicate("eof_sent")

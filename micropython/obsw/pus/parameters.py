@@ -87,9 +87,12 @@ class ParameterPool:
         what it holds (see the module text); returns how many values it held."""
         self.store = store
         saved = store.load(STORE_NAME) or {}
-        if not isinstance(saved, dict):  # not what this writes: start clean, counted
+        if not isinstance(saved, dict):  # not what this writes: set aside, start clean
             self.rejected += 1
             saved = {}
+            set_aside = getattr(store, "set_aside", None)
+            if set_aside is not None:
+                set_aside(STORE_NAME)
         for key, raw in saved.items():
             try:
                 pid = int(key)

@@ -60,6 +60,9 @@ class Service:
                     self.restore(ctx)
                 except (ValueError, TypeError, KeyError, IndexError, AttributeError):
                     app.count("context_rejected")
+                    set_aside = getattr(app.store, "set_aside", None)
+                    if set_aside is not None:
+                        set_aside(self.NAME)
 
     def handler(self, subtype):
         return self._handlers.get(subtype)

@@ -4,9 +4,9 @@ With ``$OBSW_TRACEMALLOC`` naming a folder, each process (the platform manager a
 process) traces its allocations from its start (``tracemalloc``, a few frames deep) and, on
 SIGUSR2, writes a snapshot there as ``NAME-PID-N.snap`` (``$OBSW_TRACEMALLOC_FRAMES`` sets
 the frames kept, default 4); with ``$OBSW_TRACEMALLOC_PERIOD`` (seconds) it also appends the
-memory it traces now to ``NAME-PID.traced`` that often. Without it nothing is traced and the
-signal keeps its default. ``growers(old, new)`` names the lines whose memory grew most between
-two snapshots of one process.
+memory it traces now, and tracemalloc's own, to ``NAME-PID.traced`` that often. Without it
+nothing is traced and the signal keeps its default. ``growers(old, new)`` names the lines
+whose memory grew most between two snapshots of one process.
 """
 
 import os
@@ -46,14 +46,17 @@ def install(name):
 
 
 def _record(path, period):
-    """Append 'unix-time traced-bytes' to ``path`` every ``period`` seconds (cheap: no
-    snapshot, so the process's memory does not jump as it does when one is taken)."""
+    """Append 'unix-time traced-bytes tracemalloc-bytes' to ``path`` every ``period`` seconds
+    (cheap: no snapshot, so the process's memory does not jump as it does when one is taken).
+    The third figure is tracemalloc's own memory, which grows with every new call path it sees
+    and is part of the process's RSS though the process does not hold it."""
     import time
     import tracemalloc
 
     while True:
         with open(path, "a") as f:
-            f.write("%.1f %d\n" % (time.time(), tracemalloc.get_traced_memory()[0]))
+            f.write("%.1f %d %d\n" % (time.time(), tracemalloc.get_traced_memory()[0],
+                                       tracemalloc.get_tracemalloc_memory()))  # fmt: skip
         time.sleep(period)
 
 

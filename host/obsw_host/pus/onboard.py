@@ -153,6 +153,22 @@ def service_table(sdb, table=SERVICES):
 UDP_MAX = 65536  # bytes: more than any UDP datagram carries (65,507 over IPv4)
 
 
+def _bound(host, port):
+    """A non-blocking UDP socket bound to ``host`` (a name, an IPv4 or an IPv6 address) and
+    ``port``: the first address the name gives that binds, as asyncio's endpoints do."""
+    error = None
+    for family, kind, proto, _, address in socket.getaddrinfo(host, port, 0, socket.SOCK_DGRAM):
+        sock = socket.socket(family, kind, proto)
+        try:
+            sock.setblocking(False)
+            sock.bind(address)
+            return sock
+        except OSError as e:
+            sock.close()
+            error = e
+    raise error or OSError("no address for %r" % host)
+
+
 class _Udp:
     """The process's UDP socket on the event loop: datagrams read straight into one buffer
     (``loop.add_reader``), TM sent straight from the socket (issue 41: asyncio's datagram
@@ -386,12 +402,9 @@ class Onboard:
         loop = asyncio.get_running_loop()
         self._loop = loop
         self._stopping = asyncio.Event()
-        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
-            sock.setblocking(False)
-            sock.bind((self.host, self.port))
+            sock = _bound(self.host, self.port)
         except OSError as e:
-            sock.close()
             self._error = e
             self._ready.set()
             raise

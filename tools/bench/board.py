@@ -92,8 +92,6 @@ CASES = (
     ("pus_tm_encode", "PUS TM encode (TM[3,25], 16 bytes)", 8),
     ("pluto_statement", "PLUTO statement (`i := i + 1;` in a while loop)", 8),
     ("update_verify", "update package: its manifest's Ed25519 signature (collections in)", 1),
-    ("tm_frame_rs", "TM frame of 223 octets: Reed-Solomon (255,223), randomizer, ASM", 2),
-    ("tm_frame_concatenated", "TM frame of 223 octets: RS, randomizer, ASM, K=7 rate 1/2", 2),
 )
 # the bench's own rig (a SpaceCAN controller playing the OBC, the modelled EEPROMs and DS3231)
 # shares the board's heap with the application: it gets this much on top of the Pyboard's

@@ -338,22 +338,6 @@ def _pus_tm_encode(rig):
     return op
 
 
-def _tm_frame(coding):
-    def make(rig):
-        """One 223-octet TM frame to the channel octets the radio sends (131.0-B)."""
-        from obsw.frames.tm_coding import TmEncoder
-
-        enc = TmEncoder(223, coding, 16, 1)
-        frame = bytes(range(223))
-
-        def op():
-            enc.encode(frame)
-
-        return op
-
-    return make
-
-
 PLUTO = """procedure
   initiate and confirm step Count
     declare variable i of type signed integer end declare
@@ -418,8 +402,6 @@ OPS = {
     "pus_tc_decode": _pus_tc_decode,
     "pus_tm_encode": _pus_tm_encode,
     "update_verify": _update_verify,
-    "tm_frame_rs": _tm_frame("rs"),
-    "tm_frame_concatenated": _tm_frame("concatenated"),
     "pluto_statement": _pluto,
 }
 

@@ -122,8 +122,10 @@ def test_twelve_steps_and_faults(mission, tmp_path, capsys):
 
         # each OBC process killed in turn: restarted, and the chain serves again
         for name in chain.config.processes:
-            pid = chain.pid_of(name)
-            assert pid is not None
+            # the platform names a process up at its first heartbeat, which may follow the
+            # first ping under load
+            pid = wait_for(lambda n=name: chain.pid_of(n))
+            assert pid is not None, name
             t = time.monotonic()
             os.kill(pid, signal.SIGKILL)
             assert wait_for(lambda n=name, p=pid: chain.pid_of(n) not in (None, p)), name

@@ -429,21 +429,6 @@ class TestControl(unittest.TestCase):
             r.user.resume_step("p")
         self.assertEqual(ctx.exception.code, "NOT_SUSPENDED")
 
-    def test_a_step_asked_while_a_step_runs_follows_it(self):
-        # the ground may ask for the next step before the first one has ended (the step
-        # activation's completion report comes at once): the step is queued, not refused
-        r = Rig()
-        r.user.load("p", proc(step("A", 'wait for 10 s; log "a";'), step("B", 'log "b";'),
-                              step("C", 'log "c";')))  # fmt: skip
-        r.user.activate_step("p", None)
-        r.user.resume_step("p")
-        r.drive()
-        self.assertEqual(r.user.states["p"], SUSPENDED)
-        self.assertEqual([t for _, t in r.texts()], ["a", "b"])
-        r.user.resume_step("p")
-        r.drive()
-        self.assertEqual([t for _, t in r.texts()], ["a", "b", "c"])
-
     def test_step_by_step_without_steps_runs_to_the_end(self):
         r = Rig()
         r.user.load("p", proc('log "1"; log "2";'))

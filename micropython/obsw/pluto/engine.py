@@ -178,7 +178,6 @@ class ObcpEngine:
         ob.activations += 1
         ob.outcome = ob.error = ob.requested = ob.stop_steps = None
         ob.stepping = ob.step_done = False
-        ob.more_steps = 0
         ob.ready = True
         self._changed(ob, RUNNING)
         self._emit("started", {"obcp": name})
@@ -190,12 +189,8 @@ class ObcpEngine:
         self._obcps[name].stepping = True
 
     def resume_step(self, name):
-        """Continue suspended OBCP ``name`` for one step, then suspend it again. Asked while
-        it still runs a step step by step, the next step follows that one."""
+        """Continue suspended OBCP ``name`` for one step, then suspend it again."""
         ob = self._get(name)
-        if ob.state == RUNNING and ob.stepping and ob.requested is None:
-            ob.more_steps += 1
-            return
         if ob.state != SUSPENDED and ob.requested != "suspend":
             raise ObcpError(NOT_SUSPENDED, "OBCP %s is %s" % (name, ob.state))
         self.resume(name)
@@ -350,9 +345,6 @@ class ObcpEngine:
                 return w
             if ob.step_done and proc.at_boundary():
                 ob.step_done = False
-                if ob.more_steps:
-                    ob.more_steps -= 1
-                    continue
                 proc.hold()
                 return None
             if w.activities or w.prompt or w.deadline is None or w.deadline > now:

@@ -127,7 +127,6 @@ class Obcp:
         self.stop_steps = None
         self.stepping = False  # step by step: hold once the step being run has ended
         self.step_done = False
-        self.more_steps = 0  # steps asked for while the step being run has not ended yet
         self.ready = False
         self.due = None
 

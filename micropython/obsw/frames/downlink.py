@@ -78,13 +78,14 @@ class StoreForward:
     Every TM is kept in a packet store (``obsw.pus.services.packet_store``); ``stores`` lists
     them by priority, highest first. Out of contact nothing leaves. In contact ``next(now)``
     gives the next ``(store, seq, raw)`` to send: first the packets the ground asked for again
-    (``resend``: gaps it saw in the storage sequence numbers), then each store's open
-    retrieval in priority order, so real-time TM is the open retrieval caught up with the
-    present. A packet leaves only when it fits in what the pass can still carry (``budget``
-    octets, from the pass table's time left at ``bps``), so a dump is never cut at LOS: what
-    does not fit waits for the next pass. The open retrieval's pointer never goes back, and
-    the ground's acknowledgement (``acknowledge``) deletes what it has, so nothing is sent
-    twice and nothing is dropped while the stores have room.
+    (``resend``: gaps it saw in the storage sequence numbers), then each store's packets in
+    sequence, in priority order, so real-time TM is the dump caught up with the present. A
+    packet leaves only when it fits in what the pass can still carry (``budget`` octets, from
+    the pass table's time left at ``bps``), so a dump is never cut at LOS: what does not fit
+    waits for the next pass. The forwarder's pointer (``next_seq``, apart from the stores'
+    ST[15] open retrieval, which stays the operator's) never goes back, and the ground's
+    acknowledgement (``acknowledge``) deletes what it has, so nothing is sent twice and
+    nothing is dropped while the stores have room.
     """
 
     def __init__(self, stores, contact, bps):
@@ -96,8 +97,11 @@ class StoreForward:
         self.resent = 0
         self.held = 0  # packets that waited for the next pass (did not fit in this one)
         self._resend = deque((), 64)  # (store, seq)
+        # the next storage sequence number to send, per store: the forwarder's own pointer
+        # (the stores' ST[15] open retrieval stays the operator's, apart from it)
+        self.next_seq = {}
         for st in self.stores:
-            st.open_active = True
+            self.next_seq[st.id] = 1
 
     def store(self, sid):
         for st in self.stores:
@@ -144,13 +148,14 @@ class StoreForward:
             self.resent += 1
             return self._out(st, seq, raw)
         for st in self.stores:
-            for seq, t, raw in st.packets:
-                if seq < st.open_next or t < st.open_start:
+            first = self.next_seq[st.id]
+            for seq, _t, raw in st.packets:
+                if seq < first:
                     continue
                 if len(raw) > room:
                     self.held += 1
                     return None  # the highest priority first: lower ones wait behind it
-                st.open_next = seq + 1
+                self.next_seq[st.id] = seq + 1
                 return self._out(st, seq, raw)
         return None
 
@@ -163,8 +168,9 @@ class StoreForward:
         """Octets stored and not yet sent, over all stores."""
         n = 0
         for st in self.stores:
-            for seq, t, raw in st.packets:
-                if seq >= st.open_next and t >= st.open_start:
+            first = self.next_seq[st.id]
+            for seq, _t, raw in st.packets:
+                if seq >= first:
                     n += len(raw)
         return n
 

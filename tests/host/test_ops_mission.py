@@ -116,3 +116,15 @@ def test_plan_then_check_against_a_schedule_report(folder, tmp_path, capsys):
     assert main(base + ["--report", path]) == 2
     out = json.loads(capsys.readouterr().out)
     assert len(out["problems"]) == 3  # two missing, one unplanned
+
+
+def test_close_passes_share_one_transmitter_window():
+    from obsw_host.ops.passes import Pass, Station
+    from obsw_host.ops.plan import plan
+
+    a, b = Station("a", 0, 0, 0, 10, 1, 1), Station("b", 0, 1, 0, 10, 1, 1)
+    steps = plan([Pass(a, 1000, 1100, 1200, 30), Pass(b, 1289, 1300, 1400, 30)], 60, 30)
+    assert [(s.time, s.what) for s in steps] == [(940, "transmitter on"),
+                                                 (1430, "transmitter off")]  # fmt: skip
+    steps = plan([Pass(a, 1000, 1100, 1200, 30), Pass(b, 1291, 1300, 1400, 30)], 60, 30)
+    assert len(steps) == 4  # 1 s beyond lead + lag: two windows

@@ -1,19 +1,17 @@
 """Pass plans: the service 11 time-tagged commands that fly a pass, and the check of a plan
 against the onboard schedule report.
 
-For each pass: the transmitter on ``lead`` seconds before AOS, the stores' open retrieval
-resumed at AOS (the dump: each store goes on from where the last pass stopped, so nothing is
-sent twice), suspended at LOS, and the transmitter off ``lag`` seconds after LOS. Requests are
-in the words of ``obsw ground`` (``function NAME``, ``service NAME REQUEST ARG=VALUE``), so a
-plan is uplinked with ``obsw ground schedule insert --at``.
+For each pass: the transmitter on ``lead`` seconds before AOS and off ``lag`` seconds after
+LOS. The dump needs no command: the OBC's store-and-forward starts it at AOS from its pass
+table and contact state (``obsw.frames.downlink.StoreForward``). Requests are in the words of
+``obsw ground`` (``function NAME``), so a plan is uplinked with
+``obsw ground schedule insert --at``.
 """
 
 from obsw_host.ops.tle import format_time
 
 TX_ON = "function Radio.transmitter_on"
 TX_OFF = "function Radio.transmitter_off"
-DUMP_START = "service storage resume_open_retrieval"
-DUMP_STOP = "service storage suspend_open_retrieval"
 
 
 class Step:
@@ -37,10 +35,9 @@ class Step:
         return "%s  %-44s # %s, %s" % (d["at"], d["request"], d["what"], d["station"])
 
 
-def plan(passes, lead=60.0, lag=30.0, stores=(), tx_on=TX_ON, tx_off=TX_OFF):
-    """The steps of ``passes`` in time order; ``stores``: the packet store ids to dump
-    (empty: the transmitter only). A transmitter already on (overlapping passes, or passes
-    closer than lead + lag) stays on: one on, one off around the overlapping passes."""
+def plan(passes, lead=60.0, lag=30.0, tx_on=TX_ON, tx_off=TX_OFF):
+    """The steps of ``passes`` in time order. A transmitter already on (overlapping passes,
+    or passes closer than lead + lag) stays on: one on, one off around them."""
     steps = []
     windows = []
     for p in sorted(passes, key=lambda p: p.aos):
@@ -54,12 +51,6 @@ def plan(passes, lead=60.0, lag=30.0, stores=(), tx_on=TX_ON, tx_off=TX_OFF):
         name = "+".join(p.station.name for p in group)
         if tx_on:
             steps.append(Step(on, tx_on, "transmitter on", name))
-        for p in group:
-            for sid in stores:
-                steps.append(Step(p.aos, "%s store=%s" % (DUMP_START, sid), "dump from AOS",
-                                  p.station.name))  # fmt: skip
-                steps.append(Step(p.los, "%s store=%s" % (DUMP_STOP, sid), "dump stops at LOS",
-                                  p.station.name))  # fmt: skip
         if tx_off:
             steps.append(Step(off, tx_off, "transmitter off", name))
     steps.sort(key=lambda s: s.time)

@@ -358,5 +358,27 @@ class TestMessages(unittest.TestCase):
         self.assertEqual(messages.FAILURE_INCORRECT_CHECKSUM, 2)
 
 
+class TestRequestIdAndTypeBit(unittest.TestCase):
+    def test_the_fields_of_a_request_id(self):
+        r = RequestId.from_words(0x1873, 0xC019)
+        self.assertEqual((r.version, r.packet_type, r.sec_header_flag, r.apid), (0, 1, 1, 0x73))
+        self.assertEqual((r.seq_flags, r.seq_count), (3, 25))
+        self.assertEqual(RequestId.from_words(0x1073, 0xC019).sec_header_flag, 0)
+
+    def test_equal_only_when_both_words_are(self):
+        r = RequestId.from_words(0x1873, 0xC019)
+        self.assertEqual(r, RequestId.from_words(0x1873, 0xC019))
+        self.assertNotEqual(r, RequestId.from_words(0x1873, 0xC01A))
+        self.assertNotEqual(r, RequestId.from_words(0x1874, 0xC019))
+
+    def test_the_packet_type_bit_alone_chooses_tc_or_tm(self):
+        # APID 0x100 sets the lowest bit of the first octet, next to the type bit
+        tm = PusTm(0x100, 17, 2).pack()
+        self.assertEqual(tm[0] & 0x11, 0x01)
+        got = unpack_packet(tm)
+        self.assertTrue(isinstance(got, PusTm))
+        self.assertEqual((got.apid, got.service, got.subtype), (0x100, 17, 2))
+
+
 if __name__ == "__main__":
     unittest.main()

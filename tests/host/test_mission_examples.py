@@ -199,6 +199,15 @@ def test_aurora_runs_from_its_folder(tmp_path):
         assert "adcs.gain = 250" in r.stdout
         assert re.search(r"Magnetorquer.coil_temp = [-0-9.]+ degC \(raw \d+\)", r.stdout), r.stdout
         assert "Magnetorquer.coil_current = " in r.stdout and " mA" in r.stdout
+
+        # the mission's limit check on the calibrated coil temperature (15..35 degC, the coil
+        # at about 21 degC): installed as the raw limits of those engineering values, in limits
+        r = ground("monitor", "list")
+        assert r.returncode == 0, r.stderr
+        row = next(x for x in r.stdout.splitlines() if "Magnetorquer.coil_temp" in x)
+        assert " 15 degC " in row and " 35 degC " in row, row
+        r = ground("monitor", "out-of-limits")
+        assert r.returncode == 0 and "(none)" in r.stdout, r.stdout
         assert ground("function", "Magnetorquer.enable").returncode == 0
         r = ground("params", "get", "Magnetorquer.enabled")
         assert "Magnetorquer.enabled = True" in r.stdout, r.stdout + r.stderr
@@ -243,4 +252,5 @@ def test_aurora_runs_from_its_folder(tmp_path):
     assert "CpduA=node 20, CpduB=node 21" in out
     assert "frame processor: UART A" in out and "TM in on udp 4899" in out
     assert "event Magnetorquer.degaussed" in out
+    assert "monitoring.coil_hot" not in out and "monitoring.coil_cold" not in out
     assert "Traceback" not in out

@@ -477,6 +477,29 @@ def test_the_missions_limit_checks_are_installed_at_the_first_start_only():
     assert list(again.services[12].pmons) == [43]
 
 
+def test_the_missions_limits_are_engineering_values_installed_as_raw_ones():
+    """Aurora's coil temperature is raw thermistor counts, calibrated by the spline
+    (1365 counts, 0 degC) .. (1765 counts, 100 degC): 4 counts per degC."""
+    from obsw.pus.sdb import load as load_db
+
+    root = os.path.join(os.path.dirname(__file__), "..", "..")
+    db = load_db(os.path.join(root, "examples", "aurora", "sdb.json"))
+    app = ApplicationProcess(42, lambda raw: None, SimClock(0.0), store=FakeStore())
+    app.register(OnBoardMonitoring(ParameterPool(db), db.events))
+    entry = {"pmon": 1, "parameter": "Magnetorquer.coil_temp", "low": 15, "high": 35,
+             "low_event": "monitoring.coil_cold", "high_event": "monitoring.coil_hot"}  # fmt: skip
+    assert monitoring.install(app, db, [entry]) == 1
+    d = app.services[12].pmons[1].d
+    assert (d["low"], d["high"]) == (1365 + 4 * 15, 1365 + 4 * 35)
+    assert d["high_event"] == db.event("monitoring.coil_hot").id
+    entry = dict(entry, pmon=2, low=15.1, high=34.9)  # integer raw limits: inside, not beyond
+    app.services[12].pmons.clear()
+    app.store = None
+    assert monitoring.install(app, db, [entry]) == 1
+    d = app.services[12].pmons[2].d
+    assert (d["low"], d["high"]) == (1365 + 61, 1365 + 139)
+
+
 @pytest.mark.parametrize(
     "entry, why",
     [

@@ -18,7 +18,7 @@ from obsw.pus import sdb as sdb_module
 from obsw.spacecan.equipment import equipment_interface
 from obsw.spacecan.nodedef import NodeDefinition, NodeDefinitionError
 
-from obsw_host.mission import defaults
+from obsw_host.mission import crosscheck, defaults
 from obsw_host.mission.config import ConfigError, MissionConfig
 from obsw_host.mission.errors import MissionError, Problem, did_you_mean, short
 from obsw_host.mission.folder import MAX_PROCEDURE, locate, read_text
@@ -130,7 +130,7 @@ class _Checker:
             if not isinstance(spec, dict) or not isinstance(spec.get("module"), str):
                 continue
             try:
-                itf, _ = Component(name, spec, self.folder).check()
+                itf, cls = Component(name, spec, self.folder).check()
             except PluginError as e:
                 text = str(e)[len(e.key) + 2 :]
                 if "; expected" not in text:
@@ -139,6 +139,7 @@ class _Checker:
                 self.unresolved.add(name)
                 continue
             self.interfaces[name] = itf
+            crosscheck.options(self, name, spec, cls)
 
     def _processes(self, doc):
         procs = doc.get("processes")
@@ -232,7 +233,17 @@ class _Checker:
         pos = doc.get("position_scheduling")
         if isinstance(pos, dict) and "parameter" in pos:
             self._ref(f, ["position_scheduling", "parameter"], pos["parameter"], params)
+        self._against_components(f, doc)
         return doc
+
+    def _against_components(self, f, doc):
+        """The database against the components that serve it (``crosscheck``)."""
+        from obsw_host.obc.topology import FRAME_PROCESSOR, OBC_HEALTH
+
+        served = dict(self.interfaces)
+        served.update({i.name: i for i in (OBC_HEALTH, FRAME_PROCESSOR)})
+        crosscheck.attributes(self, f, doc, served)
+        crosscheck.power_cycle(self)
 
     def _apids(self, f, doc):
         apids = doc.get("apids")
@@ -724,6 +735,8 @@ def check(mission_file):
     except (ConfigError, sdb_module.SdbError) as e:
         c.add(c.sdb_file if isinstance(e, sdb_module.SdbError) else c.file, "$", str(e))
         return None, c.problems
+    crosscheck.monitoring(c, sdb)
+    crosscheck.housekeeping(c, sdb)
     c.procedures_of(sdb)
     if c.problems:
         return None, c.problems

@@ -48,12 +48,15 @@ _SDB_INT = {
     "int32": (-0x80000000, 0x7FFFFFFF),
     "int64": (-0x8000000000000000, 0x7FFFFFFFFFFFFFFF),
 }
+_KNOWN = tuple(_INT) + ("f32", "f64", "bool", "str")
 _EXACT_IN_FLOAT = {"float32": 24, "float64": 53}  # integer bits a float holds exactly
 
 
 def _holds(comp_type, sdb_type):
     """True if database type ``sdb_type`` holds every value of component type ``comp_type``;
-    None if the component's type says nothing the check knows."""
+    None if either type says nothing the check knows (an unknown one is said elsewhere)."""
+    if sdb_type not in _SDB_INT and sdb_type not in ("bool", "float32", "float64", "string"):
+        return None if sdb_type != "octets" or comp_type not in _KNOWN else False
     if comp_type in _INT:
         lo, hi = _INT[comp_type]
         if sdb_type in _SDB_INT:
@@ -73,10 +76,11 @@ def _holds(comp_type, sdb_type):
     return None
 
 
-def _widest(comp_type):
-    """The database types that hold ``comp_type``, for the message."""
+def _narrowest(comp_type):
+    """The narrowest database type that holds ``comp_type``, for the message."""
     names = ("bool",) + tuple(_SDB_INT) + ("float32", "float64", "string")
-    return [n for n in names if _holds(comp_type, n)]
+    found = [n for n in names if _holds(comp_type, n)]
+    return found[0] if len(found) == 1 else "%s or a wider type" % found[0]
 
 
 def _dicts(items):
@@ -150,7 +154,7 @@ def _attribute(c, f, at, comp, a, mine):
               "expected no writable, or a CONFIGURATION attribute" % (comp, name))  # fmt: skip
     if isinstance(sdb_type, str) and _holds(m.type, sdb_type) is False:
         c.add(f, at + ["type"], "%s cannot hold %s.%s, a %s in the component; expected %s"
-              % (sdb_type, comp, name, m.type, " or ".join(_widest(m.type))))  # fmt: skip
+              % (sdb_type, comp, name, m.type, _narrowest(m.type)))  # fmt: skip
 
 
 def power_cycle(c):
@@ -198,6 +202,11 @@ def monitoring(c, sdb):
                 bad = True
         if bad:
             continue
+        p = sdb.parameter(e["parameter"]) if isinstance(e.get("parameter"), str) else None
+        if p is not None and p.type.ptc not in (2, 3, 4, 5):
+            c.add(c.file, at + ["parameter"], "%s is a %s; expected a numeric parameter for a "
+                  "limit check" % (p.qualified, p.type_spec))  # fmt: skip
+            continue
         try:
             d = definition(sdb, i, e)
             s12.check_definition(d)
@@ -208,7 +217,7 @@ def monitoring(c, sdb):
         except Exception as x:  # PusFailure: what a TC[12,5] would be refused for
             c.add(c.file, at, "%s; expected a definition service 12 accepts" % x)
             continue
-        fits = _raw_fits(sdb.parameter(e["parameter"]), d)
+        fits = _raw_fits(p, d)
         if fits:
             c.add(c.file, at, fits)
         elif d["pmon"] in pmons:

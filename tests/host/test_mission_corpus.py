@@ -132,6 +132,14 @@ def read_events(folder):
     db.check_interfaces(topology.interfaces())
 
 
+def read_defaults(folder):
+    """What the pool gives for a parameter no component has published yet."""
+    db = load_sdb(os.path.join(folder, "sdb.json"))
+    pool = ParameterPool(db)
+    for p in db.parameters.values():
+        p.type.check(pool.get(p.id))
+
+
 def power_cycle_operation(folder):
     topology = Topology(_mission(folder))
     pc = _mission(folder).doc["platform"]["power_cycle"]
@@ -190,6 +198,9 @@ IN_FLIGHT = [
     ("event the component lacks", _extra("Magnetorquer", "events", {"name": "overheated",
      "id": 499, "severity": "high"}), "sdb.json", "$.components[0].events[2].name",
      "Magnetorquer has no event overheated", read_events),
+    ("default beyond the calibration", _attr("Magnetorquer", "coil_temp", default=-400),
+     "sdb.json", "$.components[0].attributes[4].default", "outside the calibration's points",
+     read_defaults),
     ("power-cycle node without power_cycle", _no_power_cycle, "mission.json",
      "$.platform.power_cycle.component", "no operation power_cycle(line, off_ms)",
      power_cycle_operation),

@@ -737,6 +737,7 @@ def check(mission_file):
         return None, c.problems
     crosscheck.monitoring(c, sdb)
     crosscheck.housekeeping(c, sdb)
+    crosscheck.defaults(c, sdb)
     c.procedures_of(sdb)
     if c.problems:
         return None, c.problems

@@ -11,6 +11,7 @@ every process and means what it says:
 - ``power_cycle``: the platform's power-cycle component has ``power_cycle(line, off_ms)``;
 - ``monitoring``: ``pus.monitoring`` through the very code that installs it
   (``obsw_host.obc.monitoring``), events and parameters by name;
+- ``defaults``: each parameter's ``default`` (an engineering value) has a raw value of its type;
 - ``housekeeping``: each report structure fits in the largest packet (``largest_packet``).
 """
 
@@ -263,3 +264,27 @@ def housekeeping(c, sdb):
             c.add(c.sdb_file, ["housekeeping", i, "parameters"], "its report is at least %d "
                   "octets; expected at most %d (the largest packet): split the structure"
                   % (n, limit))  # fmt: skip
+
+
+def defaults(c, sdb):
+    """Each ``default`` (engineering) has the raw value the pool will give before any other."""
+    where = {}
+    for ci, comp in _dicts(c.sdb_doc.get("components")):
+        for ai, a in _dicts(comp.get("attributes")):
+            where["%s.%s" % (comp.get("name"), a.get("name"))] = [
+                "components",
+                ci,
+                "attributes",
+                ai,
+            ]
+    for pi, p in _dicts(c.sdb_doc.get("parameters")):
+        where[p.get("name")] = ["parameters", pi]
+    for p in sdb.parameters.values():
+        if p.default is None or p.values is None:
+            continue
+        try:
+            p.type.check(p.to_raw(p.default))
+        except ValueError as e:  # CalibrationError and FieldValueError are ValueErrors
+            c.add(c.sdb_file, where.get(p.qualified, ["parameters"]) + ["default"], "%s has no "
+                  "raw value (%s); expected an engineering value the calibration reaches"
+                  % (short(p.default), e))  # fmt: skip

@@ -514,3 +514,21 @@ def test_a_bad_limit_check_is_a_configuration_error_naming_the_entry(entry, why)
     with pytest.raises(ConfigError) as e:
         monitoring.install(app, db, [SAMPLE_CHECKS[0], entry])
     assert str(e.value).startswith("pus.monitoring[1]: ") and why in str(e.value)
+
+
+def test_a_report_that_cannot_be_built_is_logged_and_raised_as_an_event():
+    from obsw_host.obc.units import PusUnit
+
+    app, db = monitoring_app(FakeStore())
+    events, lines = [], []
+    app.event_reporters.append(lambda *e: events.append(e) or True)
+    unit = PusUnit.__new__(PusUnit)  # the unit's wiring without its sockets and processes
+    unit.app, unit.sdb, unit.out, unit._reporting_unsent = app, db, lines.append, False
+    app.unsent_listeners.append(unit._unsent)
+    assert app.send_tm(3, 25, bytes(70000)) is None
+    assert len(lines) == 1 and lines[0].startswith("TM[3,25] not sent: "), lines
+    e = db.event("pus.report_failed")
+    assert [x[0] for x in events] == [e.id]
+    values = e.unpack(events[0][2])
+    assert (values["service"], values["subtype"]) == (3, 25)
+    assert "70" in values["reason"]

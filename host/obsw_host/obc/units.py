@@ -173,6 +173,8 @@ class PusUnit:
             )
             self.module.restore()
         monitoring.install(self.app, sdb, opts["monitoring"])  # first start: the mission's
+        self.app.unsent_listeners.append(self._unsent)
+        self._reporting_unsent = False
         self._running = False
 
     # -------------------------------------------------------------------------- building
@@ -256,6 +258,18 @@ class PusUnit:
             self.app.count("platform_events_unknown")
             return None
         return self.app.event(e.id, e.severity, e.pack(values))
+
+    def _unsent(self, service, subtype, why):
+        """A report that could not be built: a line in the log and ``pus.report_failed``."""
+        self.out("TM[%d,%d] not sent: %s" % (service, subtype, why))
+        if self._reporting_unsent:  # the event's own report failed: the line above says it
+            return
+        self._reporting_unsent = True
+        try:
+            values = {"service": service, "subtype": subtype, "reason": why[:200]}
+            self.unit_event("pus.report_failed", values)
+        finally:
+            self._reporting_unsent = False
 
     def _task_died(self, name, why, restarts):
         self.out("task %s stopped (%s): restarted (%d)" % (name, why, restarts))

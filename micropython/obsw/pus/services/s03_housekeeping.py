@@ -396,11 +396,22 @@ class Housekeeping(FunctionalReporting, Service):
             values[i] = get(pid)
         try:
             data = s.layout.pack(values)
-        except ValueError:
+        except ValueError as e:
             self.app.count("hk_unpackable")
+            t = _REPORTS[kind][0]
+            self.app.unsent(t[0], t[1], "structure %d: %s" % (sid, self._why(s, values, e)))
             return None
         self.reports += 1
         return self.send(_REPORTS[kind][0], data, destination)
+
+    def _why(self, s, values, error):
+        """The parameter whose value the structure's layout refused, and why."""
+        for i, pid in enumerate(s.parameters):
+            try:
+                self.pool.type_of(pid).check(values[i])
+            except ValueError as e:
+                return "parameter %d = %r: %s" % (pid, values[i], e)
+        return str(error)
 
     def cyclic(self, now):
         for kind, structures in self.sets.items():

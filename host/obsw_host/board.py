@@ -347,6 +347,24 @@ BOARD_TESTS = (
 )
 
 
+SUPPORT = ("models.py", "dekker_sim.py")  # host models some reconfiguration tests import
+
+
+def _needs_support(path):
+    with open(path) as f:
+        text = f.read()
+    return any("reconfig.%s import" % m[:-3] in text for m in SUPPORT)
+
+
+def _deployed_code(name):
+    """MicroPython that stops with a reason unless the modules were deployed to the flash."""
+    return (
+        "import os\n"
+        "if 'obsw' not in os.listdir():\n"
+        "    raise SystemExit('%s needs the modules on the flash: obsw board deploy first')" % name
+    )
+
+
 def _results(text):
     """(passed, failed, skipped) from the runner's closing line, or None."""
     found = None
@@ -381,10 +399,13 @@ def test(files, port=None, runner=_capture):
     for f in files:
         name = os.path.basename(f)
         cmd = _mpremote(port) + ["cp", os.path.join(upy, "unittest.py"), ":unittest.py", "+"]
-        for d in ("obsw", "obsw/reconfig"):
-            cmd += ["exec", _mkdir_code(d), "+"]
-        for m in ("models.py", "dekker_sim.py"):  # test support, not in the image
-            cmd += ["cp", os.path.join(support, m), ":obsw/reconfig/" + m, "+"]
+        if _needs_support(f):
+            # test support, not in the image: it joins the deployed obsw/ on the board's
+            # flash (a package is found in one place: an obsw/ folder made only for it would
+            # hide the frozen package from every test)
+            cmd += ["exec", _deployed_code(name), "+"]
+            for m in SUPPORT:
+                cmd += ["cp", os.path.join(support, m), ":obsw/reconfig/" + m, "+"]
         cmd += ["cp", os.path.join(upy, "obsw_run_tests.py"), ":obsw_run_tests.py", "+"]
         cmd += ["cp", f, ":" + name, "+", "exec"]
         cmd.append("import obsw_run_tests; obsw_run_tests.main([%r])" % name)

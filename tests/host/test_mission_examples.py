@@ -131,17 +131,54 @@ def test_mission_new_passes_the_check_and_runs(tmp_path):
     m = load(str(folder))
     assert m.name == "pico-1" and m.sdb.mission == "pico-1"
     assert obsw("mission", "new", "pico-1", cwd=str(tmp_path)).returncode == 2  # not over it
-    base = free_base(10)
+    for name in ("mission.json", "sdb.json"):  # nothing of this machine in the folder
+        assert str(ROOT) not in (folder / name).read_text()
+    assert "cfdp" not in json.loads((folder / "mission.json").read_text())  # ports: the base's
+    base = free_base(m.sdb.apid("pus"))
     env = dict(ENV, OBSW_PORT_BASE=str(base))
     obc = Obc(str(folder), tmp_path / "state", env)
     try:
         wait_for_ping(["ground", "--mission", folder], obc, env)
         r = obsw("ground", "--mission", folder, "params", "get", "pus.tc_received", env=env)
         assert r.returncode == 0, r.stderr
+        # a file to this spacecraft lands in its filestore, over its own ports and entities
+        (tmp_path / "up.txt").write_text("pico")
+        r = obsw("cfdp", "put", "--mission", folder, "--root", tmp_path, "up.txt", "up.txt",
+                 env=env)  # fmt: skip
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "delivered up.txt to entity %d" % m.sdb.filestores["SAT"] in r.stdout, r.stdout
+        assert (tmp_path / "state" / "files" / "up.txt").read_text() == "pico"
     finally:
         out = obc.stop()
     assert "pico-1: version " in out and ", processes obc, " in out
     assert "Traceback" not in out
+
+
+def test_new_missions_never_share_a_port_an_id_or_a_path_with_another(tmp_path, monkeypatch):
+    """Two new missions and the examples, all on one base: no port, APID, spacecraft id or
+    CFDP entity in common, and no absolute path in the files."""
+    from obsw_host.mission.ids import MissionIds
+
+    names = ["pico-1", "lynx"]
+    for name in names:
+        assert obsw("mission", "new", name, cwd=str(tmp_path)).returncode == 0
+    r = obsw("mission", "new", "asked", "--slot", "7", cwd=str(tmp_path))
+    assert r.returncode == 0 and "spacecraft id 507" in r.stdout and "pus 456" in r.stdout
+    folders = [str(tmp_path / n) for n in names + ["asked"]] + [AURORA, sample.MISSION_DIR]
+    monkeypatch.delenv("OBSW_PORT_BASE", raising=False)  # every mission on its own base
+    seen = {}
+    for folder in folders:
+        ids = MissionIds.locate(folder)
+        mine = {("port", ids.ports.for_apid(a)) for a in ids.sdb.apids.values() if a}
+        mine |= {("port", ids.ports.cfdp_ground), ("scid", ids.sdb.scid)}
+        mine |= {("entity", e) for e in ids.sdb.filestores.values()}
+        for key in mine:
+            assert key not in seen, "%s %s of %s is also %s's" % (key + (folder, seen.get(key)))
+            seen[key] = folder
+    for n in names:
+        for f in ("mission.json", "sdb.json"):
+            text = (tmp_path / n / f).read_text()
+            assert str(tmp_path) not in text and str(ROOT) not in text
 
 
 def test_aurora_differs_from_the_sample_and_passes_the_check():

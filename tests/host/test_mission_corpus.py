@@ -263,3 +263,20 @@ def test_check_says_what_serve_says(sample_copy, tmp_path, monkeypatch, name, sp
     assert len(problems) == 1, problems
     line = str(problems[0])
     assert line.startswith(os.path.join("mission", file) + ": ") and text in line, line
+
+
+def test_a_database_given_as_the_mission_names_the_mission_folder(sample_copy, tmp_path):
+    db = os.path.join(sample_copy, "sdb.json")
+    before = open(db).read()
+    for action in (["obc", "serve", db], ["obc", "config", db], ["mission", "check", db]):
+        r = subprocess.run(OBSW + action, env=ENV, capture_output=True, text=True,
+                           timeout=BOUND, cwd=str(tmp_path))  # fmt: skip
+        assert r.returncode == 2, action
+        assert r.stderr.splitlines() == [
+            "mission/sdb.json: $: a spacecraft database, not a mission file; expected the "
+            "mission folder mission (whose mission file names this database)"
+        ], r.stderr
+    r = subprocess.run(OBSW + ["mission", "upgrade", db], env=ENV, capture_output=True,
+                       text=True, timeout=BOUND)  # fmt: skip
+    assert r.returncode == 2 and "not a mission file" in r.stderr
+    assert open(db).read() == before  # upgrade left it as it was

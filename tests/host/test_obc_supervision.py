@@ -3,6 +3,7 @@ simulated device, systemd's notify protocol on a fake socket, the rule that feed
 watchdog only while every critical process is healthy, the health figures from a simulated
 /proc and /sys tree, and the systemd unit. Clocks are simulated where time matters."""
 
+import json
 import math
 import os
 import shutil
@@ -365,8 +366,25 @@ def test_the_obc_component_publishes_what_changed(tmp_path):
 # ------------------------------------------------------------------------------ the unit
 
 
+def pi_mission(tmp_path):
+    """The Raspberry Pi's mission folder, its key file (``/etc/obsw/tc.keys`` on the Pi) in
+    ``tmp_path``: a mission that passes the check on this machine."""
+    folder = tmp_path / "pi"
+    shutil.copytree(os.path.join(ROOT, "boards", "raspberry-pi"), folder)
+    keys = tmp_path / "tc.keys"
+    r = subprocess.run([OBSW, "frames", "keygen", str(keys)], capture_output=True, text=True,
+                       cwd=str(tmp_path))  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    path = folder / "mission.json"
+    doc = json.loads(path.read_text())
+    doc["frames"]["keys"] = str(keys)
+    doc.pop("$schema")
+    path.write_text(json.dumps(doc))
+    return str(path)
+
+
 def test_install_service_dry_run_prints_the_unit_for_the_mission(tmp_path):
-    mission = os.path.join(ROOT, "boards", "raspberry-pi", "mission.json")
+    mission = pi_mission(tmp_path)
     out = subprocess.run(
         [OBSW, "obc", "install-service", mission, "--dry-run", "--obsw", "/opt/obsw/bin/obsw"],
         capture_output=True,
@@ -379,7 +397,7 @@ def test_install_service_dry_run_prints_the_unit_for_the_mission(tmp_path):
 
 
 def test_install_service_writes_under_root(tmp_path):
-    mission = os.path.join(ROOT, "boards", "raspberry-pi", "mission.json")
+    mission = pi_mission(tmp_path)
     r = subprocess.run(
         [
             OBSW,
@@ -409,12 +427,29 @@ def test_install_service_writes_under_root(tmp_path):
 def test_install_service_refuses_bad_input(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text("{")
-    for args in ([str(bad)], ["--state", "/a b"], ["--watchdog-sec", "0"]):
+    mission = pi_mission(tmp_path)
+    for args, said in (([str(bad)], str(bad) + ": $: not valid JSON"),
+                       ([mission, "--state", "/a b"], "obsw obc: "),
+                       ([mission, "--watchdog-sec", "0"], "obsw obc: ")):  # fmt: skip
         r = subprocess.run(
             [OBSW, "obc", "install-service", "--dry-run", *args], capture_output=True, text=True
         )
         assert r.returncode == 2, (args, r.stdout)
-        assert r.stderr.startswith("obsw obc: ") and len(r.stderr.splitlines()) == 1
+        assert r.stderr.startswith(said) and len(r.stderr.splitlines()) == 1, r.stderr
+
+
+def test_config_and_install_service_check_the_mission_first(tmp_path):
+    mission = pi_mission(tmp_path)
+    doc = json.loads(open(mission).read())
+    doc["pus"]["monitoring"] = [{"pmon": 1, "parameter": "Obc.temperature", "low": 0,
+                                 "high": 80, "high_event": "monitoring.hot"}]  # fmt: skip
+    open(mission, "w").write(json.dumps(doc))
+    for action in (["config"], ["install-service", "--dry-run"]):
+        r = subprocess.run([OBSW, "obc", *action, mission], capture_output=True, text=True)
+        assert r.returncode == 2 and r.stdout == "", (action, r.stdout)
+        lines = r.stderr.splitlines()
+        assert len(lines) == 1 and lines[0].startswith(mission + ": $.pus.monitoring[0]")
+        assert "monitoring.hot" in lines[0], lines
 
 
 def test_the_shipped_unit_is_the_default_one():

@@ -106,6 +106,9 @@ def upgrade_cmd(args):
     doc = read_json(args.file, "mission file")
     if not isinstance(doc, dict):
         raise UserError("%s is not a JSON object" % args.file, expected="a mission file")
+    if "format" not in doc and "processes" not in doc:  # a database, a node: left as it is
+        raise UserError("%s is not a mission file (no format, no processes)" % args.file,
+                        expected="a format-1 mission file; nothing was changed")  # fmt: skip
     new, changes = upgrade(doc)
     if not changes:
         print("%s: already format %d" % (args.file, new["format"]))

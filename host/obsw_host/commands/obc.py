@@ -90,6 +90,18 @@ def check_mission(path):
     return check(locate(path))[1]
 
 
+def refused_unchecked(path):
+    """None if the mission at ``path`` passes ``obsw mission check``, else ``EXIT_REFUSED``
+    after one line per problem: what works on a mission checks it first."""
+    try:
+        problems = check_mission(path)
+    except (ConfigError, UserError) as e:
+        return _refuse(e)
+    for problem in problems:
+        print(problem, file=sys.stderr, flush=True)
+    return EXIT_REFUSED if problems else None
+
+
 def ports_in_use(topology):
     """The UDP ports this OBC binds (PUS, CFDP, the frame processor's inputs) that another
     program holds now: ``["5010 (pus)", ...]``."""
@@ -239,6 +251,9 @@ def _serve_process(topology, args, out):
 
 
 def show(args):
+    refused = refused_unchecked(args.config)
+    if refused is not None:
+        return refused
     try:
         config = load(args)
         topology = Topology(config)
@@ -266,6 +281,9 @@ def reset(args):
 
 
 def install_service(args):
+    refused = refused_unchecked(args.config)
+    if refused is not None:  # no unit for a mission that would not start
+        return refused
     try:
         config = load_config(args.config)
         state = args.state or (config.state if "state" in config.doc else None)

@@ -20,7 +20,7 @@ from obsw.spacecan.nodedef import NodeDefinition, NodeDefinitionError
 
 from obsw_host.mission import crosscheck, defaults
 from obsw_host.mission.config import ConfigError, MissionConfig
-from obsw_host.mission.errors import MissionError, Problem, did_you_mean, short
+from obsw_host.mission.errors import MissionError, Problem, did_you_mean, display, short
 from obsw_host.mission.folder import MAX_PROCEDURE, locate, read_text
 from obsw_host.mission.schema import json_type, read_json, validate
 from obsw_host.obc.onboard_time import ONBOARD_TIME
@@ -101,6 +101,12 @@ class _Checker:
         self.problems += problems
         if doc is None:
             return None
+        if isinstance(doc, dict) and "format" not in doc and self._database_given(doc):
+            return None
+        if isinstance(doc, dict) and "format" not in doc and "processes" not in doc:
+            self.add(self.file, "$", "not a mission file (no format, no processes); expected a "
+                     "mission folder or its mission.json")  # fmt: skip
+            return None
         if isinstance(doc, dict) and "format" not in doc:
             self.add(
                 self.file,
@@ -117,6 +123,25 @@ class _Checker:
         self._processes(doc)
         self._paths(doc)
         return doc
+
+    def _database_given(self, doc):
+        """True (and the problem said) if ``doc`` is a spacecraft database, not a mission
+        file: the line names the mission folder to give instead."""
+        if not (isinstance(doc.get("mission"), str) or isinstance(doc.get("components"), list)):
+            return False
+        found = None
+        for name in sorted(os.listdir(self.folder)):
+            if name.endswith(".json") and os.path.join(self.folder, name) != self.file:
+                other, _ = read_json(os.path.join(self.folder, name), self.folder)
+                if isinstance(other, dict) and "format" in other:
+                    found = os.path.join(self.folder, name)
+                    if name == defaults.MISSION_FILE:
+                        found = self.folder
+                    break
+        where = "the mission folder %s" % display(found) if found else "its mission folder"
+        self.add(self.file, "$", "a spacecraft database, not a mission file; expected %s "
+                 "(whose mission file names this database)" % where)  # fmt: skip
+        return True
 
     def _components(self, doc):
         comps = doc.get("components")

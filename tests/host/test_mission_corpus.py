@@ -187,7 +187,7 @@ IN_FLIGHT = [
     ("uint8 for a text", _attr("Magnetorquer", "label", type="uint8"), "sdb.json",
      "$.components[0].attributes[12].type", "expected string", read_attributes),
     ("uint8 for a node's 16-bit value", _attr("CpduA", "state_bits", type="uint8"), "sdb.json",
-     "$.components[1].attributes[0].type", "a u16 in the component", read_attributes),
+     "$.components[2].attributes[0].type", "a u16 in the component", read_attributes),
     ("attribute the component lacks", _extra("Magnetorquer", "attributes", {"name":
      "coil_voltage", "parameter": 399, "type": "float32"}), "sdb.json",
      "$.components[0].attributes[13].name", "Magnetorquer has no attribute coil_voltage",
@@ -201,6 +201,12 @@ IN_FLIGHT = [
     ("default beyond the calibration", _attr("Magnetorquer", "coil_temp", default=-400),
      "sdb.json", "$.components[0].attributes[4].default", "outside the calibration's points",
      read_defaults),
+    ("time-driven component without its period", mission(lambda d: d["components"]
+     ["Attitude"].pop("period")), "mission.json", "$.components.Attitude.period",
+     "Attitude has tick(now) but no period", build_components),
+    ("period for a component without tick", mission(lambda d: d["components"]["Magnetorquer"]
+     .update(period=1)), "mission.json", "$.components.Magnetorquer.period",
+     "Magnetorquer has no tick(now)", build_components),
     ("power-cycle node without power_cycle", _no_power_cycle, "mission.json",
      "$.platform.power_cycle.component", "no operation power_cycle(line, off_ms)",
      power_cycle_operation),

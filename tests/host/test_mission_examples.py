@@ -251,6 +251,16 @@ def test_aurora_runs_from_its_folder(tmp_path):
         r = ground("function", "Magnetorquer.set_dipole", "x=0.3", "y=0", "z=0")
         assert r.returncode != 0  # the component refuses beyond max_dipole: a failure report
 
+        # the time-driven plug-in: its mode by label, its tick detumbling the spacecraft
+        r = ground("function", "Attitude.select_mode", "mode=DETUMBLE")
+        assert r.returncode == 0, r.stdout + r.stderr
+        r = ground("function", "Attitude.select_mode", "mode=FAST")
+        assert r.returncode == 2 and "no label 'FAST'" in r.stderr, r.stdout + r.stderr
+        r = wait_until(lambda: "POINTING" in ground("params", "get", "Attitude.mode").stdout)
+        assert r, obc.stop()
+        r = ground("params", "get", "Attitude.rate", "Attitude.ticks")
+        assert re.search(r"Attitude.rate = 0\.[0-9]+ deg/s", r.stdout), r.stdout
+
         # a SpaceCAN node's function, its effect readable at once
         assert ground("function", "CpduA.set_state_bits", "state=5").returncode == 0
         r = ground("params", "get", "CpduA.state_bits")
@@ -290,4 +300,26 @@ def test_aurora_runs_from_its_folder(tmp_path):
     assert "frame processor: UART A" in out and "TM in on udp 4899" in out
     assert "event Magnetorquer.degaussed" in out
     assert "monitoring.coil_hot" not in out and "monitoring.coil_cold" not in out
+    assert "event Attitude.mode_changed (info): old=OFF, new=DETUMBLE" in out
+    assert "event Attitude.mode_changed (info): old=DETUMBLE, new=POINTING" in out
+    assert "event Attitude.detumbled" in out
     assert "Traceback" not in out
+
+
+def test_aurora_labels_its_function_argument_and_event_fields_in_xtce(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    out = tmp_path / "aurora.xml"
+    r = obsw("yamcs", "xtce", "--mission", AURORA, "-o", out)
+    assert r.returncode == 0, r.stderr
+    ns = {"x": "http://www.omg.org/spec/XTCE/20180204"}
+    root = ET.parse(str(out)).getroot()
+
+    def labels(kind, name):
+        t = root.find(".//x:%s[@name='%s']" % (kind, name), ns)
+        assert t is not None, name
+        return {e.get("value"): e.get("label") for e in t.iter("{%s}Enumeration" % ns["x"])}
+
+    modes = {"0": "OFF", "1": "DETUMBLE", "2": "POINTING"}
+    assert labels("EnumeratedArgumentType", "select_mode_mode_t") == modes
+    assert labels("EnumeratedParameterType", "mode_changed_new_t") == modes

@@ -28,6 +28,7 @@ from obsw_host.obc import monitoring
 from obsw_host.obc.health import HostHealth, ObcHealth
 from obsw_host.obc.module_link import ModuleLink
 from obsw_host.obc.onboard_time import ONBOARD_TIME, OnboardTime
+from obsw_host.obc.ticks import Ticks
 from obsw_host.obc.topology import OBC_HEALTH, PLATFORM, PLATFORM_EVENTS
 from obsw_host.pus.onboard import Onboard, tai_now
 from obsw_host.update.component import SOFTWARE
@@ -110,7 +111,9 @@ class PusUnit:
         self.sdb = sdb = topology.sdb
         self.out = out
         opts = topology.section("pus")
-        self.components = [c.build() for c in process.components]
+        built = [(c, c.build()) for c in process.components]
+        self.components = [b for _, b in built]
+        self.ticks = Ticks(built, out)
         self.health = self._health(topology)
         self.components.append((OBC_HEALTH, self.health))
         self.onboard_time = OnboardTime(os.path.join(config.state, "onboard_time.json"), tai_now)
@@ -309,6 +312,9 @@ class PusUnit:
     async def _transport_task(self):
         await drive_transport(self.transport, self.node)
 
+    async def _ticks_task(self):
+        await self.ticks.run(lambda: self._running)
+
     async def _module_task(self):
         await self.module.run(self.onboard.period, lambda: self._running)
 
@@ -323,6 +329,8 @@ class PusUnit:
             self.onboard.tasks.append(self._engine_task)
         if self.module is not None:
             self.onboard.tasks.append(self._module_task)
+        if self.ticks:
+            self.onboard.tasks.append(self._ticks_task)
         self.onboard.start()
         self.out(
             "PUS application process APID %d on udp %s:%d, services %s"
@@ -366,13 +374,22 @@ class ComponentUnit:
         self.out = out
         self.node = Node("obc-%s-components" % process.name)
         self.transport = SocketTransport(self.node, topology.config.il_directory)
-        self.components = [c.build() for c in process.components]
+        built = [(c, c.build()) for c in process.components]
+        self.components = [b for _, b in built]
         for itf, impl in self.components:
             self.node.provide(itf, impl)
+        self.ticks = Ticks(built, out)
         self._thread = None
+        self._running = False
+
+    def _serve(self):
+        """Requests and ticks, one at a time, on this unit's thread (the threading rule of
+        ``obsw_host.obc.plugins``)."""
+        self.ticks.serve(self.transport, self.node, lambda: self._running)
 
     def start(self):
-        self._thread = threading.Thread(target=self.transport.serve, name="components")
+        self._running = True
+        self._thread = threading.Thread(target=self._serve, name="components")
         self._thread.daemon = True
         self._thread.start()
         self.out("components %s" % ", ".join(itf.name for itf, _ in self.components))
@@ -384,6 +401,7 @@ class ComponentUnit:
         return _components_alive(self.components)
 
     def stop(self):
+        self._running = False
         self.transport.stop()
         if self._thread is not None:
             self._thread.join(2.0)

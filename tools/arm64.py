@@ -16,7 +16,7 @@ Needs root, debootstrap and qemu-user-static (Debian packages); prints why and e
 skip line when they are missing. The root file system is kept in build/arm64/ and reused
 (`--fresh` builds it again). See docs/hardware.md.
 
-    sudo tools/arm64.py [--fresh] [--no-tests]
+    sudo tools/arm64.py [--fresh] [--no-tests] [--record]
 """
 
 import argparse
@@ -43,6 +43,11 @@ class Stage:
     def __init__(self):
         self.passed = self.failed = 0
         self.t0 = time.monotonic()
+        self.lines = []
+
+    def say(self, line):
+        self.lines.append(line)
+        print(line, flush=True)
 
     def step(self, title, fn):
         t = time.monotonic()
@@ -50,10 +55,10 @@ class Stage:
             detail = fn()
         except Exception as e:  # a step that fails says why; the others still run
             self.failed += 1
-            print("FAIL %-52s %7.1f s  %s" % (title, time.monotonic() - t, e), flush=True)
+            self.say("FAIL %-50s %7.1f s  %s" % (title, time.monotonic() - t, e))
             return None
         self.passed += 1
-        print("ok   %-52s %7.1f s  %s" % (title, time.monotonic() - t, detail or ""), flush=True)
+        self.say("ok   %-50s %7.1f s  %s" % (title, time.monotonic() - t, detail or ""))
         return detail
 
 
@@ -94,7 +99,7 @@ class Rootfs:
         for name in ("OBSW_PORT_BASE", "http_proxy", "https_proxy", "PIP_INDEX_URL"):
             if os.environ.get(name):
                 env[name] = os.environ[name]
-        cmd = ["chroot", self.path, "/bin/sh", "-c", script]
+        cmd = [shutil.which("chroot"), self.path, "/bin/sh", "-c", script]
         if not check:
             return subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
         return run(cmd, env=env, timeout=timeout)
@@ -146,7 +151,7 @@ def install(rootfs):
     if os.path.exists(certs):
         shutil.copy(certs, rootfs.path + certs)
     rootfs.chroot("[ -x %s/bin/pip ] || python3 -m venv %s" % (VENV, VENV))
-    rootfs.chroot("%s/bin/pip install -q %s pytest" % (VENV, SRC))
+    rootfs.chroot("%s/bin/pip install -q %s pytest hypothesis" % (VENV, SRC))  # + the tests
     machine = "import platform; print(platform.machine())"
     out = rootfs.chroot("%s/bin/obsw --version; %s/bin/python -c '%s'" % (VENV, VENV, machine))
     return out.replace("\n", ", ")
@@ -203,7 +208,7 @@ def serve_and_ping(rootfs):
     os.environ["OBSW_PORT_BASE"] = str(free_base())
     rootfs.chroot("rm -rf /var/lib/obsw-emulated")
     server = subprocess.Popen(
-        ["chroot", rootfs.path, "/bin/sh", "-c",
+        [shutil.which("chroot"), rootfs.path, "/bin/sh", "-c",
          "exec %s/bin/obsw obc serve /etc/obsw-emulated" % VENV],
         env={"PATH": VENV + "/bin:/usr/bin:/bin", "HOME": "/root", "LANG": "C.UTF-8",
              "OBSW_PORT_BASE": os.environ["OBSW_PORT_BASE"]},
@@ -246,6 +251,7 @@ def main(argv=None):
     ap.add_argument("--rootfs", default=os.path.join(ROOT, "build", "arm64", "rootfs"))
     ap.add_argument("--fresh", action="store_true", help="build the root file system again")
     ap.add_argument("--no-tests", action="store_true", help="skip the core tests (the longest)")
+    ap.add_argument("--record", action="store_true", help="write docs/arm64-last-run.txt")
     args = ap.parse_args(argv)
     reason = why_not()
     if reason:
@@ -272,7 +278,10 @@ def main(argv=None):
                     break
         finally:
             rootfs.unmount()
-    print("arm64: %.0f s in all" % (time.monotonic() - stage.t0))
+    stage.say("arm64: %.0f s in all" % (time.monotonic() - stage.t0))
+    if args.record:
+        with open(os.path.join(ROOT, "docs", "arm64-last-run.txt"), "w") as f:
+            f.write("    " + "\n    ".join(stage.lines) + "\n")
     print("%d passed, %d failed" % (stage.passed, stage.failed))
     return 1 if stage.failed else 0
 

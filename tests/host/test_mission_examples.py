@@ -275,6 +275,19 @@ def test_aurora_runs_from_its_folder(tmp_path):
         assert "Magnetorquer.max_dipole = 0.2 A.m^2" in r, obc.stop()
         assert ground("function", "Magnetorquer.enable").returncode == 0
 
+        # the processes with their pids, uptime and restarts, the plug-ins' among them
+        def adcs_row():
+            r = obsw("obc", "status", AURORA, "--state", tmp_path / "state", "--json", env=env)
+            rows = [p for p in json.loads(r.stdout)["processes"] if p["name"] == "adcs"]
+            return rows[0] if rows[0]["state"] == "up" and rows[0]["restarts"] == 1 else None
+
+        row = wait_until(adcs_row)
+        assert row and row["pid"] == obc.pids_of("adcs")[-1], row
+        assert row["runs"] == ["Magnetorquer", "Attitude"], row
+        r = obsw("obc", "status", AURORA, "--state", tmp_path / "state", env=env)
+        assert re.search(r"\nadcs +%d +up +\d+ s +1 +Magnetorquer, Attitude\n" % row["pid"],
+                         r.stdout), r.stdout  # fmt: skip
+
         # its procedure, from its own procedures folder
         r = obcp("load-ref", "detumble", ".", "detumble.plt")
         assert r.returncode == 0, r.stdout + r.stderr
@@ -303,6 +316,8 @@ def test_aurora_runs_from_its_folder(tmp_path):
     assert "event Attitude.mode_changed (info): old=OFF, new=DETUMBLE" in out
     assert "event Attitude.mode_changed (info): old=DETUMBLE, new=POINTING" in out
     assert "event Attitude.detumbled" in out
+    r = obsw("obc", "status", AURORA, "--state", tmp_path / "state", env=env)
+    assert r.returncode == 1 and "aurora-1: not running" in r.stdout
     assert "Traceback" not in out
 
 

@@ -372,8 +372,10 @@ class ApplicationProcess:
     def _emit(self, raw):
         try:
             self.out(raw)
-        except Exception:  # the output's failure is counted; the process keeps going
+        except Exception as e:  # the output's failure is counted and said; the loop goes on
             self.count("tm_lost")
+            if len(raw) > 8:  # TM[service, subtype] from the secondary header
+                self.unsent(raw[7], raw[8], "output failed: %s" % (e,))
             return False
         return True
 

@@ -53,7 +53,12 @@ from obsw.pus.messages import (
     TM_HK_HK_STRUCTURE_REPORT,
 )
 from obsw.pus.services.base import STRUCTURE_ID, U16, Service
-from obsw.pus.services.s01_verification import FAILURE_REFUSED, FAILURE_UNKNOWN_ID, PusFailure
+from obsw.pus.services.s01_verification import (
+    FAILURE_EXECUTION,
+    FAILURE_REFUSED,
+    FAILURE_UNKNOWN_ID,
+    PusFailure,
+)
 from obsw.pus.services.s03_functional import FunctionalReporting
 from obsw.pus.services.s03_layouts import (
     APPEND,
@@ -287,8 +292,9 @@ class Housekeeping(FunctionalReporting, Service):
         sids = req.decode(SIDS)["sids"]
         self._known(kind, sids)
         req.start()
-        for sid in sids:
-            self.generate(sid, req.source, kind)
+        lost = [sid for sid in sids if self.generate(sid, req.source, kind) is None]
+        if lost:  # said with its reason by the application process's unsent listeners
+            raise _sid_failure(FAILURE_EXECUTION, "no report of structure %d" % lost[0], lost[0])
 
     def _append(self, req, kind):
         tc = req.decode(APPEND)

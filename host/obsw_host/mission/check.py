@@ -5,7 +5,10 @@ First each file against its JSON Schema (``schema/``), then what a schema cannot
 Python: names and ids given twice, references between the files (housekeeping, functions,
 positions, nodes, procedures against the database and the components), the shapes of
 ``range``, ``limits`` and ``calibration``, processes naming known kinds or declared components.
-Entries the schema already refused are skipped here, so one mistake gives one line.
+Entries the schema already refused are skipped here, so one mistake gives one line. Last,
+what the OBC would otherwise find out only while it runs (``crosscheck``: the database against
+the components, component options, monitoring, report sizes): a mission that passes starts
+every process, and its database means what it says.
 """
 
 import glob

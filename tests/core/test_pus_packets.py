@@ -168,6 +168,20 @@ class TestDecodeErrors(unittest.TestCase):
             PusTc.unpack(raw)
         self.assertEqual((cm.exception.expected, cm.exception.got), (13, 10))
 
+    def test_the_shortest_tc_exactly(self):
+        # PUS-C TC: primary header 6 + secondary header 5 + PEC 2 = 13 octets at least; a
+        # 12-octet TC with a good checksum is refused (its source ID would be read from the
+        # checksum), on every decode path (accelerated, fast, careful)
+        short = _sealed("1873 c019 0005 2f 11 01 00")
+        self.assertEqual(len(short), 12)
+        for unpack in (PusTc.unpack, lambda b: PusTc._decode(b, 0, DEFAULT, True)[0]):
+            with self.assertRaises(PusLengthError) as cm:
+                unpack(short)
+            self.assertEqual((cm.exception.expected, cm.exception.got), (13, 12))
+            self.assertEqual(failure_code(cm.exception), messages.FAILURE_INVALID_LENGTH)
+            tc = unpack(TC_17_1)
+            self.assertEqual((len(TC_17_1), tc.service, tc.subtype, tc.source_id), (13, 17, 1, 0))
+
     def test_pus_version(self):
         raw = _sealed("1873 c019 0006 1f 11 01 0000")  # PUS version 1 (PUS-A)
         with self.assertRaises(PusVersionError) as cm:

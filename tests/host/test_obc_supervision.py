@@ -567,3 +567,26 @@ def test_a_report_that_cannot_be_built_is_logged_and_raised_as_an_event():
     values = e.unpack(events[0][2])
     assert (values["service"], values["subtype"]) == (3, 25)
     assert "70" in values["reason"]
+
+
+def test_a_datagram_the_socket_refuses_is_heard_with_its_reason():
+    import asyncio
+
+    from obsw_host.pus.onboard import _Udp
+
+    loop = asyncio.new_event_loop()
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.bind(("127.0.0.1", 0))
+    sock.setblocking(False)
+    counted, heard = [], []
+    try:
+        udp = _Udp(loop, sock, lambda *a: None, counted.append, lambda *a: heard.append(a))
+        tm = bytes([0x08, 0x0A, 0xC0, 0, 0xFF, 0xFF, 0x20, 3, 25]) + bytes(70000)
+        udp.sendto(tm, sock.getsockname())
+    finally:
+        loop.remove_reader(sock.fileno())
+        loop.close()
+        sock.close()
+    assert counted == ["udp_errors"]
+    assert len(heard) == 1 and heard[0][:2] == (3, 25)
+    assert heard[0][2].startswith("UDP send of 70009 octets failed: "), heard

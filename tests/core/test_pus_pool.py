@@ -132,3 +132,26 @@ class TestPool(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestDefaults(unittest.TestCase):
+    """A parameter's ``default`` is an engineering value (as its range is): the pool gives
+    its raw value until the parameter has one of its own."""
+
+    def test_a_default_is_turned_raw(self):
+        from obsw.pus.sdb import loads
+
+        db = loads(
+            '{"mission": "m", "parameters": ['
+            '{"name": "t", "id": 1, "type": "uint16", "default": 20, '
+            '"calibration": {"spline": [[1365, 0], [1765, 100]]}},'
+            '{"name": "m", "id": 2, "type": "uint8", "default": "POINTING", '
+            '"enumeration": {"0": "OFF", "2": "POINTING"}},'
+            '{"name": "g", "id": 3, "type": "int32", "default": 250}]}'
+        )
+        pool = ParameterPool(db)
+        self.assertEqual(pool.get(1), 1365 + 4 * 20)
+        self.assertEqual(pool.get(2), 2)
+        self.assertEqual(pool.get(3), 250)
+        pool.values[1] = 1500
+        self.assertEqual(pool.get(1), 1500)

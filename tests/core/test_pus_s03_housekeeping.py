@@ -3,7 +3,11 @@
 import unittest
 
 from obsw.pus.parameters import ParameterPool
-from obsw.pus.services.s01_verification import FAILURE_REFUSED, FAILURE_UNKNOWN_ID
+from obsw.pus.services.s01_verification import (
+    FAILURE_EXECUTION,
+    FAILURE_REFUSED,
+    FAILURE_UNKNOWN_ID,
+)
 from obsw.pus.services.s03_housekeeping import Housekeeping, HousekeepingUser
 from obsw.store import Store
 from pus_loop import APID, Loop, sdb
@@ -142,3 +146,57 @@ class TestHousekeeping(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestUnsent(unittest.TestCase):
+    """A report that cannot be built is heard with its reason; the counts do not skip."""
+
+    def test_a_value_the_structure_cannot_carry_names_the_parameter(self):
+        loop, hk, user, pool = make()
+        heard = []
+        loop.app.unsent_listeners.append(lambda *a: heard.append(a))
+        count = loop.app.sequence.peek(APID)
+        pool.values[3] = 70000  # Panel.mode is a uint8
+        self.assertIsNone(hk.generate(1))
+        self.assertEqual(len(heard), 1)
+        service, subtype, why = heard[0]
+        self.assertEqual((service, subtype), (3, 25))
+        self.assertTrue(why.startswith("structure 1: parameter 3 = 70000: "), why)
+        self.assertEqual(loop.app.counters.get("hk_unpackable"), 1)
+        self.assertEqual(loop.app.sequence.peek(APID), count)
+
+    def test_a_one_shot_report_that_cannot_be_built_fails_its_request(self):
+        loop, hk, user, pool = make()
+        heard = []
+        loop.app.unsent_listeners.append(lambda *a: heard.append(a))
+        pool.values[3] = 70000  # Panel.mode is a uint8
+        tx = loop.run(user.one_shot(APID, [1]))
+        self.assertFalse(tx.ok)
+        self.assertEqual((tx.failure["stage"], tx.failure["code"]), (4, FAILURE_EXECUTION))
+        self.assertEqual(bytes(tx.failure["data"]), b"\x00\x01")
+        self.assertEqual([h[:2] for h in heard], [(3, 25)])
+        self.assertTrue((3, 25) not in loop.types())
+
+    def test_an_output_that_fails_is_heard(self):
+        loop, hk, user, pool = make()
+        heard = []
+        loop.app.unsent_listeners.append(lambda *a: heard.append(a))
+
+        def broken(raw):
+            raise OSError("message too long")
+
+        loop.app.out = broken
+        self.assertIsNone(hk.generate(1))
+        self.assertEqual(heard, [(3, 25, "output failed: message too long")])
+
+    def test_a_packet_too_long_is_heard_and_leaves_no_gap(self):
+        loop, hk, user, pool = make()
+        heard = []
+        loop.app.unsent_listeners.append(lambda *a: heard.append(a))
+        count = loop.app.sequence.peek(APID)
+        self.assertIsNone(loop.app.send_tm(3, 25, bytes(70000)))
+        self.assertEqual([h[:2] for h in heard], [(3, 25)])
+        self.assertTrue("70" in heard[0][2], heard)
+        self.assertEqual(loop.app.sequence.peek(APID), count)
+        self.assertIsNotNone(loop.app.send_tm(3, 25, b"\x00\x01"))
+        self.assertEqual(loop.app.sequence.peek(APID), count + 1)

@@ -163,3 +163,40 @@ class TestFunctions(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestLabels(unittest.TestCase):
+    """An argument or an event field with an enumeration takes and shows its labels."""
+
+    def db(self):
+        doc = json.loads(SDB)
+        doc["functions"] = [
+            {"id": 9, "name": "Heater.mode", "arguments": [{"id": 1, "name": "mode",
+             "type": "uint8", "enumeration": {"0": "OFF", "2": "ECO"}}]},
+        ]  # fmt: skip
+        doc["events"] = [{"name": "heater.mode", "id": 77, "severity": "info", "data": [
+            {"name": "old", "type": "uint8", "enumeration": {"0": "OFF", "2": "ECO"}},
+            {"name": "watts", "type": "uint8"}]}]  # fmt: skip
+        return Sdb(doc)
+
+    def test_a_label_is_sent_as_its_number(self):
+        user = FunctionUser(functions(self.db()))
+        self.assertEqual(user.pack("Heater.mode", {"mode": "ECO"}), user.pack(9, {"mode": 2}))
+        self.assertEqual(user.pack(9, {1: "OFF"}), user.pack(9, {1: 0}))
+        with self.assertRaises(ValueError) as e:
+            user.pack(9, {"mode": "HOT"})
+        said = str(e.exception)
+        self.assertTrue("no label 'HOT'" in said and "OFF" in said and "ECO" in said, said)
+
+    def test_an_event_field_shows_its_label(self):
+        ev = self.db().event("heater.mode")
+        values = ev.unpack(ev.pack({"old": 2, "watts": 2}))
+        self.assertEqual(values, {"old": 2, "watts": 2})
+        self.assertEqual(ev.labelled(values), {"old": "ECO", "watts": 2})
+        self.assertEqual(ev.labelled({"old": 5, "watts": 1}), {"old": 5, "watts": 1})
+
+    def test_a_bad_enumeration_is_a_database_error(self):
+        doc = json.loads(SDB)
+        arg = {"id": 1, "name": "mode", "type": "uint8", "enumeration": {"x": "OFF"}}
+        doc["functions"] = [{"id": 9, "name": "Heater.mode", "arguments": [arg]}]
+        self.assertRaises(SdbError, Sdb, doc)

@@ -6,6 +6,7 @@ import unittest
 from obsw.pus.parameters import ParameterPool
 from obsw.pus.sdb import Sdb
 from obsw.pus.services.s01_verification import (
+    FAILURE_EXECUTION,
     FAILURE_OUT_OF_BOUNDS,
     FAILURE_OUT_OF_RANGE,
     FAILURE_REFUSED,
@@ -84,6 +85,16 @@ class TestParameters(unittest.TestCase):
         tx = loop.run(user.report(APID, [1, 999]))
         self.assertEqual((tx.failure["stage"], tx.failure["code"]), (2, FAILURE_UNKNOWN_ID))
         self.assertEqual(tx.failure["data"], b"\x03\xe7")
+
+    def test_a_value_its_type_cannot_carry_is_a_failure_naming_it_and_why(self):
+        loop, pool, user = make()
+        pool.values[3] = 70000  # Panel.mode is a uint8: a component wider than its database
+        tx = loop.run(user.report(APID, ["Panel.angle", "Panel.mode"]))
+        self.assertEqual((tx.failure["stage"], tx.failure["code"]), (4, FAILURE_EXECUTION))
+        data = bytes(tx.failure["data"])
+        self.assertEqual(data[:2], b"\x00\x03")
+        self.assertTrue(data[2:].decode().startswith("70000: "), data)
+        self.assertEqual([t for t in loop.types() if t[0] == 20], [])
 
     def test_set_values(self):
         loop, pool, user = make()

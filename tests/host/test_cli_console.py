@@ -174,3 +174,14 @@ def test_completion_of_commands_and_database_names():
     assert "SolarPanel.speed=" in complete("params set Sol")
     assert complete("function SolarPanel.set_angle ") == ["angle="]
     assert "SolarPanel.deployed" in complete("events disable Sol")
+
+
+def test_a_labelled_argument_completes_with_its_labels():
+    from obsw.pus.sdb import load
+
+    aurora = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "aurora", "sdb.json")
+    ground = _subcommands(build_parser("ground"))["ground"]
+    completer = GroundCompleter(ground, load(aurora))
+    texts = [c.text for c in completer.get_completions(
+        Document("function Attitude.select_mode mode=D"), None)]  # fmt: skip
+    assert texts == ["mode=DETUMBLE"]

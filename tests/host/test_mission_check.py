@@ -258,8 +258,12 @@ def test_at_least_23_mistakes():
 
 
 @pytest.mark.parametrize("name,spoil,file,text", MISTAKES, ids=[m[0] for m in MISTAKES])
-def test_a_mistake_stops_obc_serve_in_one_line(folder, tmp_path, name, spoil, file, text):
+def test_a_mistake_stops_obc_serve_in_one_line(
+    folder, tmp_path, monkeypatch, name, spoil, file, text
+):
     spoil(folder)
+    monkeypatch.chdir(tmp_path)
+    said = [str(p) for p in check(os.path.join(folder, "mission.json"))[1]]
     state = tmp_path / "state"
     t0 = time.monotonic()
     r = subprocess.run(
@@ -275,6 +279,7 @@ def test_a_mistake_stops_obc_serve_in_one_line(folder, tmp_path, name, spoil, fi
     assert text in line, line
     assert "; expected " in line or "line " in line, line
     assert "Traceback" not in line
+    assert lines == said  # `obsw mission check` says the same
     assert not state.exists()  # no process started: none made its state folder
     assert took < BOUND
 

@@ -131,17 +131,54 @@ def test_mission_new_passes_the_check_and_runs(tmp_path):
     m = load(str(folder))
     assert m.name == "pico-1" and m.sdb.mission == "pico-1"
     assert obsw("mission", "new", "pico-1", cwd=str(tmp_path)).returncode == 2  # not over it
-    base = free_base(10)
+    for name in ("mission.json", "sdb.json"):  # nothing of this machine in the folder
+        assert str(ROOT) not in (folder / name).read_text()
+    assert "cfdp" not in json.loads((folder / "mission.json").read_text())  # ports: the base's
+    base = free_base(m.sdb.apid("pus"))
     env = dict(ENV, OBSW_PORT_BASE=str(base))
     obc = Obc(str(folder), tmp_path / "state", env)
     try:
         wait_for_ping(["ground", "--mission", folder], obc, env)
         r = obsw("ground", "--mission", folder, "params", "get", "pus.tc_received", env=env)
         assert r.returncode == 0, r.stderr
+        # a file to this spacecraft lands in its filestore, over its own ports and entities
+        (tmp_path / "up.txt").write_text("pico")
+        r = obsw("cfdp", "put", "--mission", folder, "--root", tmp_path, "up.txt", "up.txt",
+                 env=env)  # fmt: skip
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "delivered up.txt to entity %d" % m.sdb.filestores["SAT"] in r.stdout, r.stdout
+        assert (tmp_path / "state" / "files" / "up.txt").read_text() == "pico"
     finally:
         out = obc.stop()
     assert "pico-1: version " in out and ", processes obc, " in out
     assert "Traceback" not in out
+
+
+def test_new_missions_never_share_a_port_an_id_or_a_path_with_another(tmp_path, monkeypatch):
+    """Two new missions and the examples, all on one base: no port, APID, spacecraft id or
+    CFDP entity in common, and no absolute path in the files."""
+    from obsw_host.mission.ids import MissionIds
+
+    names = ["pico-1", "lynx"]
+    for name in names:
+        assert obsw("mission", "new", name, cwd=str(tmp_path)).returncode == 0
+    r = obsw("mission", "new", "asked", "--slot", "7", cwd=str(tmp_path))
+    assert r.returncode == 0 and "spacecraft id 507" in r.stdout and "pus 456" in r.stdout
+    folders = [str(tmp_path / n) for n in names + ["asked"]] + [AURORA, sample.MISSION_DIR]
+    monkeypatch.delenv("OBSW_PORT_BASE", raising=False)  # every mission on its own base
+    seen = {}
+    for folder in folders:
+        ids = MissionIds.locate(folder)
+        mine = {("port", ids.ports.for_apid(a)) for a in ids.sdb.apids.values() if a}
+        mine |= {("port", ids.ports.cfdp_ground), ("scid", ids.sdb.scid)}
+        mine |= {("entity", e) for e in ids.sdb.filestores.values()}
+        for key in mine:
+            assert key not in seen, "%s %s of %s is also %s's" % (key + (folder, seen.get(key)))
+            seen[key] = folder
+    for n in names:
+        for f in ("mission.json", "sdb.json"):
+            text = (tmp_path / n / f).read_text()
+            assert str(tmp_path) not in text and str(ROOT) not in text
 
 
 def test_aurora_differs_from_the_sample_and_passes_the_check():
@@ -199,11 +236,30 @@ def test_aurora_runs_from_its_folder(tmp_path):
         assert "adcs.gain = 250" in r.stdout
         assert re.search(r"Magnetorquer.coil_temp = [-0-9.]+ degC \(raw \d+\)", r.stdout), r.stdout
         assert "Magnetorquer.coil_current = " in r.stdout and " mA" in r.stdout
+
+        # the mission's limit check on the calibrated coil temperature (15..35 degC, the coil
+        # at about 21 degC): installed as the raw limits of those engineering values, in limits
+        r = ground("monitor", "list")
+        assert r.returncode == 0, r.stderr
+        row = next(x for x in r.stdout.splitlines() if "Magnetorquer.coil_temp" in x)
+        assert " 15 degC " in row and " 35 degC " in row, row
+        r = ground("monitor", "out-of-limits")
+        assert r.returncode == 0 and "(none)" in r.stdout, r.stdout
         assert ground("function", "Magnetorquer.enable").returncode == 0
         r = ground("params", "get", "Magnetorquer.enabled")
         assert "Magnetorquer.enabled = True" in r.stdout, r.stdout + r.stderr
         r = ground("function", "Magnetorquer.set_dipole", "x=0.3", "y=0", "z=0")
         assert r.returncode != 0  # the component refuses beyond max_dipole: a failure report
+
+        # the time-driven plug-in: its mode by label, its tick detumbling the spacecraft
+        r = ground("function", "Attitude.select_mode", "mode=DETUMBLE")
+        assert r.returncode == 0, r.stdout + r.stderr
+        r = ground("function", "Attitude.select_mode", "mode=FAST")
+        assert r.returncode == 2 and "no label 'FAST'" in r.stderr, r.stdout + r.stderr
+        r = wait_until(lambda: "POINTING" in ground("params", "get", "Attitude.mode").stdout)
+        assert r, obc.stop()
+        r = ground("params", "get", "Attitude.rate", "Attitude.ticks")
+        assert re.search(r"Attitude.rate = 0\.[0-9]+ deg/s", r.stdout), r.stdout
 
         # a SpaceCAN node's function, its effect readable at once
         assert ground("function", "CpduA.set_state_bits", "state=5").returncode == 0
@@ -218,6 +274,19 @@ def test_aurora_runs_from_its_folder(tmp_path):
         r = wait_until(lambda: ground("params", "get", "Magnetorquer.max_dipole").stdout)
         assert "Magnetorquer.max_dipole = 0.2 A.m^2" in r, obc.stop()
         assert ground("function", "Magnetorquer.enable").returncode == 0
+
+        # the processes with their pids, uptime and restarts, the plug-ins' among them
+        def adcs_row():
+            r = obsw("obc", "status", AURORA, "--state", tmp_path / "state", "--json", env=env)
+            rows = [p for p in json.loads(r.stdout)["processes"] if p["name"] == "adcs"]
+            return rows[0] if rows[0]["state"] == "up" and rows[0]["restarts"] == 1 else None
+
+        row = wait_until(adcs_row)
+        assert row and row["pid"] == obc.pids_of("adcs")[-1], row
+        assert row["runs"] == ["Magnetorquer", "Attitude"], row
+        r = obsw("obc", "status", AURORA, "--state", tmp_path / "state", env=env)
+        assert re.search(r"\nadcs +%d +up +\d+ s +1 +Magnetorquer, Attitude\n" % row["pid"],
+                         r.stdout), r.stdout  # fmt: skip
 
         # its procedure, from its own procedures folder
         r = obcp("load-ref", "detumble", ".", "detumble.plt")
@@ -243,4 +312,29 @@ def test_aurora_runs_from_its_folder(tmp_path):
     assert "CpduA=node 20, CpduB=node 21" in out
     assert "frame processor: UART A" in out and "TM in on udp 4899" in out
     assert "event Magnetorquer.degaussed" in out
+    assert "monitoring.coil_hot" not in out and "monitoring.coil_cold" not in out
+    assert "event Attitude.mode_changed (info): old=OFF, new=DETUMBLE" in out
+    assert "event Attitude.mode_changed (info): old=DETUMBLE, new=POINTING" in out
+    assert "event Attitude.detumbled" in out
+    r = obsw("obc", "status", AURORA, "--state", tmp_path / "state", env=env)
+    assert r.returncode == 1 and "aurora-1: not running" in r.stdout
     assert "Traceback" not in out
+
+
+def test_aurora_labels_its_function_argument_and_event_fields_in_xtce(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    out = tmp_path / "aurora.xml"
+    r = obsw("yamcs", "xtce", "--mission", AURORA, "-o", out)
+    assert r.returncode == 0, r.stderr
+    ns = {"x": "http://www.omg.org/spec/XTCE/20180204"}
+    root = ET.parse(str(out)).getroot()
+
+    def labels(kind, name):
+        t = root.find(".//x:%s[@name='%s']" % (kind, name), ns)
+        assert t is not None, name
+        return {e.get("value"): e.get("label") for e in t.iter("{%s}Enumeration" % ns["x"])}
+
+    modes = {"0": "OFF", "1": "DETUMBLE", "2": "POINTING"}
+    assert labels("EnumeratedArgumentType", "select_mode_mode_t") == modes
+    assert labels("EnumeratedParameterType", "mode_changed_new_t") == modes

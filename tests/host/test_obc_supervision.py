@@ -3,6 +3,7 @@ simulated device, systemd's notify protocol on a fake socket, the rule that feed
 watchdog only while every critical process is healthy, the health figures from a simulated
 /proc and /sys tree, and the systemd unit. Clocks are simulated where time matters."""
 
+import json
 import math
 import os
 import shutil
@@ -365,8 +366,25 @@ def test_the_obc_component_publishes_what_changed(tmp_path):
 # ------------------------------------------------------------------------------ the unit
 
 
+def pi_mission(tmp_path):
+    """The Raspberry Pi's mission folder, its key file (``/etc/obsw/tc.keys`` on the Pi) in
+    ``tmp_path``: a mission that passes the check on this machine."""
+    folder = tmp_path / "pi"
+    shutil.copytree(os.path.join(ROOT, "boards", "raspberry-pi"), folder)
+    keys = tmp_path / "tc.keys"
+    r = subprocess.run([OBSW, "frames", "keygen", str(keys)], capture_output=True, text=True,
+                       cwd=str(tmp_path))  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    path = folder / "mission.json"
+    doc = json.loads(path.read_text())
+    doc["frames"]["keys"] = str(keys)
+    doc.pop("$schema")
+    path.write_text(json.dumps(doc))
+    return str(path)
+
+
 def test_install_service_dry_run_prints_the_unit_for_the_mission(tmp_path):
-    mission = os.path.join(ROOT, "boards", "raspberry-pi", "mission.json")
+    mission = pi_mission(tmp_path)
     out = subprocess.run(
         [OBSW, "obc", "install-service", mission, "--dry-run", "--obsw", "/opt/obsw/bin/obsw"],
         capture_output=True,
@@ -379,7 +397,7 @@ def test_install_service_dry_run_prints_the_unit_for_the_mission(tmp_path):
 
 
 def test_install_service_writes_under_root(tmp_path):
-    mission = os.path.join(ROOT, "boards", "raspberry-pi", "mission.json")
+    mission = pi_mission(tmp_path)
     r = subprocess.run(
         [
             OBSW,
@@ -409,12 +427,29 @@ def test_install_service_writes_under_root(tmp_path):
 def test_install_service_refuses_bad_input(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text("{")
-    for args in ([str(bad)], ["--state", "/a b"], ["--watchdog-sec", "0"]):
+    mission = pi_mission(tmp_path)
+    for args, said in (([str(bad)], str(bad) + ": $: not valid JSON"),
+                       ([mission, "--state", "/a b"], "obsw obc: "),
+                       ([mission, "--watchdog-sec", "0"], "obsw obc: ")):  # fmt: skip
         r = subprocess.run(
             [OBSW, "obc", "install-service", "--dry-run", *args], capture_output=True, text=True
         )
         assert r.returncode == 2, (args, r.stdout)
-        assert r.stderr.startswith("obsw obc: ") and len(r.stderr.splitlines()) == 1
+        assert r.stderr.startswith(said) and len(r.stderr.splitlines()) == 1, r.stderr
+
+
+def test_config_and_install_service_check_the_mission_first(tmp_path):
+    mission = pi_mission(tmp_path)
+    doc = json.loads(open(mission).read())
+    doc["pus"]["monitoring"] = [{"pmon": 1, "parameter": "Obc.temperature", "low": 0,
+                                 "high": 80, "high_event": "monitoring.hot"}]  # fmt: skip
+    open(mission, "w").write(json.dumps(doc))
+    for action in (["config"], ["install-service", "--dry-run"]):
+        r = subprocess.run([OBSW, "obc", *action, mission], capture_output=True, text=True)
+        assert r.returncode == 2 and r.stdout == "", (action, r.stdout)
+        lines = r.stderr.splitlines()
+        assert len(lines) == 1 and lines[0].startswith(mission + ": $.pus.monitoring[0]")
+        assert "monitoring.hot" in lines[0], lines
 
 
 def test_the_shipped_unit_is_the_default_one():
@@ -477,6 +512,29 @@ def test_the_missions_limit_checks_are_installed_at_the_first_start_only():
     assert list(again.services[12].pmons) == [43]
 
 
+def test_the_missions_limits_are_engineering_values_installed_as_raw_ones():
+    """Aurora's coil temperature is raw thermistor counts, calibrated by the spline
+    (1365 counts, 0 degC) .. (1765 counts, 100 degC): 4 counts per degC."""
+    from obsw.pus.sdb import load as load_db
+
+    root = os.path.join(os.path.dirname(__file__), "..", "..")
+    db = load_db(os.path.join(root, "examples", "aurora", "sdb.json"))
+    app = ApplicationProcess(42, lambda raw: None, SimClock(0.0), store=FakeStore())
+    app.register(OnBoardMonitoring(ParameterPool(db), db.events))
+    entry = {"pmon": 1, "parameter": "Magnetorquer.coil_temp", "low": 15, "high": 35,
+             "low_event": "monitoring.coil_cold", "high_event": "monitoring.coil_hot"}  # fmt: skip
+    assert monitoring.install(app, db, [entry]) == 1
+    d = app.services[12].pmons[1].d
+    assert (d["low"], d["high"]) == (1365 + 4 * 15, 1365 + 4 * 35)
+    assert d["high_event"] == db.event("monitoring.coil_hot").id
+    entry = dict(entry, pmon=2, low=15.1, high=34.9)  # integer raw limits: inside, not beyond
+    app.services[12].pmons.clear()
+    app.store = None
+    assert monitoring.install(app, db, [entry]) == 1
+    d = app.services[12].pmons[2].d
+    assert (d["low"], d["high"]) == (1365 + 61, 1365 + 139)
+
+
 @pytest.mark.parametrize(
     "entry, why",
     [
@@ -491,3 +549,44 @@ def test_a_bad_limit_check_is_a_configuration_error_naming_the_entry(entry, why)
     with pytest.raises(ConfigError) as e:
         monitoring.install(app, db, [SAMPLE_CHECKS[0], entry])
     assert str(e.value).startswith("pus.monitoring[1]: ") and why in str(e.value)
+
+
+def test_a_report_that_cannot_be_built_is_logged_and_raised_as_an_event():
+    from obsw_host.obc.units import PusUnit
+
+    app, db = monitoring_app(FakeStore())
+    events, lines = [], []
+    app.event_reporters.append(lambda *e: events.append(e) or True)
+    unit = PusUnit.__new__(PusUnit)  # the unit's wiring without its sockets and processes
+    unit.app, unit.sdb, unit.out, unit._reporting_unsent = app, db, lines.append, False
+    app.unsent_listeners.append(unit._unsent)
+    assert app.send_tm(3, 25, bytes(70000)) is None
+    assert len(lines) == 1 and lines[0].startswith("TM[3,25] not sent: "), lines
+    e = db.event("pus.report_failed")
+    assert [x[0] for x in events] == [e.id]
+    values = e.unpack(events[0][2])
+    assert (values["service"], values["subtype"]) == (3, 25)
+    assert "70" in values["reason"]
+
+
+def test_a_datagram_the_socket_refuses_is_heard_with_its_reason():
+    import asyncio
+
+    from obsw_host.pus.onboard import _Udp
+
+    loop = asyncio.new_event_loop()
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.bind(("127.0.0.1", 0))
+    sock.setblocking(False)
+    counted, heard = [], []
+    try:
+        udp = _Udp(loop, sock, lambda *a: None, counted.append, lambda *a: heard.append(a))
+        tm = bytes([0x08, 0x0A, 0xC0, 0, 0xFF, 0xFF, 0x20, 3, 25]) + bytes(70000)
+        udp.sendto(tm, sock.getsockname())
+    finally:
+        loop.remove_reader(sock.fileno())
+        loop.close()
+        sock.close()
+    assert counted == ["udp_errors"]
+    assert len(heard) == 1 and heard[0][:2] == (3, 25)
+    assert heard[0][2].startswith("UDP send of 70009 octets failed: "), heard

@@ -177,6 +177,12 @@ class GroundCompleter(Completer):
             for r in catalog.function_rows(sdb):
                 names = [a.split(":")[0].strip() for a in r["arguments"].split(",") if a]
                 self.arguments[r["name"]] = [n + "=" for n in names]
+            for f in sdb.functions.values():  # a labelled argument completes with its labels
+                names = {a[0]: a[1] for a in f.arguments}
+                for aid, labels in (getattr(f, "labels", None) or {}).items():
+                    self.arguments.setdefault(f.name, []).extend(
+                        "%s=%s" % (names[aid], label) for label in labels.values()
+                    )
 
     def candidates(self, words):
         """What may follow ``words`` (the words before the one being typed)."""

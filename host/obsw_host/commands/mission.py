@@ -33,6 +33,9 @@ def add_parser(sub):
                    "default: the template's, + 1 per mission)")  # fmt: skip
     n.add_argument("--port-base", type=int, help="the mission's port base (with --count, the "
                    "first one's, default 20000; each next one 200 above)")  # fmt: skip
+    n.add_argument("--slot", type=int, help="the ids' slot, 0 to 199: APIDs 400 + 8 x SLOT "
+                   "(pus; frames + 2, cfdp + 4), spacecraft id 500 + SLOT, CFDP entities "
+                   "20 + 2 x SLOT and the next (default: from the name)")  # fmt: skip
     n.add_argument("--count", type=int, help="write N missions NAME-1 .. NAME-N, each with "
                    "its own spacecraft id and ports (a fleet for one Yamcs)")  # fmt: skip
     n.set_defaults(func=new_cmd)
@@ -75,13 +78,19 @@ def new_cmd(args):
             print("%s: mission %s, spacecraft id %s, port base %d"
                   % (folder, ids.name, ids.scid, ids.config.doc["ports"]["base"]))  # fmt: skip
         return 0
-    if args.template or args.scid is not None or args.port_base is not None:
-        folder = new.copy(args.template or new.TEMPLATE_DIR, args.name, args.dir or args.name,
-                          args.scid, args.port_base)  # fmt: skip
+    if args.template:
+        folder = new.copy(args.template, args.name, args.dir or args.name, args.scid,
+                          args.port_base)  # fmt: skip
     else:
-        folder = new.write(args.name, args.dir or args.name)
-    print("%s: mission %s written; next: obsw mission check %s && obsw obc serve %s"
-          % (folder, args.name, folder, folder))  # fmt: skip
+        folder, _ = new.write(args.name, args.dir or args.name, args.slot)
+        if args.scid is not None or args.port_base is not None:
+            new.retarget_folder(folder, args.scid, args.port_base)
+    ids = _ids(folder)
+    local, ground = ids.cfdp_entities
+    print("%s: mission %s written: APIDs %s, spacecraft id %s, CFDP entities %d (onboard) and "
+          "%d (ground), PUS port %d; next: obsw mission check %s && obsw obc serve %s"
+          % (folder, args.name, ", ".join("%s %d" % kv for kv in ids.sdb.apids.items()),
+             ids.sdb.scid, local, ground, ids.ports.pus, folder, folder))  # fmt: skip
     return 0
 
 
@@ -97,6 +106,9 @@ def upgrade_cmd(args):
     doc = read_json(args.file, "mission file")
     if not isinstance(doc, dict):
         raise UserError("%s is not a JSON object" % args.file, expected="a mission file")
+    if "format" not in doc and "processes" not in doc:  # a database, a node: left as it is
+        raise UserError("%s is not a mission file (no format, no processes)" % args.file,
+                        expected="a format-1 mission file; nothing was changed")  # fmt: skip
     new, changes = upgrade(doc)
     if not changes:
         print("%s: already format %d" % (args.file, new["format"]))

@@ -42,6 +42,10 @@ def add_parser(sub):
     c.add_argument("config", nargs="?", help=MISSION_HELP)
     c.add_argument("--state", help="the state folder (default: the mission's)")
     c.set_defaults(func=show)
+    t = s.add_parser("status", help="the running OBC's processes: pids, uptime, restarts")
+    t.add_argument("config", nargs="?", help=MISSION_HELP)
+    t.add_argument("--state", help="the state folder (default: the mission's)")
+    t.set_defaults(func=status)
     r = s.add_parser("reset", help="clear the mission's state folder (refused while it runs)")
     r.add_argument("config", nargs="?", help=MISSION_HELP)
     r.add_argument("--state", help="the state folder (default: the mission's)")
@@ -88,6 +92,18 @@ def check_mission(path):
     from obsw_host.mission.check import check  # jsonschema and the PLUTO checker: parent only
 
     return check(locate(path))[1]
+
+
+def refused_unchecked(path):
+    """None if the mission at ``path`` passes ``obsw mission check``, else ``EXIT_REFUSED``
+    after one line per problem: what works on a mission checks it first."""
+    try:
+        problems = check_mission(path)
+    except (ConfigError, UserError) as e:
+        return _refuse(e)
+    for problem in problems:
+        print(problem, file=sys.stderr, flush=True)
+    return EXIT_REFUSED if problems else None
 
 
 def ports_in_use(topology):
@@ -239,6 +255,9 @@ def _serve_process(topology, args, out):
 
 
 def show(args):
+    refused = refused_unchecked(args.config)
+    if refused is not None:
+        return refused
     try:
         config = load(args)
         topology = Topology(config)
@@ -250,6 +269,64 @@ def show(args):
         "processes": config.processes, "platform": config.platform,
         "topology": topology.describe(),
     }, indent=2))  # fmt: skip
+    return 0
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process: there all the same
+        return True
+    return True
+
+
+def _duration(seconds):
+    s = int(seconds)
+    if s < 120:
+        return "%d s" % s
+    if s < 7200:
+        return "%d min" % (s // 60)
+    return "%d h %02d min" % (s // 3600, s % 3600 // 60)
+
+
+def status(args):
+    """The processes of the OBC running this mission, as its platform manager last wrote
+    them (``STATE/platform.json``); exit status 1 when it is not running."""
+    import time
+
+    from obsw_host.obc.platform import STATUS_FILE
+
+    try:
+        config = load(args)
+    except ConfigError as e:
+        return _refuse(e)
+    path = os.path.join(config.state, STATUS_FILE)
+    try:
+        with open(path) as f:
+            st = json.load(f)
+    except (OSError, ValueError):
+        print("%s: not running (no status in %s)" % (config.name, config.state))
+        return 1
+    if not st.get("running") or not _alive(int(st.get("manager", 0))):
+        print("%s: not running (last status %s)" % (config.name, time.strftime(
+            "%Y-%m-%d %H:%M:%S", time.localtime(st.get("written", 0)))))  # fmt: skip
+        return 1
+    if args.json:
+        print(json.dumps(st, indent=2))
+        return 0
+    now = time.time()
+    print("%s: platform manager pid %d" % (config.name, st["manager"]))
+    rows = [("process", "pid", "state", "uptime", "restarts", "runs")]
+    for p in st["processes"]:
+        up = _duration(now - p["started"]) if p.get("started") and p["state"] == "up" else "-"
+        state = p["state"] + (" (%s)" % p["why"] if p.get("why") else "")
+        rows.append((p["name"], str(p["pid"]), state, up, str(p["restarts"]),
+                     ", ".join(p["runs"])))  # fmt: skip
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]) - 1)]
+    for r in rows:
+        print("  ".join(x.ljust(w) for x, w in zip(r, widths)) + "  " + r[-1])
     return 0
 
 
@@ -266,6 +343,9 @@ def reset(args):
 
 
 def install_service(args):
+    refused = refused_unchecked(args.config)
+    if refused is not None:  # no unit for a mission that would not start
+        return refused
     try:
         config = load_config(args.config)
         state = args.state or (config.state if "state" in config.doc else None)

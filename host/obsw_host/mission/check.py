@@ -5,7 +5,10 @@ First each file against its JSON Schema (``schema/``), then what a schema cannot
 Python: names and ids given twice, references between the files (housekeeping, functions,
 positions, nodes, procedures against the database and the components), the shapes of
 ``range``, ``limits`` and ``calibration``, processes naming known kinds or declared components.
-Entries the schema already refused are skipped here, so one mistake gives one line.
+Entries the schema already refused are skipped here, so one mistake gives one line. Last,
+what the OBC would otherwise find out only while it runs (``crosscheck``: the database against
+the components, component options, monitoring, report sizes): a mission that passes starts
+every process, and its database means what it says.
 """
 
 import glob
@@ -18,9 +21,9 @@ from obsw.pus import sdb as sdb_module
 from obsw.spacecan.equipment import equipment_interface
 from obsw.spacecan.nodedef import NodeDefinition, NodeDefinitionError
 
-from obsw_host.mission import defaults
+from obsw_host.mission import crosscheck, defaults
 from obsw_host.mission.config import ConfigError, MissionConfig
-from obsw_host.mission.errors import MissionError, Problem, did_you_mean, short
+from obsw_host.mission.errors import MissionError, Problem, did_you_mean, display, short
 from obsw_host.mission.folder import MAX_PROCEDURE, locate, read_text
 from obsw_host.mission.schema import json_type, read_json, validate
 from obsw_host.obc.onboard_time import ONBOARD_TIME
@@ -101,6 +104,12 @@ class _Checker:
         self.problems += problems
         if doc is None:
             return None
+        if isinstance(doc, dict) and "format" not in doc and self._database_given(doc):
+            return None
+        if isinstance(doc, dict) and "format" not in doc and "processes" not in doc:
+            self.add(self.file, "$", "not a mission file (no format, no processes); expected a "
+                     "mission folder or its mission.json")  # fmt: skip
+            return None
         if isinstance(doc, dict) and "format" not in doc:
             self.add(
                 self.file,
@@ -119,6 +128,25 @@ class _Checker:
         self._orbit_and_stations(doc)
         return doc
 
+    def _database_given(self, doc):
+        """True (and the problem said) if ``doc`` is a spacecraft database, not a mission
+        file: the line names the mission folder to give instead."""
+        if not (isinstance(doc.get("mission"), str) or isinstance(doc.get("components"), list)):
+            return False
+        found = None
+        for name in sorted(os.listdir(self.folder)):
+            if name.endswith(".json") and os.path.join(self.folder, name) != self.file:
+                other, _ = read_json(os.path.join(self.folder, name), self.folder)
+                if isinstance(other, dict) and "format" in other:
+                    found = os.path.join(self.folder, name)
+                    if name == defaults.MISSION_FILE:
+                        found = self.folder
+                    break
+        where = "the mission folder %s" % display(found) if found else "its mission folder"
+        self.add(self.file, "$", "a spacecraft database, not a mission file; expected %s "
+                 "(whose mission file names this database)" % where)  # fmt: skip
+        return True
+
     def _components(self, doc):
         comps = doc.get("components")
         if not isinstance(comps, dict):
@@ -131,7 +159,7 @@ class _Checker:
             if not isinstance(spec, dict) or not isinstance(spec.get("module"), str):
                 continue
             try:
-                itf, _ = Component(name, spec, self.folder).check()
+                itf, cls = Component(name, spec, self.folder).check()
             except PluginError as e:
                 text = str(e)[len(e.key) + 2 :]
                 if "; expected" not in text:
@@ -140,6 +168,7 @@ class _Checker:
                 self.unresolved.add(name)
                 continue
             self.interfaces[name] = itf
+            crosscheck.options(self, name, spec, cls)
 
     def _processes(self, doc):
         procs = doc.get("processes")
@@ -262,7 +291,17 @@ class _Checker:
         pos = doc.get("position_scheduling")
         if isinstance(pos, dict) and "parameter" in pos:
             self._ref(f, ["position_scheduling", "parameter"], pos["parameter"], params)
+        self._against_components(f, doc)
         return doc
+
+    def _against_components(self, f, doc):
+        """The database against the components that serve it (``crosscheck``)."""
+        from obsw_host.obc.topology import FRAME_PROCESSOR, OBC_HEALTH
+
+        served = dict(self.interfaces)
+        served.update({i.name: i for i in (OBC_HEALTH, FRAME_PROCESSOR)})
+        crosscheck.attributes(self, f, doc, served)
+        crosscheck.power_cycle(self)
 
     def _apids(self, f, doc):
         apids = doc.get("apids")
@@ -754,6 +793,9 @@ def check(mission_file):
     except (ConfigError, sdb_module.SdbError) as e:
         c.add(c.sdb_file if isinstance(e, sdb_module.SdbError) else c.file, "$", str(e))
         return None, c.problems
+    crosscheck.monitoring(c, sdb)
+    crosscheck.housekeeping(c, sdb)
+    crosscheck.defaults(c, sdb)
     c.procedures_of(sdb)
     if c.problems:
         return None, c.problems

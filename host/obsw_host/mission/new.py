@@ -6,6 +6,7 @@ entity, the OBCP engine and the SpaceCAN master with the reconfiguration module'
 The new folder's files name the shipped JSON Schemas in ``$schema`` for editors.
 """
 
+import binascii
 import json
 import os
 import re
@@ -33,27 +34,89 @@ def _rewrite(path, changes):
 
 
 def _schema_ref(folder, schema):
-    """How ``folder``'s files name ``schema``: relative when it is nearby (a source tree),
-    else its absolute path (an installed package)."""
+    """How ``folder``'s files name ``schema``: a relative path when both are in one source
+    tree (``examples/``, ``missions/`` beside ``host/``), else None: an absolute path would
+    name one machine's checkout in a folder that is copied to others."""
     rel = os.path.relpath(schema, folder)
-    return rel if not rel.startswith("../../..") else schema
+    return rel if not rel.startswith("../../..") else None
 
 
-def write(name, folder):
-    """Write mission ``name`` into ``folder`` (new or empty); returns the folder."""
+# A new mission's ids, chosen from its name so that two missions on one machine differ: a
+# slot of SLOTS, each with its APIDs (ports are the base + APID), its CFDP entities and its
+# spacecraft id; the sample's and aurora's ids are in no slot.
+SLOTS = 200
+APID_FIRST = 400  # pus = 400 + 8 * slot, frames + 2, cfdp + 4 (its ground port + 5)
+SCID_FIRST = 500  # spacecraft id 500 + slot
+ENTITY_FIRST = 20  # onboard CFDP entity 20 + 2 * slot, the ground's + 1
+
+
+def identity(name, slot=None):
+    """The ids of new mission ``name`` (``slot``: 0 .. SLOTS - 1, default from the name)."""
+    if slot is None:
+        slot = binascii.crc32(name.encode()) % SLOTS
+    if not 0 <= slot < SLOTS:
+        raise UserError("slot %d" % slot, expected="a slot from 0 to %d" % (SLOTS - 1))
+    pus = APID_FIRST + 8 * slot
+    return {
+        "slot": slot,
+        "apids": {"pus": pus, "frames": pus + 2, "cfdp": pus + 4, "ground": 0},
+        "scid": SCID_FIRST + slot,
+        "entities": (ENTITY_FIRST + 2 * slot, ENTITY_FIRST + 2 * slot + 1),
+    }
+
+
+def _set_schema(path, ref):
+    """``$schema`` of file ``path`` set to ``ref``, or taken out (None)."""
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    if ref is None:
+        text = re.sub(r'\n\s*"\$schema": "[^"]*",', "", text, count=1)
+    else:
+        text = re.sub(r'"\$schema": "[^"]*"', _escaped("$schema", ref), text, count=1)
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+
+
+def _set_ids(folder, name, ids):
+    """The template's ids replaced by ``ids`` (``identity``), keeping its layout."""
+    path = os.path.join(folder, "sdb.json")
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    text = re.sub(r'"apids": \{[^}]*\}', '"apids": %s,\n  "frames": {"scid": %d}' % (
+        json.dumps(ids["apids"]), ids["scid"]), text, count=1)  # fmt: skip
+    local, ground = ids["entities"]
+    text = text.replace('"entity": 2, "local": true', '"entity": %d, "local": true' % local)
+    text = text.replace('"prefix": "GROUND", "entity": 1}', '"prefix": "GROUND", "entity": %d}'
+                        % ground)  # fmt: skip
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+    path = os.path.join(folder, MISSION_FILE)
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    text = text.replace('"obc-can-a"', json.dumps(name + "-can-a"))
+    text = text.replace('"obc-can-b"', json.dumps(name + "-can-b"))
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+
+
+def write(name, folder, slot=None):
+    """Write mission ``name`` into ``folder`` (new or empty) with the ids of ``identity(name,
+    slot)``; returns (the folder, the ids)."""
     if not NAME.match(name):
         raise UserError("mission name %r is not usable" % name,
                         expected="letters, digits, '_', '.' and '-' (up to 64)")  # fmt: skip
+    ids = identity(name, slot)
     folder = os.path.abspath(folder)
     if os.path.exists(folder) and (not os.path.isdir(folder) or os.listdir(folder)):
         raise UserError("%s already exists" % folder, expected="a new or empty folder")
     shutil.copytree(TEMPLATE_DIR, folder, dirs_exist_ok=True,
                     ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
-    _rewrite(os.path.join(folder, MISSION_FILE),
-             {"$schema": _schema_ref(folder, MISSION_SCHEMA), "name": name})  # fmt: skip
-    _rewrite(os.path.join(folder, "sdb.json"),
-             {"$schema": _schema_ref(folder, SDB_SCHEMA), "mission": name})  # fmt: skip
-    return folder
+    _rewrite(os.path.join(folder, MISSION_FILE), {"name": name})
+    _rewrite(os.path.join(folder, "sdb.json"), {"mission": name})
+    _set_schema(os.path.join(folder, MISSION_FILE), _schema_ref(folder, MISSION_SCHEMA))
+    _set_schema(os.path.join(folder, "sdb.json"), _schema_ref(folder, SDB_SCHEMA))
+    _set_ids(folder, name, ids)
+    return folder, ids
 
 
 # the mission file's keys that fix a port by itself (older files): (section, key)
@@ -92,6 +155,20 @@ def copy(template, name, folder, scid=None, port_base=None):
     for d, path, schema in ((doc, mission_path, MISSION_SCHEMA), (sdb, sdb_path, SDB_SCHEMA)):
         if "$schema" in d:
             d["$schema"] = _schema_ref(os.path.dirname(path), schema)
+            if d["$schema"] is None:
+                del d["$schema"]
+    retarget(doc, sdb, scid, port_base)
+    for d, path in ((doc, mission_path), (sdb, sdb_path)):
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(d, f, indent=2)
+            f.write("\n")
+    return folder
+
+
+def retarget(doc, sdb, scid=None, port_base=None):
+    """Mission file ``doc`` and database ``sdb`` given spacecraft id ``scid`` and port base
+    ``port_base`` (when not None): the ports the mission file fixes by themselves move with
+    the base."""
     if scid is not None:
         sdb.setdefault("frames", {})["scid"] = scid
         if "scid" in doc.get("frames", {}):  # a mission file that repeats it
@@ -108,11 +185,6 @@ def copy(template, name, folder, scid=None, port_base=None):
         peers = doc.get("cfdp", {}).get("peers") or {}
         for eid in peers:
             peers[eid] = _shift_address(peers[eid], delta)
-    for d, path in ((doc, mission_path), (sdb, sdb_path)):
-        with open(path, "w", encoding="utf-8") as f:
-            json.dump(d, f, indent=2)
-            f.write("\n")
-    return folder
 
 
 def fleet(template, prefix, folder, count, scid=None, port_base=FLEET_BASE, step=FLEET_STEP):
@@ -163,3 +235,18 @@ def free_fleet_base(count, step=FLEET_STEP, host="127.0.0.1"):
             continue
         return base
     raise RuntimeError("no free port base for %d missions" % count)
+
+
+def retarget_folder(folder, scid=None, port_base=None):
+    """``retarget`` the mission folder ``folder`` in place."""
+    mission_path = os.path.join(folder, MISSION_FILE)
+    with open(mission_path, encoding="utf-8") as f:
+        doc = json.load(f)
+    sdb_path = os.path.join(folder, doc.get("sdb", "sdb.json"))
+    with open(sdb_path, encoding="utf-8") as f:
+        sdb = json.load(f)
+    retarget(doc, sdb, scid, port_base)
+    for d, path in ((doc, mission_path), (sdb, sdb_path)):
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(d, f, indent=2)
+            f.write("\n")

@@ -6,6 +6,11 @@ The mission file's ``pus.monitoring`` lists limit checks by parameter and event 
      "low_event": "monitoring.obc_low", "high_event": "monitoring.obc_high",
      "interval": 10, "repetitions": 3, "enabled": true}
 
+``low`` and ``high`` are engineering values, as in the database (its ``calibration``, its unit):
+they become the raw limits a limit check compares the raw value with, exactly as the ground's
+``obsw ground monitor add`` converts them (``Parameter.raw_limits``); a falling calibration
+swaps the two limits and so the two events.
+
 They are installed, enabled, when service 12 has no saved state (a fresh state folder); after
 that the operators own the definitions (TC[12,5], [12,6], ...) and the context store keeps
 theirs across restarts, so a deleted or changed definition stays deleted or changed.
@@ -29,16 +34,18 @@ class MonitoringError(ConfigError):
 def definition(sdb, index, entry):
     """The complete limit-check definition of one ``pus.monitoring`` entry."""
     try:
-        pid = sdb.parameter(entry["parameter"]).id
+        p = sdb.parameter(entry["parameter"])
         low_event = sdb.event(entry["low_event"]).id if entry.get("low_event") else 0
         high_event = sdb.event(entry["high_event"]).id if entry.get("high_event") else 0
-        d = limit_check(
-            int(entry["pmon"]), pid, entry["low"], entry["high"], low_event, high_event
-        )
+        low, high, swapped = p.raw_limits(entry["low"], entry["high"])
+        if swapped:  # a falling calibration: the low raw limit is the high engineering one
+            low_event, high_event = high_event, low_event
+        d = limit_check(int(entry["pmon"]), p.id, low, high, low_event, high_event)
     except KeyError as e:
         raise MonitoringError(index, "unknown or missing %s" % e) from None
-    except (TypeError, ValueError) as e:
+    except (TypeError, ValueError) as e:  # CalibrationError is a ValueError
         raise MonitoringError(index, str(e)) from None
+    pid = p.id
     d.update(
         validity=pid,
         validity_mask=0,

@@ -24,6 +24,7 @@ component (``platform.power_cycle`` event first), once per window.
 """
 
 import collections
+import json
 import os
 import signal
 import subprocess
@@ -39,6 +40,7 @@ from obsw_host.obc.supervision import Supervision
 from obsw_host.obc.topology import PLATFORM, Topology
 
 EXIT_REFUSED = 2  # a process's exit status when it refuses its configuration
+STATUS_FILE = "platform.json"  # in the state folder: the processes as the manager sees them
 _STARTING_BEAT = 0.05  # seconds between heartbeats until a process's first answer
 
 
@@ -127,6 +129,37 @@ class PlatformManager:
     def say(self, text):
         self.log.append((self.clock(), text))
         self.out("[platform] " + text)
+        self.write_status()
+
+    # -------------------------------------------------------------------------- status
+
+    def status(self, running=True):
+        """What ``obsw obc status`` shows: the manager's pid and each process's pid, state,
+        start (wall clock), restarts and components."""
+        wall = time.time() - self.clock()
+        plans = {p.name: p for p in self.topology.processes}
+        out = []
+        for c in self.children:
+            state = "stopped" if c.stopped else ("up" if c.last_beat is not None else "starting")
+            plan = plans.get(c.name)
+            out.append({
+                "name": c.name, "pid": c.pid, "state": state, "why": c.stopped,
+                "started": wall + c.started if c.popen is not None else None,
+                "restarts": c.restarts,
+                "runs": list(plan.kinds) + [x.name for x in plan.components] if plan else [],
+            })  # fmt: skip
+        return {"manager": os.getpid(), "running": running, "written": time.time(),
+                "mission": self.config.name, "processes": out}  # fmt: skip
+
+    def write_status(self, running=True):
+        """``STATUS_FILE`` in the state folder, replaced whole (a reader never sees half)."""
+        path = os.path.join(self.config.state, STATUS_FILE)
+        try:
+            with open(path + ".new", "w") as f:
+                json.dump(self.status(running), f)
+            os.replace(path + ".new", path)
+        except OSError:  # a full or read-only state folder: the log still says everything
+            pass
 
     # -------------------------------------------------------------------------- processes
 
@@ -266,6 +299,7 @@ class PlatformManager:
         if now >= self._next_status:
             self._next_status = now + float(self.settings["health_period"])
             self._send_status()
+            self.write_status()
 
     def _send_status(self):
         """Restarts and watchdog state to the PUS process's ``Obc`` health component."""
@@ -319,6 +353,7 @@ class PlatformManager:
                     p.kill()
                     p.wait(5.0)
         self.transport.close()
+        self.write_status(running=False)
 
     def serve(self, done=None):
         """Run until SIGTERM or SIGINT (True), until every process is stopped (False), or

@@ -20,7 +20,16 @@ The contract a module keeps:
   name); the mission's ``options`` are passed to its constructor as keyword arguments;
 - the instance may have ``il_bind(provider)`` (called once provided: its handle to publish
   attributes and emit events), ``alive()`` (False when its work has stopped: the platform
-  manager then restarts its process) and ``close()`` (called when its process stops).
+  manager then restarts its process) and ``close()`` (called when its process stops);
+- its periodic hook, ``tick(now)``, is called every ``period`` seconds (the mission file's
+  ``"period"``, required when the class has ``tick``; ``now`` is ``time.monotonic()``) by the
+  loop of the unit that serves it (``obsw_host.obc.ticks``).
+
+The threading rule: the unit calls ``tick``, the operations, the attribute reads and writes
+and ``close`` of a component from one thread, its own, one call at a time; a component
+publishes (``provider.update``, ``provider.emit``) from those calls only. A component that
+needs a thread of its own (a blocking driver) hands what it finds to the next ``tick``
+(a ``collections.deque`` is safe to append to from another thread) and publishes there.
 
 Nothing of the module runs until a process builds the component, except its top level when
 the topology checks that the interface and the class are there. ``serve`` (``obsw il serve
@@ -94,9 +103,15 @@ class Component:
         where = "components.%s" % name
         if not isinstance(doc, dict):
             raise PluginError(where, "expected an object with module, class, options")
-        unknown = sorted(set(doc) - {"module", "class", "options"})
+        unknown = sorted(set(doc) - {"module", "class", "options", "period"})
         if unknown:
-            raise PluginError(where, "unknown key %r (module, class, options)" % unknown[0])
+            raise PluginError(where, "unknown key %r (module, class, options, period)" % (
+                unknown[0],))  # fmt: skip
+        period = doc.get("period")
+        if period is not None and (
+            isinstance(period, bool) or not isinstance(period, (int, float)) or period <= 0
+        ):
+            raise PluginError(where + ".period", "expected seconds above 0, got %r" % (period,))
         module = doc.get("module")
         if not isinstance(module, str) or not module:
             raise PluginError(where + ".module", "expected a module name or a .py file")
@@ -110,6 +125,7 @@ class Component:
         self.module_ref = module
         self.class_name = cls
         self.options = options
+        self.period = None if period is None else float(period)
         self.base_dir = base_dir
         self.key = where
 
@@ -132,8 +148,18 @@ class Component:
         return cls
 
     def check(self):
-        """Import the module and find the interface and the class (``PluginError`` if not)."""
-        return self.interface(), self.implementation_class()
+        """Import the module and find the interface and the class (``PluginError`` if not):
+        a class with ``tick`` has a ``period``, a ``period`` has a class with ``tick``."""
+        itf, cls = self.interface(), self.implementation_class()
+        ticks = callable(getattr(cls, "tick", None))
+        if ticks and self.period is None:
+            raise PluginError(self.key + ".period", "%s has tick(now) but no period; expected "
+                              "the seconds between two ticks" % cls.__name__)  # fmt: skip
+        if self.period is not None and not ticks:
+            raise PluginError(self.key + ".period", "%s has no tick(now) to call every %g s; "
+                              "expected a class with tick, or no period" % (
+                                  cls.__name__, self.period))  # fmt: skip
+        return itf, cls
 
     def build(self):
         """``(interface, implementation)``: the class built with the mission's options."""
@@ -154,7 +180,7 @@ def components(config):
     return {name: Component(name, entry, config.dir) for name, entry in doc.items()}
 
 
-def component_for(module_ref, name=None, cls=None, options=None, base_dir="."):
+def component_for(module_ref, name=None, cls=None, options=None, base_dir=".", period=None):
     """A ``Component`` outside any mission file: ``name`` defaults to the name of the module's
     only ``Interface``."""
     if name is None:
@@ -168,18 +194,24 @@ def component_for(module_ref, name=None, cls=None, options=None, base_dir="."):
     doc = {"module": module_ref, "options": dict(options or {})}
     if cls:
         doc["class"] = cls
+    if period is not None:
+        doc["period"] = period
     return Component(name, doc, base_dir)
 
 
 def serve(component, directory=None, node_name=None, out=None):
     """Provide ``component`` in this process on the interaction layer of ``directory`` until
     SIGTERM or SIGINT (its name is withdrawn then)."""
+    from obsw_host.obc.ticks import Ticks
+
     node = Node(node_name or component.name)
     itf, impl = component.build()
     transport = SocketTransport(node, directory)
     node.provide(itf, impl)
+    running = [True]
 
     def stop(signum, frame):
+        running[0] = False
         transport.stop()
 
     signal.signal(signal.SIGTERM, stop)
@@ -187,7 +219,7 @@ def serve(component, directory=None, node_name=None, out=None):
     if out is not None:
         out("%s served by pid %d at %r" % (itf.name, os.getpid(), transport.address))
     try:
-        transport.serve()
+        Ticks([(component, (itf, impl))], out or print).serve(transport, node, lambda: running[0])
     finally:
         transport.close()
         close = getattr(impl, "close", None)
@@ -213,12 +245,15 @@ def add_serve_arguments(p):
     p.add_argument("--option", action="append", type=_option, default=[], metavar="KEY=VALUE",
                    help="constructor argument (VALUE as JSON, else text); repeatable")  # fmt: skip
     p.add_argument("--node", help="node name (default: the component's name)")
+    p.add_argument("--period", type=float, help="seconds between two tick(now) calls (a "
+                   "component with a periodic hook)")  # fmt: skip
 
 
 def serve_args(args):
     """Serve what ``add_serve_arguments`` parsed; one line and status 2 if it cannot."""
     try:
-        component = component_for(args.module, args.component, args.cls, dict(args.option))
+        component = component_for(args.module, args.component, args.cls, dict(args.option),
+                                  period=args.period)  # fmt: skip
         out = None if getattr(args, "quiet", False) else (lambda s: print(s, flush=True))
         return serve(component, args.dir, args.node, out)
     except ConfigError as e:

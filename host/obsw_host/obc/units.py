@@ -28,6 +28,7 @@ from obsw_host.obc import monitoring
 from obsw_host.obc.health import HostHealth, ObcHealth
 from obsw_host.obc.module_link import ModuleLink
 from obsw_host.obc.onboard_time import ONBOARD_TIME, OnboardTime
+from obsw_host.obc.ticks import Ticks
 from obsw_host.obc.topology import OBC_HEALTH, PLATFORM, PLATFORM_EVENTS
 from obsw_host.pus.onboard import Onboard, tai_now
 from obsw_host.update.component import SOFTWARE
@@ -110,7 +111,9 @@ class PusUnit:
         self.sdb = sdb = topology.sdb
         self.out = out
         opts = topology.section("pus")
-        self.components = [c.build() for c in process.components]
+        built = [(c, c.build()) for c in process.components]
+        self.components = [b for _, b in built]
+        self.ticks = Ticks(built, out)
         self.health = self._health(topology)
         self.components.append((OBC_HEALTH, self.health))
         self.onboard_time = OnboardTime(os.path.join(config.state, "onboard_time.json"), tai_now)
@@ -173,6 +176,8 @@ class PusUnit:
             )
             self.module.restore()
         monitoring.install(self.app, sdb, opts["monitoring"])  # first start: the mission's
+        self.app.unsent_listeners.append(self._unsent)
+        self._reporting_unsent = False
         self._running = False
 
     # -------------------------------------------------------------------------- building
@@ -257,6 +262,18 @@ class PusUnit:
             return None
         return self.app.event(e.id, e.severity, e.pack(values))
 
+    def _unsent(self, service, subtype, why):
+        """A report that could not be built: a line in the log and ``pus.report_failed``."""
+        self.out("TM[%d,%d] not sent: %s" % (service, subtype, why))
+        if self._reporting_unsent:  # the event's own report failed: the line above says it
+            return
+        self._reporting_unsent = True
+        try:
+            values = {"service": service, "subtype": subtype, "reason": why[:200]}
+            self.unit_event("pus.report_failed", values)
+        finally:
+            self._reporting_unsent = False
+
     def _task_died(self, name, why, restarts):
         self.out("task %s stopped (%s): restarted (%d)" % (name, why, restarts))
         n = min(restarts, 65535)
@@ -295,6 +312,9 @@ class PusUnit:
     async def _transport_task(self):
         await drive_transport(self.transport, self.node)
 
+    async def _ticks_task(self):
+        await self.ticks.run(lambda: self._running)
+
     async def _module_task(self):
         await self.module.run(self.onboard.period, lambda: self._running)
 
@@ -309,6 +329,8 @@ class PusUnit:
             self.onboard.tasks.append(self._engine_task)
         if self.module is not None:
             self.onboard.tasks.append(self._module_task)
+        if self.ticks:
+            self.onboard.tasks.append(self._ticks_task)
         self.onboard.start()
         self.out(
             "PUS application process APID %d on udp %s:%d, services %s"
@@ -352,13 +374,22 @@ class ComponentUnit:
         self.out = out
         self.node = Node("obc-%s-components" % process.name)
         self.transport = SocketTransport(self.node, topology.config.il_directory)
-        self.components = [c.build() for c in process.components]
+        built = [(c, c.build()) for c in process.components]
+        self.components = [b for _, b in built]
         for itf, impl in self.components:
             self.node.provide(itf, impl)
+        self.ticks = Ticks(built, out)
         self._thread = None
+        self._running = False
+
+    def _serve(self):
+        """Requests and ticks, one at a time, on this unit's thread (the threading rule of
+        ``obsw_host.obc.plugins``)."""
+        self.ticks.serve(self.transport, self.node, lambda: self._running)
 
     def start(self):
-        self._thread = threading.Thread(target=self.transport.serve, name="components")
+        self._running = True
+        self._thread = threading.Thread(target=self._serve, name="components")
         self._thread.daemon = True
         self._thread.start()
         self.out("components %s" % ", ".join(itf.name for itf, _ in self.components))
@@ -370,6 +401,7 @@ class ComponentUnit:
         return _components_alive(self.components)
 
     def stop(self):
+        self._running = False
         self.transport.stop()
         if self._thread is not None:
             self._thread.join(2.0)

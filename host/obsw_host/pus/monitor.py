@@ -93,7 +93,7 @@ class Display:
 
     def _event(self, ev):
         name = ev.get("event", "event %d" % ev["id"])
-        data = ev.get("data")
+        data = ev.get("labelled", ev.get("data"))
         body = "event %s (%s)" % (name, ev["severity"])
         if isinstance(data, dict) and data:
             body += ": " + ", ".join("%s=%s" % (k, _num(v)) for k, v in data.items())

@@ -176,11 +176,12 @@ class _Udp:
     per TC, and its layers cost a TC round trip more than the work of its four reports). A
     datagram the socket cannot take now (its buffer full) waits in order for it to drain."""
 
-    def __init__(self, loop, sock, received, count):
+    def __init__(self, loop, sock, received, count, unsent=None):
         self.loop = loop
         self.sock = sock
         self.received = received  # received(data, address)
         self.count = count  # count(counter name)
+        self.unsent = unsent  # unsent(service, subtype, why) for a TM the socket refused
         self.buf = bytearray(UDP_MAX)
         self.view = memoryview(self.buf)
         self.waiting = collections.deque()  # (data, address) for the socket to take
@@ -203,10 +204,16 @@ class _Udp:
                 return
             except (BlockingIOError, InterruptedError):
                 self.loop.add_writer(self.sock.fileno(), self._writable)
-            except OSError:
-                self.count("udp_errors")
+            except OSError as e:
+                self._refused(data, e)
                 return
         self.waiting.append((bytes(data), address))
+
+    def _refused(self, data, error):
+        """A datagram the socket refused (too long, no route): counted and said."""
+        self.count("udp_errors")
+        if self.unsent is not None and len(data) > 8:  # TM[service, subtype]
+            self.unsent(data[7], data[8], "UDP send of %d octets failed: %s" % (len(data), error))
 
     def _writable(self):
         while self.waiting:
@@ -215,8 +222,8 @@ class _Udp:
                 self.sock.sendto(data, address)
             except (BlockingIOError, InterruptedError):
                 return
-            except OSError:
-                self.count("udp_errors")
+            except OSError as e:
+                self._refused(data, e)
             self.waiting.popleft()
         self.loop.remove_writer(self.sock.fileno())
 
@@ -408,7 +415,9 @@ class Onboard:
             self._error = e
             self._ready.set()
             raise
-        transport = self._transport = _Udp(loop, sock, self._received, self.app.count)
+        transport = self._transport = _Udp(
+            loop, sock, self._received, self.app.count, self.app.unsent
+        )
         self.address = transport.get_extra_info("sockname")
         run = [("activity", lambda: self.app.run(self.period))]
         if self.node is not None:

@@ -472,10 +472,11 @@ def failure_detail(tx, sdb=None):
 
         fn = functions(sdb).get(fid)
         return "function %s" % (fn.name if fn else fid)
-    if tx.tc.service == 20 and data and len(data) == 2:
-        pid = int.from_bytes(bytes(data), "big")
+    if tx.tc.service == 20 and data and len(data) >= 2:  # the ID, then why as text
+        pid = int.from_bytes(bytes(data[:2]), "big")
         p = _parameter(sdb, pid)
-        return "parameter %s" % (p.qualified if p is not None else pid)
+        why = bytes(data[2:]).decode("utf-8", "replace")
+        return "parameter %s%s" % (p.qualified if p is not None else pid, why and ": " + why)
     if tx.tc.service in sdb.services and data and len(data) == 1:
         return _mission_failure(sdb.services[tx.tc.service], tx.tc.subtype, failure, data[0])
     return ""

@@ -52,7 +52,7 @@ class TmLog:
     def _event(self, tm):
         ev = self.events.decode_event(tm)
         name = ev.get("event", "event %d" % ev["id"])
-        data = ev["data"]
+        data = ev.get("labelled", ev["data"])
         if isinstance(data, dict):
             data = ", ".join("%s=%s" % kv for kv in data.items())
         elif isinstance(data, (bytes, bytearray)):

@@ -45,11 +45,12 @@ class Event:
         self.qualified = qualified
         self.path = qualified.split(".")
         self.severity = severity
-        self.fields = fields  # [(name, (ptc, pfc))]
+        self.fields = fields  # [(name, (ptc, pfc), {raw: label} or None)]
 
 
 class Function:
-    """One service 8 function: id, qualified name and its arguments [(id, name, pair)]."""
+    """One service 8 function: id, qualified name and its arguments [(id, name, pair,
+    {raw: label} or None)]."""
 
     def __init__(self, fid, qualified, arguments):
         self.id = fid
@@ -127,11 +128,13 @@ def from_sdb(db, ids):
         params[pid] = Param(pid, p.qualified, _pair(p.type_spec), p.unit, p.writable, extra)
     events = {}
     for eid, e in db.events.items():
-        fields = [(name, _pair(spec)) for name, spec in e.type_specs]
+        labels = getattr(e, "labels", None) or {}
+        fields = [(name, _pair(spec), labels.get(name)) for name, spec in e.type_specs]
         events[eid] = Event(eid, e.qualified, e.severity, fields)
     functions = {}
     for fid, f in db.functions.items():
-        args = [(aid, name, _pair(spec)) for aid, name, spec, _ in f.arguments]
+        labels = getattr(f, "labels", None) or {}
+        args = [(aid, name, _pair(spec), labels.get(aid)) for aid, name, spec, _ in f.arguments]
         functions[fid] = Function(fid, f.name, args)
     structures = [
         Structure(h["sid"], h["interval"], list(h["parameters"]), h["enabled"])

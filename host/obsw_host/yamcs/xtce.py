@@ -313,9 +313,10 @@ class Generator:
         for e in sorted(self.sc.events.values(), key=lambda e: e.id):
             s = self.system_of(e.path[:-1])
             refs = []
-            for fname, pair in e.fields:
+            for fname, pair, flabels in e.fields:
                 pname = "%s_%s" % (_label(e.path[-1]), _label(fname))
-                refs.append((fname, s.parameter(pname, parameter_type("", pair))))
+                ptype = parameter_type("", pair, labels=flabels)
+                refs.append((fname, s.parameter(pname, ptype)))
             r.containers.append(
                 _container(
                     "event_" + _label(e.qualified),
@@ -762,9 +763,9 @@ class Generator:
             f = self.sc.functions[fid]
             s = self.system_of(f.path[:-1])
             fields = [("fixed", "function", fid, 16), ("fixed", "n", len(f.arguments), 8)]
-            for aid, aname, pair in f.arguments:
+            for aid, aname, pair, labels in f.arguments:
                 fields.append(("fixed", "id_" + _label(aname), aid, 8))
-                fields.append(("arg", _label(aname), argument_type("", pair)))
+                fields.append(("arg", _label(aname), argument_type("", pair, labels=labels)))
             self.command(
                 s, _label(f.path[-1]), M.TC_FUNCTION_PERFORM, fields, "TC[8,1] %s" % f.qualified
             )

@@ -197,6 +197,7 @@ class ApplicationProcess:
         self.playback = None  # callable(raw, vc) for TM retrieved from packet stores
         self.event_reporters = []  # callable(event_id, severity, aux) -> True if reported
         self.event_listeners = []  # callable(event_id, severity, aux), after the reporters
+        self.unsent_listeners = []  # callable(service, subtype, why) for a TM not sent
         self.services = {}
         self.sequence = SequenceCounter()
         self.message_counters = {}  # (service << 8 | subtype) -> next message type counter
@@ -322,7 +323,6 @@ class ApplicationProcess:
         key = (service << 8) | subtype
         counters = self.message_counters
         n = counters.get(key, 0)
-        counters[key] = (n + 1) & self.config.message_counter_max
         code = self.config.time
         try:
             t = code.from_seconds(self.time()) if code is not None else None
@@ -331,16 +331,19 @@ class ApplicationProcess:
                 service,
                 subtype,
                 data,
-                self.sequence.next(apid),
+                self.sequence.peek(apid),
                 n,
                 destination,
                 t,
                 self.time_ref,
                 config=self.config,
             ).pack()
-        except ValueError:
+        except ValueError as e:  # counts advance only for packets sent: no gap on the ground
             self.count("tm_unpackable")
+            self.unsent(service, subtype, str(e))
             return None
+        self.sequence.next(apid)
+        counters[key] = (n + 1) & self.config.message_counter_max
         if self.tm_stores or self.tm_filters:
             if not self._pipeline(raw):
                 self.count("tm_withheld")
@@ -369,8 +372,10 @@ class ApplicationProcess:
     def _emit(self, raw):
         try:
             self.out(raw)
-        except Exception:  # the output's failure is counted; the process keeps going
+        except Exception as e:  # the output's failure is counted and said; the loop goes on
             self.count("tm_lost")
+            if len(raw) > 8:  # TM[service, subtype] from the secondary header
+                self.unsent(raw[7], raw[8], "output failed: %s" % (e,))
             return False
         return True
 
@@ -385,6 +390,15 @@ class ApplicationProcess:
             self.count("tm_lost")
             return False
         return True
+
+    def unsent(self, service, subtype, why):
+        """A TM[service, subtype] that could not be built: each of ``unsent_listeners`` hears
+        why (the host raises an event and logs it); never raises."""
+        for fn in self.unsent_listeners:
+            try:
+                fn(service, subtype, why)
+            except Exception:
+                self.count("listener_errors")
 
     def event(self, event_id, severity, aux=b""):
         """Raise an on-board event: reporters first, then listeners; True if it was reported."""

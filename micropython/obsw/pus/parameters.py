@@ -222,8 +222,8 @@ class ParameterPool:
         if v is not None:
             return v
         p = self.parameter(pid)
-        if p.default is not None:
-            return p.default
+        if p.default is not None:  # an engineering value, like the range it lies in
+            return p.default if p.values is None else p.to_raw(p.default)
         return _ZERO.get(p.type.ptc, 0)
 
     def _prepare(self, pid, value):

@@ -178,10 +178,21 @@ class EventDef:
             for f in data
         ]
         self.layout = Structure(self.fields)
+        self.labels = _labels(data, "name", "event %s" % name)  # field -> {raw: label}
 
     @property
     def qualified(self):
         return "%s.%s" % (self.component, self.name) if self.component else self.name
+
+    def labelled(self, values):
+        """Decoded ``values`` with each labelled field's raw value as its label."""
+        if not self.labels or not isinstance(values, dict):
+            return values
+        out = dict(values)
+        for k, labels in self.labels.items():
+            if k in out:
+                out[k] = labels.get(out[k], out[k])
+        return out
 
     def pack(self, payload):
         """Auxiliary data for ``payload``: a dict, a list in field order, or a single value."""
@@ -216,15 +227,36 @@ def _severity(value, what):
     return s
 
 
+def _labels(entries, key, what):
+    """{entry[key]: {raw: label}} of the ``entries`` with an ``enumeration``, or None."""
+    out = None
+    for e in entries:
+        spec = e.get("enumeration")
+        if spec is not None:
+            # imported here, as for values: a database without labels does not pay its heap
+            from obsw.pus.calibration import CalibrationError, enumeration
+
+            try:
+                labels = enumeration(spec, "%s %s.enumeration" % (what, e.get(key)))
+            except CalibrationError as x:
+                raise SdbError(str(x)) from None
+            if out is None:
+                out = {}
+            out[e[key]] = labels
+    return out
+
+
 class FunctionDef:
-    """A service 8 function: ``arguments`` are (id, name, type spec, default) in call order."""
+    """A service 8 function: ``arguments`` are (id, name, type spec, default) in call order;
+    ``labels`` maps an argument id to its enumeration ({raw: label}), or is None."""
 
-    __slots__ = ("id", "name", "arguments")
+    __slots__ = ("id", "name", "arguments", "labels")
 
-    def __init__(self, id, name, arguments):
+    def __init__(self, id, name, arguments, labels=None):
         self.id = id
         self.name = name
         self.arguments = arguments
+        self.labels = labels
 
     def __repr__(self):
         return "FunctionDef(%d, %s)" % (self.id, self.name)
@@ -438,7 +470,7 @@ class Sdb:
                 seen.add(aid)
                 field_type(a["type"], "%s.%s" % (name, a["name"]))
                 args.append((aid, a["name"], a["type"], a.get("default")))
-            fd = FunctionDef(fid, name, args)
+            fd = FunctionDef(fid, name, args, _labels(f.get("arguments", ()), "id", name))
             self.functions[fid] = fd
             self._functions_by_name[name] = fd
 

@@ -53,7 +53,12 @@ from obsw.pus.messages import (
     TM_HK_HK_STRUCTURE_REPORT,
 )
 from obsw.pus.services.base import STRUCTURE_ID, U16, Service
-from obsw.pus.services.s01_verification import FAILURE_REFUSED, FAILURE_UNKNOWN_ID, PusFailure
+from obsw.pus.services.s01_verification import (
+    FAILURE_EXECUTION,
+    FAILURE_REFUSED,
+    FAILURE_UNKNOWN_ID,
+    PusFailure,
+)
 from obsw.pus.services.s03_functional import FunctionalReporting
 from obsw.pus.services.s03_layouts import (
     APPEND,
@@ -287,8 +292,9 @@ class Housekeeping(FunctionalReporting, Service):
         sids = req.decode(SIDS)["sids"]
         self._known(kind, sids)
         req.start()
-        for sid in sids:
-            self.generate(sid, req.source, kind)
+        lost = [sid for sid in sids if self.generate(sid, req.source, kind) is None]
+        if lost:  # said with its reason by the application process's unsent listeners
+            raise _sid_failure(FAILURE_EXECUTION, "no report of structure %d" % lost[0], lost[0])
 
     def _append(self, req, kind):
         tc = req.decode(APPEND)
@@ -396,11 +402,22 @@ class Housekeeping(FunctionalReporting, Service):
             values[i] = get(pid)
         try:
             data = s.layout.pack(values)
-        except ValueError:
+        except ValueError as e:
             self.app.count("hk_unpackable")
+            t = _REPORTS[kind][0]
+            self.app.unsent(t[0], t[1], "structure %d: %s" % (sid, self._why(s, values, e)))
             return None
         self.reports += 1
         return self.send(_REPORTS[kind][0], data, destination)
+
+    def _why(self, s, values, error):
+        """The parameter whose value the structure's layout refused, and why."""
+        for i, pid in enumerate(s.parameters):
+            try:
+                self.pool.type_of(pid).check(values[i])
+            except ValueError as e:
+                return "parameter %d = %r: %s" % (pid, values[i], e)
+        return str(error)
 
     def cyclic(self, now):
         for kind, structures in self.sets.items():

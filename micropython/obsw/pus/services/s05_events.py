@@ -138,6 +138,8 @@ class EventUser(ServiceUser):
         else:
             out["event"] = ev.qualified
             out["data"] = ev.unpack(aux)
+            if getattr(ev, "labels", None):  # for display: labelled fields as their labels
+                out["labelled"] = ev.labelled(out["data"])
         return out
 
     def decode_disabled(self, tm):

@@ -49,9 +49,10 @@ _DECODE_ERRORS = (ValueError, KeyError, IndexError, TypeError)
 class Function:
     """A function of the database: its ID, the operation it calls, its arguments."""
 
-    def __init__(self, id, name, arguments=()):
+    def __init__(self, id, name, arguments=(), labels=None):
         self.id = id
         self.name = name
+        self.labels = labels or {}  # argument id -> {raw: label}
         self.arguments = []  # (id, name, type, default) in call order
         self.by_id = {}
         for a in arguments:
@@ -79,6 +80,17 @@ class Function:
                 return a
         raise KeyError("function %s has no argument %r" % (self.name, key))
 
+    def raw(self, aid, value):
+        """The raw value of argument ``aid`` for ``value``: a label becomes its number."""
+        labels = self.labels.get(aid)
+        if labels is None or not isinstance(value, str):
+            return value
+        for raw, label in labels.items():
+            if label == value:
+                return raw
+        raise ValueError("argument %s of %s: no label %r, expected one of %s" % (
+            self.by_id[aid][1], self.name, value, ", ".join(labels.values())))  # fmt: skip
+
     def __repr__(self):
         return "Function(%d, %s, %d arguments)" % (self.id, self.name, len(self.arguments))
 
@@ -88,7 +100,7 @@ def functions(sdb):
     table = {}
     for fid, fd in sdb.functions.items():
         args = [{"id": a[0], "name": a[1], "type": a[2], "default": a[3]} for a in fd.arguments]
-        table[fid] = Function(fid, fd.name, args)
+        table[fid] = Function(fid, fd.name, args, getattr(fd, "labels", None))
     return table
 
 
@@ -213,7 +225,8 @@ class FunctionUser(ServiceUser):
         fn = self.function(key)
         args = []
         for k, v in (arguments or {}).items():
-            args.append({"id": fn.argument(k)[0], "value": v})
+            aid = fn.argument(k)[0]
+            args.append({"id": aid, "value": fn.raw(aid, v)})
         return fn.layout.pack({"function": fn.id, "args": args})
 
     def perform(self, apid, key, arguments=None):

@@ -46,6 +46,7 @@ from obsw.pus.services.base import (
 )
 from obsw.pus.services.s01_verification import (
     FAILURE_COMPONENT,
+    FAILURE_EXECUTION,
     FAILURE_OUT_OF_BOUNDS,
     FAILURE_OUT_OF_RANGE,
     FAILURE_REFUSED,
@@ -199,10 +200,25 @@ class ParameterManagement(Service):
             self._known(pid)
         req.start()
         get = self.pool.get
-        req.report(
-            TM_PARAM_VALUE_REPORT,
-            self.layout.pack({"items": [{"id": pid, "value": get(pid)} for pid in ids]}),
-        )
+        items = [{"id": pid, "value": get(pid)} for pid in ids]
+        try:
+            data = self.layout.pack({"items": items})
+        except ValueError as e:
+            raise self._unreadable(items, e) from None
+        req.report(TM_PARAM_VALUE_REPORT, data)
+
+    def _unreadable(self, items, error):
+        """The failure naming the first value its parameter's type cannot carry, and why
+        (the failure data: the parameter ID, then the reason as UTF-8 text)."""
+        for i in items:
+            p = self.pool.parameter(i["id"])
+            try:
+                p.type.check(i["value"])
+            except ValueError as e:
+                why = "%r: %s" % (i["value"], e)
+                data = PARAMETER_ID.pack(p.id) + why.encode()[:200]
+                return PusFailure(FAILURE_EXECUTION, "%s = %s" % (p.qualified, why), data)
+        return PusFailure(FAILURE_EXECUTION, str(error))
 
     async def set_values(self, req):
         items = req.decode(self.layout)["items"]

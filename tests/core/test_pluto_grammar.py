@@ -84,7 +84,7 @@ class TestSaveContext(unittest.TestCase):
 
     def test_syntax(self):
         for bad in ("save context refer mode of OBC by m;", "save context refer to mode of OBC;",
-                    "save context refer to mode of OBC by m, to x by y;"):  # fmt: skip
+                    "save context refer to mode of OBC by m, x by y;"):  # fmt: skip
             with self.assertRaises(PlutoSyntaxError):
                 parse(step(bad))
         with self.assertRaises(PlutoSyntaxError) as c:

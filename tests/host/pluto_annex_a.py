@@ -6,7 +6,6 @@ Run as a script to rewrite the production table of docs/pluto.md from a grammar 
 (``python tests/host/pluto_annex_a.py --write``; ``--check`` says whether it is current).
 """
 
-import os
 import random
 import re
 import sys
@@ -34,9 +33,37 @@ LEXICAL = {
 # after a space ("12.5e-3 V", "1d2h30min", "-1:02:03:04:005").
 NUMERIC = {"Integer Constant", "Real Constant", "Relative Time Constant"}
 
-# Where the reference departs from the text pluto-parser ships, and why: each is an extension
-# of this implementation that docs/pluto.md lists, or a typing slip of the transcription.
-EXTENSIONS = ()
+
+def _replace(node, old, new):
+    """``node`` with every reference to production ``old`` made one to ``new``."""
+    k = node[0]
+    if k == "ref":
+        return ("ref", new) if node[1] == old else node
+    if k in ("seq", "alt"):
+        return (k, tuple(_replace(x, old, new) for x in node[1]))
+    if k == "opt":
+        return (k, _replace(node[1], old, new))
+    if k == "rep":
+        return (k, _replace(node[1], old, new), node[2])
+    return node
+
+
+def _no_step_activity(prods):
+    """'initiate and confirm step X;' is a step statement: Annex A also reads it as an
+    activity whose reference has the object type step, which no activity has."""
+    types = prods["Object Type"]
+    prods["Activity Object Type"] = ("alt", tuple(x for x in types[1] if x != ("lit", "step")))
+    prods["Confirmed Activity Reference"] = _replace(prods["Object Reference"], "Object Type",
+                                                     "Activity Object Type")  # fmt: skip
+    prods["Confirmed Activity Call"] = _replace(prods["Activity Call"], "Activity Reference",
+                                                "Confirmed Activity Reference")  # fmt: skip
+    name = "Initiate And Confirm Activity Statement"
+    prods[name] = _replace(prods[name], "Activity Call", "Confirmed Activity Call")
+
+
+# Where this implementation reads Annex A in one way where the grammar allows two, as
+# docs/pluto.md says: each a change of the productions, named after what it decides.
+DISAMBIGUATIONS = (_no_step_activity,)
 
 
 def _read(name):
@@ -152,7 +179,9 @@ def productions():
     assert text.count(typo) == 1
     text = text.replace(typo, typo[:-1] + ",\n")
     prods = _Reader(text).productions()
-    units = _read("engineering_units.ebnf").replace("? Engineering Units ? =", "Engineering Units =")
+    units = _read("engineering_units.ebnf").replace(
+        "? Engineering Units ? =", "Engineering Units ="
+    )
     units = units.replace("Unit Simple Factor  =", "Unit Simple Factor =")
     # Annex B's railroad diagram (B.2.g.7) has one simple factor where this text has two
     typo = "Unit Simple Factor (Unit Simple Factor ,"
@@ -165,7 +194,7 @@ def productions():
     for n, node in prods.items():
         if n != "Characters":
             prods[n] = _unescape(node)
-    for patch in EXTENSIONS:
+    for patch in DISAMBIGUATIONS:
         patch(prods)
     return prods
 
@@ -319,7 +348,9 @@ class Generator:
         else:
             opts = [path + "{1}", path + "{n}"] + ([path + "{0}"] if node[2] == 0 else [])
             one = ("seq", (node[1],))
-            j = self._pick(name, opts, [one, ("seq", (node[1], node[1])), ("lit", "")][:len(opts)])
+            j = self._pick(
+                name, opts, [one, ("seq", (node[1], node[1])), ("lit", "")][: len(opts)]
+            )
             for _ in range((1, 2 + self.rng.randrange(2), 0)[j]):
                 self.emit(node[1], name, path + "{}", out)
 
@@ -494,14 +525,18 @@ def lark_grammar(prods):
     lines.append(r"WORD: /(?!(?:%s)\b)[A-Za-z][A-Za-z0-9_]*/" % kw)
     lines.append("DIGITS: /[0-9]+/")
     d = r"[0-9]+"
-    lines.append(r'integer_constant: INTNUM [engineering_units] | HEXADECIMAL_CONSTANT')
+    lines.append(r"integer_constant: INTNUM [engineering_units] | HEXADECIMAL_CONSTANT")
     lines.append(r"INTNUM: /[+-]?%s/" % d)
     lines.append(r"real_constant: REALNUM [engineering_units]")
     lines.append(r"REALNUM: /[+-]?%s(?:\.%s)?(?:e[+-]?%s)?/" % (d, d, d))
     lines.append("relative_time_constant: RELTIME")
-    lines.append(r"RELTIME: /[+-]?(?:(?:%s)d|(?:(?:%s)d)?(?:(?:%s)h|(?:(?:%s)h)?(?:(?:%s)min"
-                 r"|(?:(?:%s)min)?(?:%s)(?:\.%s)?s)))|[+-]?%s:%s:%s:%s:%s/"
-                 % (d, d, d, d, d, d, d, d, d, d, d, d, d))  # fmt: skip
+    # any of days, hours, minutes and seconds in that order, the longest first
+    dd, hh, mm, ss = (r"(?:%sd)" % d, r"(?:%sh)" % d, r"(?:%smin)" % d,
+                      r"(?:%s(?:\.%s)?s)" % (d, d))  # fmt: skip
+    units = "|".join((dd + hh + "?" + mm + "?" + ss + "?", hh + mm + "?" + ss + "?",
+                      mm + ss + "?", ss))  # fmt: skip
+    colon = ":".join((d, d, d, d, d))
+    lines.append(r"RELTIME: /[+-]?(?:%s|%s)/" % (units, colon))
     if "HEXADECIMAL_CONSTANT" not in terms:
         terms["HEXADECIMAL_CONSTANT"] = _regex(prods, prods["Hexadecimal Constant"])
     for t, pattern in terms.items():

@@ -140,7 +140,10 @@ class ExprChecker:
             t = self.expr(e[2], scopes)
             tol = type_of_value(e[3][2])
             self.comparable(e, t, self.expr(e[5], scopes), "<", e[2], e[5])
-            if (
+            if len(e[3]) > 3 or not _num(tol):
+                self.fail(PlutoTypeError, "within needs a number as its tolerance, with units"
+                          " at most once: found %s" % source(e[3]), e[3][1])  # fmt: skip
+            elif (
                 not _num(t)
                 or (e[4] and tol[1] != NONE)
                 or (not e[4] and tol[1] != NONE and t[0] != "?" and tol[1] != t[1])

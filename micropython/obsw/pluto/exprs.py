@@ -2,7 +2,18 @@
 
 from obsw.pluto import units
 from obsw.pluto.builtins import FIRST_WORDS, FUNCTIONS, MAX_NAME_WORDS
-from obsw.pluto.lexer import ABST, EOF, NUM, OP, RELT, STR, WORD, PlutoSyntaxError, line_col
+from obsw.pluto.lexer import (
+    ABST,
+    DIGITS,
+    EOF,
+    NUM,
+    OP,
+    RELT,
+    STR,
+    WORD,
+    PlutoSyntaxError,
+    line_col,
+)
 
 # Words that end a multi-word name: every keyword that may follow a name or open a statement.
 RESERVED = set(
@@ -13,7 +24,24 @@ RESERVED = set(
         " within ask record array AND OR XOR NOT TRUE FALSE"
     ).split()
 )
-OBJECT_TYPES = ("variable", "parameter", "argument", "activity", "event", "step")
+# Annex A's object types, longest first; a reference may name one before each of its names.
+OBJECT_TYPES = (
+    ("predefined", "value", "set"),
+    ("activity", "statement"),
+    ("system", "element"),
+    ("reporting", "data"),
+    ("variable",),
+    ("parameter",),
+    ("argument",),
+    ("activity",),
+    ("event",),
+    ("step",),
+    ("record",),
+    ("array",),
+)
+_KINDS = (("system", "element"), ("reporting", "data"), ("parameter",), ("activity",), ("event",))
+_TYPE_FIRST = ("predefined", "activity", "system", "reporting", "variable", "parameter",
+               "argument", "event", "step", "record", "array")  # fmt: skip
 RELOPS = ("=", "!=", "<", ">", "<=", ">=")
 _LOGIC = {"OR": 1, "XOR": 2, "AND": 3}
 _ARITH = {"+": 1, "-": 1, "*": 2, "/": 2, "**": 3}
@@ -79,33 +107,55 @@ class ExprParser:
         t = self.toks[self.i]
         return t[0] == OP and t[1] == sym
 
-    def name(self, what="a name"):
-        """A multi-word identifier: the run of non-reserved words here."""
+    def name(self, what="a name", limit=99):
+        """A multi-word identifier: the run of non-reserved words here; a word after the first
+        may start with a digit ("Wheel 2", "Heater 2b")."""
         words = []
-        while True:
+        end = -1  # where the last word ends (line, column): "2" then "b" glued is one word
+        start = self.i
+        while self.i - start < limit:
             t = self.toks[self.i]
-            if t[0] != WORD or t[1] in RESERVED:
+            k = t[0]
+            if k == DIGITS and words:
+                pass
+            elif k != WORD or t[1] in RESERVED:
                 break
-            words.append(t[1])
+            elif t[1] == "save" and self.tok(1)[1] == "context":  # a wait's save context
+                break
+            if words and t[2] == end:
+                words[-1] += t[1]
+            else:
+                words.append(t[1])
+            end = t[2] + len(t[1])
             self.i += 1
         if not words:
             self.err("expected %s, found %s" % (what, _show(self.tok())))
         return " ".join(words)
 
+    def object_type(self):
+        """The object type that starts here and is followed by a name, its words taken, or
+        None."""
+        t = self.toks[self.i]
+        if t[0] != WORD or t[1] not in _TYPE_FIRST:
+            return None
+        for words in OBJECT_TYPES:
+            if self.at(*words):
+                nxt = self.tok(len(words))
+                if nxt[0] == WORD and nxt[1] not in RESERVED:
+                    self.i += len(words)
+                    return " ".join(words)
+        return None
+
     def ref(self, what="a reference"):
-        """Object reference ``[type] name {of name}`` as a mutable node the checker resolves:
-        ['r', pos, names, object type, kind, target]."""
+        """Object reference ``[type] name {of [type] name}`` as a mutable node the checker
+        resolves: ['r', pos, names, object type of the first name, kind, target]. The types of
+        the names after 'of' are read and not kept: the names alone say what they are."""
         p = self.pos()
-        otype = None
-        t = self.tok()
-        if t[0] == WORD and t[1] in OBJECT_TYPES and self.tok(1)[0] == WORD:
-            nxt = self.tok(1)[1]
-            if nxt not in RESERVED or nxt == "event":
-                otype = t[1]
-                self.i += 1
+        otype = self.object_type()
         names = [self.name(what)]
         while self.at("of"):
             self.i += 1
+            self.object_type()
             names.append(self.name(what))
         return ["r", p, tuple(names), otype, None, None]
 
@@ -140,6 +190,13 @@ class ExprParser:
             if self.isop("%"):
                 self.i += 1
                 pct = True
+            else:  # 'within 5 [mV] of': units may follow any constant; twice is a load error
+                u = self.unit()
+                if u is not None:
+                    v = tol[2]
+                    t = type(v)
+                    tol = ("c", tol[1], units.Quantity(v, u)) if t is int or t is float else (
+                        "c", tol[1], v, u)  # fmt: skip
             self.expect("of", after="in within")
             return ("wi", p, left, tol, pct, self.term())
         if self.at("in") and self.tok(1)[1] == "(":
@@ -189,7 +246,7 @@ class ExprParser:
     def _simple(self):
         t = self.toks[self.i]
         k, v, p = t
-        if k == NUM or k == RELT or k == ABST or k == STR:
+        if k == NUM or k == DIGITS or k == RELT or k == ABST or k == STR:
             return self.constant()
         if k == OP:
             if v == "(":
@@ -223,7 +280,12 @@ class ExprParser:
             if self.take("confirmation", "status", "of"):  # 'confirmation' opens a body too
                 r = self.ref()
                 r[2] = ("confirmation status",) + r[2]
-                return r
+                return self.with_arguments(r)
+            if v in _TYPE_FIRST and v in RESERVED:  # 'step X', 'event X', 'array X' ...
+                save = self.i
+                if self.object_type() is not None:
+                    self.i = save
+                    return self.with_arguments(self.ref())
             if v not in RESERVED:
                 if v == "get" and self.tok(1)[0] == WORD and self.tok(1)[1] not in RESERVED:
                     self.i += 1
@@ -232,8 +294,33 @@ class ExprParser:
                 if self.isop("("):
                     return self.call(n, p)
                 self.i = save
-                return self.ref()
+                return self.with_arguments(self.ref())
         self.err("expected an expression, found %s" % _show(t))
+
+    def with_arguments(self, r):
+        """An object property request may give arguments: ``<reference> with [<name> :=]
+        <expression> {, ...} end with``; they are kept on the reference node (r[6])."""
+        if not self.at("with") or self.tok(1)[1] in ("arguments", "value", "directives", "units"):
+            return r
+        self.i += 1
+        args = [self.named_expr()]
+        while self.isop(","):
+            self.i += 1
+            args.append(self.named_expr())
+        self.expect("end", "with", after="after the arguments of %s" % " of ".join(r[2]))
+        r.append(tuple(args))
+        return r
+
+    def named_expr(self):
+        """``[<name> :=] <expression>``."""
+        save = self.i
+        if self.tok()[0] == WORD and self.tok()[1] not in RESERVED:
+            n = self.name()
+            if self.isop(":="):
+                self.i += 1
+                return (n, self.expr())
+        self.i = save
+        return (None, self.expr())
 
     def function_name(self):
         """The longest standard function name (Annex C, words such as 'to' or 'of' included)
@@ -273,8 +360,12 @@ class ExprParser:
     def constant(self):
         k, v, p = self.toks[self.i]
         self.i += 1
+        if k == DIGITS:
+            k, v = NUM, int(v)
         if k == STR:
             return ("c", p, v)
+        if k == WORD and (v == "TRUE" or v == "FALSE"):
+            return ("c", p, v == "TRUE")
         if k == ABST:
             return ("c", p, units.AbsTime(v))
         if k == RELT:
@@ -290,11 +381,12 @@ class ExprParser:
             return ("c", p, v)
         if u in _TIME_ORDER:  # relative time chain such as "1 d 2 h" or "2min30s"
             total, last, fl = v * units.parse(u)[0], _TIME_ORDER.index(u), False
-            while self.toks[self.i][0] == NUM:
+            while self.toks[self.i][0] in (DIGITS, NUM):
                 nt = self.tok(1)
                 if nt[0] != WORD or nt[1] not in _TIME_ORDER[last + 1 :]:
                     break
-                total += self.toks[self.i][1] * units.parse(nt[1])[0]
+                n = self.toks[self.i][1]
+                total += (int(n) if type(n) is str else n) * units.parse(nt[1])[0]
                 last, fl = _TIME_ORDER.index(nt[1]), True
                 self.i += 2
             if fl:
@@ -325,7 +417,7 @@ class ExprParser:
                     sign = ""
                     if self.toks[j][1] == "-":
                         sign, j = "-", j + 1
-                    if self.toks[j][0] != NUM:
+                    if self.toks[j][0] != DIGITS:
                         self.err("expected an exponent after '^'")
                     text += "^" + sign + str(self.toks[j][1])
                     self.i = j + 1
@@ -356,4 +448,44 @@ class ExprParser:
         ):
             if self.take(*words):
                 return code
-        return ("e", self.name("a type"))
+        p = self.pos()
+        if self.take("same", "as"):  # the data type of a system object's property
+            return ("sys", p, "same as " + self.type_path(False))
+        for words in _KINDS:
+            if self.at(*words) and self.tok(len(words))[1] == "reference":
+                self.i += len(words) + 1
+                self.expect("of", after="after '%s reference'" % " ".join(words))
+                return ("sys", p, "%s reference of %s" % (" ".join(words), self.type_path(True)))
+        n = self.name("a type")
+        if not self.at("of"):
+            return ("e", n)
+        self.i += 1  # the values a property of a system object may take
+        return ("sys", p, n + " of " + self.type_path(True))
+
+    def type_path(self, constant):
+        """``<property> {of <property>} of (<reference> | [current] <kind> [of ...])``, with a
+        constant after a property where ``constant``; as text."""
+        parts = []
+        while True:
+            if self.take("current"):
+                parts.append("current " + self.kind())
+            else:
+                k = self.kind(False)
+                if k is None or self.tok()[0] == WORD and self.tok()[1] not in RESERVED:
+                    t = self.object_type()
+                    parts.append((t + " " if t else "") + self.name("a property or an object"))
+                else:
+                    parts.append(k)
+                if constant and self.tok()[0] in (NUM, DIGITS, STR, ABST, RELT):
+                    parts[-1] += " " + str(self.constant()[2])
+            if not self.take("of"):
+                return " of ".join(parts)
+
+    def kind(self, needed=True):
+        for words in _KINDS:
+            if self.take(*words):
+                return " ".join(words)
+        if needed:
+            self.err("expected system element, reporting data, parameter, activity or event,"
+                     " found %s" % _show(self.tok()))  # fmt: skip
+        return None

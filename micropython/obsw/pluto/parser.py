@@ -4,7 +4,7 @@ A procedure or step definition is ``("def", pos, decls, preconditions, main, wat
 confirmation)``; statements are tuples tagged by their first item (see README, PLUTO section).
 """
 
-from obsw.pluto.exprs import MAX_NESTING, SUBJECT, ExprParser, _show
+from obsw.pluto.exprs import MAX_NESTING, RESERVED, SUBJECT, ExprParser, _show
 from obsw.pluto.lexer import EOF, STR, WORD, PlutoSyntaxError, line_col, tokenize
 
 # Deepest tree (tuples and lists) a procedure may give: long operator chains such as
@@ -12,6 +12,7 @@ from obsw.pluto.lexer import EOF, STR, WORD, PlutoSyntaxError, line_col, tokeniz
 MAX_TREE_DEPTH = 6 * MAX_NESTING
 
 _STATUS = (("confirmed",), ("not", "confirmed"), ("aborted",))
+_ARGUMENT_KINDS = ("activity", "parameter", "reporting data", "event", "system element")
 _MAIN_STOPS = ("end", "watchdog", "confirmation")
 _PROC_ONLY = (
     "only initiate, initiate and confirm, in parallel, inform user, log and in the context of"
@@ -73,7 +74,10 @@ class Parser(ExprParser):
             while True:
                 if not self.at("initiate", "and", "confirm", "step"):
                     self.err("a watchdog body holds 'initiate and confirm step' statements")
-                wd.append(self.statement(True))
+                st = self.statement(True)
+                if st[0] != "step":
+                    self.err("a watchdog body holds steps, found an activity", st[1])
+                wd.append(st)
                 self.expect(";", after="after the watchdog step")
                 self.take("watchdog")
                 if self.take("end", "watchdog"):
@@ -167,15 +171,13 @@ class Parser(ExprParser):
 
     def statement(self, step):
         p = self.pos()
-        if self.take("initiate", "and", "confirm", "step"):
-            n = self.name("a step name")
-            d = self.definition(True, "step")
-            self.expect("end", "step")
-            return ("step", p, n, d, self.continuation())
+        if self.at("initiate", "and", "confirm", "step"):
+            # always a step: Annex A also reads 'initiate and confirm step X;' as an activity
+            # whose reference has object type step, which no activity has
+            self.i += 3
+            return self.step_statement(p)
         if self.take("initiate", "and", "confirm"):
-            c = self.activity_call()
-            r = self.name() if self.take("refer", "by") else None
-            return ("conf", p, c, r, self.continuation())
+            return self.confirm_activity(p)
         if self.take("initiate"):
             c = self.activity_call()
             return ("init", p, c, self.name() if self.take("refer", "by") else None)
@@ -238,29 +240,72 @@ class Parser(ExprParser):
                     mode, x = "for", self.expr()
             else:
                 self.err("expected 'until' or 'for' after 'wait', found %s" % _show(self.tok()))
-            return ("wait", p, mode, x, self.timeout())
+            saved = self.save_items() if self.take("save", "context", "refer") else None
+            return ("wait", p, mode, x, self.timeout(), saved)
         if self.tok()[0] != WORD:
             self.err("expected a statement, found %s" % _show(self.tok()))
         r = self.ref("a statement")
         if self.take(":="):
             return ("set", p, r, self.expr())
+        if self.tok()[0] == WORD and self.object_type_here():  # 'open variable x': 'of' left out
+            r[2] = r[2] + tuple(self.ref("an object")[2])
         return ("op", p, r, self.arguments_opt(("with",)))
 
+    def object_type_here(self):
+        save = self.i
+        t = self.object_type()
+        self.i = save
+        return t is not None
+
+    def step_statement(self, p):
+        self.expect("step")
+        n, d = self.named_step()
+        self.expect("end", "step")
+        return ("step", p, n, d, self.continuation())
+
+    def confirm_activity(self, p):
+        c = self.activity_call()
+        r = self.name() if self.take("refer", "by") else None
+        return ("conf", p, c, r, self.continuation())
+
+    def named_step(self):
+        """A step's name and definition. Without 'main', 'step A B x := 1;' may be step 'A B'
+        or step 'A' doing 'B x := 1': when the body cannot start right after the name, its
+        last words are given to the body, one at a time."""
+        start = self.i
+        self.name("a step name")
+        limit = self.i - start
+        while True:
+            self.i = start
+            n = self.name("a step name", limit)
+            body = self.i
+            try:
+                return n, self.definition(True, "step")
+            except PlutoSyntaxError as e:
+                if limit == 1 or line_col(self.toks[body][2]) != (e.line, e.col):
+                    raise
+                limit -= 1
+
     def save_context(self, p):
-        """``save context refer to <reference> by <name> {, refer to ... by ...} [end context]``:
-        entries are [reference, name, variable key (set by the checker)]."""
+        """``save context refer to <reference> by <name> {, to <reference> by <name>}
+        [end context]``."""
+        items = self.save_items()
+        self.take("end", "context")
+        return ("save", p, items)
+
+    def save_items(self):
+        """The pairs of a save context (after 'save context refer'), as [reference, name,
+        variable key (set by the checker)]; 'refer' may be repeated after ','."""
         items = []
         while True:
             self.expect("to", after="after 'save context refer'")
             r = self.ref("a reporting data reference")
             self.expect("by", after="after the saved reference")
             items.append([r, self.name("a name for the saved value"), None])
-            if not self.isop(","):
-                break
+            if not (self.isop(",") and self.tok(1)[1] in ("to", "refer")):
+                return items
             self.i += 1
-            self.expect("refer", after="after ',' in save context")
-        self.take("end", "context")
-        return ("save", p, items)
+            self.take("refer")
 
     def expr_list(self):
         out = [self.expr()]
@@ -324,27 +369,68 @@ class Parser(ExprParser):
         return tuple(out)
 
     def argument(self):
-        name = None
-        save = self.i
-        if self.tok()[0] == WORD and not self.at("record") and not self.at("array"):
+        """``[<name> :=] <expression>``, ``[<name>] record ... end record``, ``[<name>] array
+        ... end array``, ``activity <call>``, ``parameter <ref>``, ``event <ref>``...: the
+        forms overlap ('array X' is also a reference), so each that may start here is tried
+        until one ends where an argument ends."""
+        start = self.i
+        err = None
+        for form in (self._named, self._structured, self._typed, self._simple_argument):
+            self.i = start
             try:
-                name = self.name()
-            except ValueError:
-                name = None
-            if not (self.isop(":=") or self.at("record") or self.at("array")):
-                name, self.i = None, save
-            else:
-                self.take(":=")
+                a = form()
+            except PlutoSyntaxError as e:
+                if err is None or (e.line, e.col) > (err.line, err.col):
+                    err = e
+                continue
+            if a is not None and (self.isop(",") or self.at("end")):
+                return a
+        if err is None:
+            self.i = start
+            return self._simple_argument()
+        raise err
+
+    def _named(self):
+        if self.tok()[0] != WORD or self.tok()[1] in RESERVED:
+            return None
+        name = self.name()
+        if self.take(":="):  # 'name := record ...' too, an extension
+            if self.at("record") or self.at("array"):
+                return (name, self.structured(self.pos()))
+            return (name, self.expr())
+        if (self.at("record") or self.at("array")) and name not in _ARGUMENT_KINDS:
+            return (name, self.structured(self.pos()))  # 'activity array X' is an activity
+        return None
+
+    def _structured(self):
+        if self.at("record") or self.at("array"):
+            return (None, self.structured(self.pos()))
+        return None
+
+    def _typed(self):
         p = self.pos()
+        if self.take("activity"):  # an activity, with its arguments, handed to the one called
+            return (None, ("act", p, self.activity_call()))
+        if self.take("parameter") or self.take("reporting", "data"):
+            r = self.ref()  # its value, as any reference to a parameter gives
+            r[3] = r[3] or "parameter"
+            return (None, r)
+        if self.take("event") or self.take("system", "element"):
+            return (None, ("refarg", p, self.ref()))  # the reference itself, not a value
+        return None
+
+    def _simple_argument(self):
+        return (None, self.expr())
+
+    def structured(self, p):
         if self.take("record"):
             v = ("rec", p, self.arguments())
             self.expect("end", "record")
-        elif self.take("array"):
+        else:
+            self.expect("array")
             v = ("arr", p, self.arguments())
             self.expect("end", "array")
-        else:
-            v = self.expr()
-        return (name, v)
+        return v
 
     def parallel(self, p):
         every = True

@@ -166,7 +166,19 @@ class ExprChecker:
             if e[3] is not None:
                 self.expr(e[3], scopes)
             t = e[4]
-            return ("e", None) if isinstance(t, tuple) else type_of_code(t or "s")
+            if isinstance(t, tuple):
+                return ANY if t[0] == "sys" else ("e", None)
+            return type_of_code(t or "s")
+        if k == "act":  # an activity handed as an argument: its name (and arguments)
+            self.activity(e[2], scopes)
+            return ANY
+        if k == "refarg":  # an event or a system element handed as an argument: its name
+            r = e[2]
+            if e[3] == "event":
+                self.event_ref(r, scopes)
+            else:
+                r[4], r[5] = "ctx", " of ".join(self._ctx_names(r[2]))
+            return STRING
         return ANY
 
     def unit_name(self, e, t):

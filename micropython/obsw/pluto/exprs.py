@@ -40,6 +40,7 @@ OBJECT_TYPES = (
     ("array",),
 )
 _KINDS = (("system", "element"), ("reporting", "data"), ("parameter",), ("activity",), ("event",))
+_TYPE_PHRASE = ("predefined", "activity", "system", "reporting")  # types of several words
 _TYPE_FIRST = ("predefined", "activity", "system", "reporting", "variable", "parameter",
                "argument", "event", "step", "record", "array")  # fmt: skip
 RELOPS = ("=", "!=", "<", ">", "<=", ">=")
@@ -122,6 +123,8 @@ class ExprParser:
                 break
             elif t[1] == "save" and self.tok(1)[1] == "context":  # a wait's save context
                 break
+            elif t[1] in _TYPE_PHRASE and words and self.object_type_here():  # 'open system
+                break  # element Valve': an operation, then the object's type and name
             if words and t[2] == end:
                 words[-1] += t[1]
             else:
@@ -145,6 +148,12 @@ class ExprParser:
                     self.i += len(words)
                     return " ".join(words)
         return None
+
+    def object_type_here(self):
+        save = self.i
+        t = self.object_type()
+        self.i = save
+        return t is not None
 
     def ref(self, what="a reference"):
         """Object reference ``[type] name {of [type] name}`` as a mutable node the checker

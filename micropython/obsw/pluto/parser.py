@@ -251,12 +251,6 @@ class Parser(ExprParser):
             r[2] = r[2] + tuple(self.ref("an object")[2])
         return ("op", p, r, self.arguments_opt(("with",)))
 
-    def object_type_here(self):
-        save = self.i
-        t = self.object_type()
-        self.i = save
-        return t is not None
-
     def step_statement(self, p):
         self.expect("step")
         n, d = self.named_step()
@@ -415,8 +409,10 @@ class Parser(ExprParser):
             r = self.ref()  # its value, as any reference to a parameter gives
             r[3] = r[3] or "parameter"
             return (None, r)
-        if self.take("event") or self.take("system", "element"):
-            return (None, ("refarg", p, self.ref()))  # the reference itself, not a value
+        if self.take("event"):  # the reference itself, not a value
+            return (None, ("refarg", p, self.ref(), "event"))
+        if self.take("system", "element"):
+            return (None, ("refarg", p, self.ref(), "system element"))
         return None
 
     def _simple_argument(self):

@@ -71,8 +71,9 @@ class TestObjectTypes(unittest.TestCase):
 
 class TestWaitSavesContext(unittest.TestCase):
     def test_values_saved_when_the_wait_ends(self):
-        t = dry_run(step('wait until mode of OBC = "NOMINAL" save context refer to voltage of'
-                         " EPS by v, to mode of OBC by m timeout 1 min; log v, m;"), SPEC)  # fmt: skip
+        src = ('wait until mode of OBC = "NOMINAL" save context refer to voltage of EPS by v,'
+               " to mode of OBC by m timeout 1 min; log v, m;")
+        t = dry_run(step(src), SPEC)
         self.assertEqual(t["log"], ["6.5 VNOMINAL"])
 
     def test_wait_for_event_saves_too(self):

@@ -71,8 +71,10 @@ class TestObjectTypes(unittest.TestCase):
 
 class TestWaitSavesContext(unittest.TestCase):
     def test_values_saved_when_the_wait_ends(self):
-        src = ('wait until mode of OBC = "NOMINAL" save context refer to voltage of EPS by v,'
-               " to mode of OBC by m timeout 1 min; log v, m;")
+        src = (
+            'wait until mode of OBC = "NOMINAL" save context refer to voltage of EPS by v,'
+            " to mode of OBC by m timeout 1 min; log v, m;"
+        )
         t = dry_run(step(src), SPEC)
         self.assertEqual(t["log"], ["6.5 VNOMINAL"])
 

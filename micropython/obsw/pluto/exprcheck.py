@@ -205,7 +205,16 @@ class ExprChecker:
         x = e[3] if x is None else x
         y = e[4] if y is None else y
         if _num(a) and _num(b):
-            if a[1] == b[1] or a[1] == NONE or b[1] == NONE:
+            if a[1] == b[1]:
+                return
+            if a[1] == NONE or b[1] == NONE:
+                # a number without units is dimensionless (Annex A: units are part of a
+                # constant): '< 1800' against degC would silently mean 1800 degC
+                ua = "none" if a[1] == NONE else self.unit_name(x, a)
+                ub = "none" if b[1] == NONE else self.unit_name(y, b)
+                self.fail(PlutoTypeError, "cannot compare %s with %s: units %s and %s differ (a"
+                          " number without units is dimensionless)" % (self.operand(x, a),
+                          self.operand(y, b), ua, ub), e[1])  # fmt: skip
                 return
             self.fail(PlutoTypeError, "cannot compare %s with %s: units %s and %s differ"
                       % (self.operand(x, a), self.operand(y, b), self.unit_name(x, a),

@@ -22,6 +22,7 @@ class SignatureChecker:
         """Arguments against the activity's declared signature: names, count, types, units."""
         takes = ", ".join([a[0] for a in sig]) or "none"
         given = {}
+        unknown = []  # (name, value, position) of arguments the activity does not declare
         for i, (name, v) in enumerate(args):
             q = v[1] if isinstance(v, tuple) else p
             if name is None:
@@ -37,8 +38,7 @@ class SignatureChecker:
                     if norm(d[0]) == norm(name):
                         decl = d
                 if decl is None:
-                    self.fail(PlutoReferenceError, "activity %s has no argument %s (takes: %s)"
-                              % (path, name, takes), q)  # fmt: skip
+                    unknown.append((name, q))
                     self.argument(v, scopes)
                     continue
             if decl[0] in given:
@@ -53,10 +53,18 @@ class SignatureChecker:
                                  " record" if v[0] == "rec" else "n array"), q)  # fmt: skip
                 continue
             self.argument_type(path, decl, v, self.expr(v, scopes), q)
+        for name, q in unknown:  # a misspelt name: say which declared one it resembles
+            near = closest(name, [d[0] for d in sig if d[0] not in given])
+            hint = "; did you mean %s?" % near if near else ""
+            if near:
+                given[near] = True  # named by this error: not reported missing as well
+            self.fail(PlutoReferenceError, "activity %s has no argument %s%s (takes: %s)"
+                      % (path, name, hint, takes), q)  # fmt: skip
+        at = unknown[0][1] if unknown else p  # after the misspelt names, that come first
         for d in sig:
             if d[0] not in given:
                 self.fail(PlutoTypeError, "activity %s needs argument %s (takes: %s)"
-                          % (path, d[0], takes), p)  # fmt: skip
+                          % (path, d[0], takes), at)  # fmt: skip
 
     def argument_type(self, path, decl, v, et, p):
         name, code, unit = decl
@@ -84,6 +92,30 @@ class SignatureChecker:
         if why:
             self.fail(PlutoTypeError, "activity %s: argument %s takes %s, got %s: %s"
                       % (path, name, _a(want), self.operand(v, et), why), p)  # fmt: skip
+
+
+def distance(a, b):
+    """Edit distance (Levenshtein) between two strings."""
+    row = list(range(len(b) + 1))
+    for i, ca in enumerate(a):
+        prev, row[0] = row[0], i + 1
+        for j, cb in enumerate(b):
+            cur = row[j + 1]
+            row[j + 1] = min(cur + 1, row[j] + 1, prev + (ca != cb))
+            prev = cur
+    return row[-1]
+
+
+def closest(name, names):
+    """The one of ``names`` nearest to ``name`` when near enough to be a typo of it (at most a
+    third of its letters differ, spaces, underscores and case aside), else None."""
+    a = norm(name)
+    best, bd = None, 0
+    for n in names:
+        d = distance(a, norm(n))
+        if best is None or d < bd:
+            best, bd = n, d
+    return best if best is not None and bd <= max(1, len(a) // 3) else None
 
 
 def _below_zero(v):

@@ -65,7 +65,7 @@ class TestObjectTypes(unittest.TestCase):
         self.assertEqual(t["log"], ["7 V SAFE"])
 
     def test_operation_request_without_of(self):
-        body = main_body(parse(step("open system element Valve with angle := 3 end with;")))
+        body = main_body(parse(step("open variable Valve with angle := 3 end with;")))
         self.assertEqual((body[0][0], body[0][2][2]), ("op", ("open", "Valve")))
 
 

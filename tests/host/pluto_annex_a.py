@@ -483,9 +483,10 @@ def _regex(prods, node):
     return "(?:%s)%s" % (_regex(prods, node[1]), "+" if node[2] else "*")
 
 
-def lark_grammar(prods):
+def lark_grammar(prods, reserved=None):
     """The productions as a Lark grammar: keywords split into words, the lexical productions
-    as terminals, identifier words any word that is no keyword."""
+    as terminals, identifier words any word but the ``reserved`` ones (by default every
+    keyword of the grammar)."""
     lines = []
     terms = {}
 
@@ -520,10 +521,12 @@ def lark_grammar(prods):
         if n in NUMERIC:
             continue
         lines.append("%s: %s" % (_rule(n), conv(node)))
-    kw = "|".join(sorted(keywords(prods), key=len, reverse=True))
+    words = keywords(prods) if reserved is None else reserved
+    kw = "|".join(sorted(words, key=len, reverse=True))
     lines.append("identifier: WORD (WORD | DIGITS)*")
     lines.append(r"WORD: /(?!(?:%s)\b)[A-Za-z][A-Za-z0-9_]*/" % kw)
-    lines.append("DIGITS: /[0-9]+/")
+    # a word of digits: '1e5' and '1.5' are numbers, never two words of a name
+    lines.append(r"DIGITS: /[0-9]+(?![eE][+-]?[0-9]|\.[0-9])/")
     d = r"[0-9]+"
     lines.append(r"integer_constant: INTNUM [engineering_units] | HEXADECIMAL_CONSTANT")
     lines.append(r"INTNUM: /[+-]?%s/" % d)
@@ -546,10 +549,10 @@ def lark_grammar(prods):
     return "\n".join(lines) + "\n"
 
 
-def reference_parser(prods=None):
+def reference_parser(prods=None, reserved=None):
     from lark import Lark
 
-    text = lark_grammar(prods or productions())
+    text = lark_grammar(prods or productions(), reserved)
     return Lark(text, start="procedure_definition", parser="earley", lexer="dynamic")
 
 

@@ -40,7 +40,6 @@ OBJECT_TYPES = (
     ("array",),
 )
 _KINDS = (("system", "element"), ("reporting", "data"), ("parameter",), ("activity",), ("event",))
-_TYPE_PHRASE = ("predefined", "activity", "system", "reporting")  # types of several words
 _TYPE_FIRST = ("predefined", "activity", "system", "reporting", "variable", "parameter",
                "argument", "event", "step", "record", "array")  # fmt: skip
 RELOPS = ("=", "!=", "<", ">", "<=", ">=")
@@ -123,8 +122,6 @@ class ExprParser:
                 break
             elif t[1] == "save" and self.tok(1)[1] == "context":  # a wait's save context
                 break
-            elif t[1] in _TYPE_PHRASE and words and self.object_type_here():  # 'open system
-                break  # element Valve': an operation, then the object's type and name
             if words and t[2] == end:
                 words[-1] += t[1]
             else:
@@ -455,7 +452,12 @@ class ExprParser:
             (("absolute", "time"), "a"),
             (("relative", "time"), "rt"),
         ):
+            start = self.i
             if self.take(*words):
+                t = self.tok()
+                if t[0] == DIGITS or t[0] == WORD and t[1] not in RESERVED:
+                    self.i = start  # 'Boolean flags', a set named with the word: a name
+                    break
                 return code
         p = self.pos()
         if self.take("same", "as"):  # the data type of a system object's property

@@ -5,13 +5,15 @@ confirmation)``; statements are tuples tagged by their first item (see README, P
 """
 
 from obsw.pluto.exprs import MAX_NESTING, RESERVED, SUBJECT, ExprParser, _show
-from obsw.pluto.lexer import EOF, STR, WORD, PlutoSyntaxError, line_col, tokenize
+from obsw.pluto.lexer import EOF, OP, STR, WORD, PlutoSyntaxError, line_col, tokenize
 
 # Deepest tree (tuples and lists) a procedure may give: long operator chains such as
 # 1 + 1 + ... + 1 nest without any parenthesis.
 MAX_TREE_DEPTH = 6 * MAX_NESTING
 
 _STATUS = (("confirmed",), ("not", "confirmed"), ("aborted",))
+# words that carry an expression on: after 'wait for event X' they make it 'wait for <expr>'
+_GOES_ON = ("AND", "OR", "XOR", "between", "within", "in")
 _ARGUMENT_KINDS = ("activity", "parameter", "reporting data", "event", "system element")
 _MAIN_STOPS = ("end", "watchdog", "confirmation")
 _PROC_ONLY = (
@@ -234,10 +236,16 @@ class Parser(ExprParser):
             if self.take("until"):
                 mode, x = "until", self.expr()
             elif self.take("for"):
+                mode, x = "for", None
+                start = self.i
                 if self.take("event"):
                     mode, x = "event", self.ref("an event")
-                else:
-                    mode, x = "for", self.expr()
+                    t = self.tok()
+                    if t[0] == OP and t[1] != ";" or t[1] in _GOES_ON:
+                        # 'wait for event X AND Y': the expression 'event X AND Y' is waited
+                        self.i, mode = start, "for"
+                if mode == "for":
+                    x = self.expr()
             else:
                 self.err("expected 'until' or 'for' after 'wait', found %s" % _show(self.tok()))
             saved = self.save_items() if self.take("save", "context", "refer") else None
@@ -344,7 +352,11 @@ class Parser(ExprParser):
             args = (("value set", self.ref("a value set")),)
             self.expect("end", "with", after="after the value set")
         if self.take("with", "directives"):
-            dirs = self.arguments()
+            dirs = [self.named_expr()]
+            while self.isop(","):
+                self.i += 1
+                dirs.append(self.named_expr())
+            dirs = tuple(dirs)
             self.expect("end", "with", after="after the directives")
         return (r, args, dirs)
 
@@ -355,14 +367,15 @@ class Parser(ExprParser):
         self.expect("end", "with", after="after the arguments")
         return a
 
-    def arguments(self):
-        out = [self.argument()]
+    def arguments(self, closer="with"):
+        """Arguments up to 'end <closer>'."""
+        out = [self.argument(closer)]
         while self.isop(","):
             self.i += 1
-            out.append(self.argument())
+            out.append(self.argument(closer))
         return tuple(out)
 
-    def argument(self):
+    def argument(self, closer):
         """``[<name> :=] <expression>``, ``[<name>] record ... end record``, ``[<name>] array
         ... end array``, ``activity <call>``, ``parameter <ref>``, ``event <ref>``...: the
         forms overlap ('array X' is also a reference), so each that may start here is tried
@@ -377,7 +390,7 @@ class Parser(ExprParser):
                 if err is None or (e.line, e.col) > (err.line, err.col):
                     err = e
                 continue
-            if a is not None and (self.isop(",") or self.at("end")):
+            if a is not None and (self.isop(",") or self.at("end", closer)):
                 return a
         if err is None:
             self.i = start
@@ -420,11 +433,11 @@ class Parser(ExprParser):
 
     def structured(self, p):
         if self.take("record"):
-            v = ("rec", p, self.arguments())
+            v = ("rec", p, self.arguments("record"))
             self.expect("end", "record")
         else:
             self.expect("array")
-            v = ("arr", p, self.arguments())
+            v = ("arr", p, self.arguments("array"))
             self.expect("end", "array")
         return v
 

@@ -153,3 +153,12 @@ class TestSyntaxErrors(unittest.TestCase):
                     "log 1 within 2 V V2 of 3;"):  # fmt: skip
             with self.assertRaises(PlutoSyntaxError):
                 parse(step(bad))
+
+
+class TestSigns(unittest.TestCase):
+    def test_a_sign_before_a_time_or_a_string_is_refused_not_a_crash(self):
+        for bad in ("-2025-01-01T00:00:00Z", '+"x"', "-TRUE"):
+            with self.assertRaises(PlutoTypeError):
+                load(step("log %s;" % bad), SimulatedSystem(SPEC))
+        with self.assertRaises(PlutoSyntaxError):
+            parse(step("log 1 within -2025-01-01T00:00:00Z of 2;"))

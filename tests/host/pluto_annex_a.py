@@ -6,6 +6,7 @@ Run as a script to rewrite the production table of docs/pluto.md from a grammar 
 (``python tests/host/pluto_annex_a.py --write``; ``--check`` says whether it is current).
 """
 
+import os
 import random
 import re
 import sys
@@ -14,6 +15,17 @@ from importlib import resources
 # The lexical productions: their parts are written together, without spaces, as one token.
 # Identifier words, numbers, times, strings and a unit symbol with its prefix.
 LEXICAL = {
+    "Letter",
+    "Digit",
+    "Hexadecimal Digit",
+    "Hexadecimal Symbol",
+    "Year",
+    "Month",
+    "Day",
+    "Day Of Month",
+    "Hour",
+    "Minute",
+    "Second",
     "Absolute Time Constant",
     "Characters",
     "Days",
@@ -224,9 +236,18 @@ def choice_points(prods):
             walk(name, node[1], path + "{}")
 
     for name, node in prods.items():
-        if name not in LEXICAL:
+        if name in NUMERIC:  # written by Generator.numeric, which counts these
+            out.extend((name, c) for c in NUMERIC_POINTS[name])
+        elif name not in LEXICAL or name == "Unit Simple Factor":
             walk(name, node, "")
     return out
+
+
+NUMERIC_POINTS = {
+    "Integer Constant": ("|0", "|1", "[+]", "[-]"),  # decimal or hexadecimal; units or none
+    "Real Constant": ("[+]", "[-]", ".", "e"),  # units or none; a fraction; an exponent
+    "Relative Time Constant": ("|0", "|1"),  # with units (1d2h) or with colons
+}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -273,18 +294,20 @@ class Generator:
     """Procedures from the productions: at every choice the least used alternative first (the
     coverage drives the walk), past ``max_depth`` the cheapest; deterministic per seed."""
 
-    def __init__(self, prods, seed=0, max_depth=7, budget=120):
+    def __init__(self, prods, seed=0, max_depth=8, budget=200):
         self.prods = prods
         self.rng = random.Random(seed)
         self.max_depth = max_depth
-        self.budget = budget
+        self.default_budget = budget
         self.out = []
         self.counts = {}  # (production, path) -> uses
         self.uses = {}  # production -> uses
         self.cost, self._c = _min_cost(prods)
+        self._costs = {}  # id(node) -> cost (the nodes live as long as the productions)
 
-    def sentence(self, start="Procedure Definition"):
+    def sentence(self, start="Procedure Definition", budget=None):
         self.depth = 0
+        self.budget = budget or self.default_budget
         out = self.out = []
         self.emit(("ref", start), start, "", out)
         return out
@@ -298,16 +321,28 @@ class Generator:
             out.append(t)
         return "".join(out)
 
+    def node_cost(self, node):
+        """What closing ``node`` costs at least (``node`` a part of the productions: the cache
+        is by identity)."""
+        c = self._costs.get(id(node))
+        if c is None:
+            c = self._costs[id(node)] = self._c(node, frozenset())
+        return c
+
     def _count(self, name, path):
         key = (name, path)
         self.counts[key] = self.counts.get(key, 0) + 1
 
-    def _pick(self, name, options, nodes):
-        """Index among ``options`` (paths): deep, the cheapest; else mostly the least used."""
+    def _pick(self, name, options, costs):
+        """Index among ``options`` (paths): deep, the cheapest (``costs()`` says what each
+        costs); else mostly the least used."""
         if self.depth > self.max_depth or len(self.out) > self.budget:
-            costs = [self._c(x, frozenset()) for x in nodes]
+            # deep or long: close the sentence, still by the least used of the cheap ones
+            costs = costs()
             least = min(costs)
-            j = self.rng.choice([k for k, c in enumerate(costs) if c <= least + 1])
+            cheap = [k for k, c in enumerate(costs) if c <= least + 2]
+            used = [self.counts.get((name, options[k]), 0) for k in cheap]
+            j = cheap[used.index(min(used))]
         elif self.rng.random() < 0.7:
             used = [self.counts.get((name, o), 0) for o in options]
             least = min(used)
@@ -339,24 +374,26 @@ class Generator:
                 self.emit(x, name, path + ".%d" % j, out)
         elif k == "alt":
             opts = [path + "|%d" % j for j in range(len(node[1]))]
-            j = self._pick(name, opts, node[1])
+            j = self._pick(name, opts, lambda: [self.node_cost(x) for x in node[1]])
             self.emit(node[1][j], name, opts[j], out)
         elif k == "opt":
-            j = self._pick(name, [path + "[+]", path + "[-]"], [node[1], ("lit", "")])
+            j = self._pick(
+                name, [path + "[+]", path + "[-]"], lambda: [self.node_cost(node[1]), 0]
+            )
             if j == 0:
                 self.emit(node[1], name, path + "[]", out)
         else:
             opts = [path + "{1}", path + "{n}"] + ([path + "{0}"] if node[2] == 0 else [])
-            one = ("seq", (node[1],))
-            j = self._pick(
-                name, opts, [one, ("seq", (node[1], node[1])), ("lit", "")][: len(opts)]
-            )
+            c = self.node_cost(node[1])
+            j = self._pick(name, opts, lambda: [c, 2 * c, 0][: len(opts)])
             for _ in range((1, 2 + self.rng.randrange(2), 0)[j]):
                 self.emit(node[1], name, path + "{}", out)
 
     def identifier(self):
         words = [self.rng.choice(FIRST_WORDS)]
-        for _ in range(self.rng.choice((0, 0, 1, 2))):
+        more = self.rng.choice((0, 0, 1, 2))
+        self._count("Identifier", (".1{0}", ".1{1}", ".1{n}")[more])
+        for _ in range(more):
             words.append(self.rng.choice(NEXT_WORDS))
         return " ".join(words)
 
@@ -411,14 +448,22 @@ class Generator:
                 text = sign + "".join(parts)
             out.append(text)
             return
+        if n == "Integer Constant" and r.random() < 0.2:
+            self._count(n, "|1")
+            out.append(self.lexical("Hexadecimal Constant"))
+            return
+        if n == "Integer Constant":
+            self._count(n, "|0")
         text = sign + self.digits(1, 5)
         if n == "Real Constant":
             if r.random() < 0.6:
+                self._count(n, ".")
                 text += "." + self.digits(1, 4)
             if r.random() < 0.3:
+                self._count(n, "e")
                 text += "e" + r.choice(("", "-", "+")) + self.digits(1, 2)
         out.append(text)
-        j = self._pick(n, ["[+]", "[-]"], [("ref", "Engineering Units"), ("lit", "")])
+        j = self._pick(n, ["[+]", "[-]"], lambda: [self.cost["Engineering Units"], 0])
         if j == 0:
             self.emit(("ref", "Engineering Units"), n, "", out)
 
@@ -526,7 +571,7 @@ def lark_grammar(prods, reserved=None):
     lines.append("identifier: WORD (WORD | DIGITS)*")
     lines.append(r"WORD: /(?!(?:%s)\b)[A-Za-z][A-Za-z0-9_]*/" % kw)
     # a word of digits: '1e5' and '1.5' are numbers, never two words of a name
-    lines.append(r"DIGITS: /[0-9]+(?![eE][+-]?[0-9]|\.[0-9])/")
+    lines.append(r"DIGITS: /[0-9]+(?![eE][+-]?[0-9]|\.[0-9]|x[0-9A-F])/")
     d = r"[0-9]+"
     lines.append(r"integer_constant: INTNUM [engineering_units] | HEXADECIMAL_CONSTANT")
     lines.append(r"INTNUM: /[+-]?%s/" % d)
@@ -556,5 +601,160 @@ def reference_parser(prods=None, reserved=None):
     return Lark(text, start="procedure_definition", parser="earley", lexer="dynamic")
 
 
+# ---------------------------------------------------------------------------------------------
+# a run: generated procedures, procedures one token away from them, coverage
+
+GENERATED = 2000  # procedures generated from the grammar, each parsed
+CHECKED = 10  # of them also given to the reference parser (it is slow)
+MUTANTS = 250  # procedures one token away from a small generated one, given to both
+SEED = 2008  # the year of ECSS-E-ST-70-32C
+
+
+START = "Procedure Definition"
+STEP = "procedure initiate and confirm step S main %s; end main end step; end procedure"
+FOCUS = (  # (start, the procedure around it, tokens before the walk closes)
+    ("Step Statement", STEP, 0),
+    ("Flow Control Statement", STEP, 0),
+    ("Case Statement", STEP, 800),
+    ("Expression", "procedure log %s; end procedure", 0),
+    (
+        "Predefined Type",
+        "procedure initiate and confirm step S declare variable v of type %s"
+        " end declare main log v; end main end step; end procedure",
+        0,
+    ),
+)
+
+
+def mutant(tokens, rng, words):
+    """``tokens`` with one token deleted, repeated, swapped with the next or inserted."""
+    t = list(tokens)
+    j = rng.randrange(len(t))
+    m = rng.randrange(4)
+    if m == 0:
+        del t[j]
+    elif m == 1:
+        t.insert(j, t[j])
+    elif m == 2 and j + 1 < len(t):
+        t[j], t[j + 1] = t[j + 1], t[j]
+    else:
+        t.insert(j, rng.choice(words))
+    return " ".join(t)
+
+
+class Run:
+    """What one run of the generator and the reference found (``parse`` is ours)."""
+
+    def __init__(self, parse, syntax_error, reserved, seed=SEED, generated=GENERATED,
+                 checked=CHECKED, mutants=MUTANTS):  # fmt: skip
+        self.prods = productions()
+        self.gen = Generator(self.prods, seed)
+        self.refused = []  # (error, text) of generated procedures our parser refused
+        self.texts = []
+        for j in range(generated):
+            # half from the start symbol, half from a statement, an expression or a type in
+            # the smallest procedure that holds it, so that deep clauses are reached too
+            start, frame, budget = FOCUS[j % 10] if j % 10 < len(FOCUS) else (START, "%s", 0)
+            text = frame % self.gen.text(self.gen.sentence(start, budget))
+            self.texts.append(text)
+            try:
+                parse(text)
+            except syntax_error as e:
+                self.refused.append((e, text))
+        ref = reference_parser(self.prods, reserved)
+        self.outside = []  # generated procedures the reference refuses (a generator fault)
+        for text in self.texts[:checked]:
+            if not accepts(ref, text):
+                self.outside.append(text)
+        small = Generator(self.prods, seed + 1, budget=40)
+        rng = random.Random(seed)
+        words = sorted(keywords(self.prods)) + [";", ",", "(", ")", ":="]
+        self.mutants = mutants
+        self.reference_accepts = 0
+        self.disagreements = []  # (reference accepts, our error or None, text)
+        for _ in range(mutants):
+            text = mutant(small.sentence(), rng, words)
+            ok = accepts(ref, text)
+            self.reference_accepts += ok
+            try:
+                parse(text)
+                ours = None
+            except syntax_error as e:
+                ours = e
+            if ok != (ours is None):
+                self.disagreements.append((ok, ours, text))
+        self.checked = checked
+
+    def missing(self):
+        """Alternatives and optional clauses no generated procedure took."""
+        return [c for c in choice_points(self.prods) if self.gen.counts.get(c, 0) == 0]
+
+    def markdown(self):
+        points = {}
+        for name, path in choice_points(self.prods):
+            n = points.setdefault(name, [0, 0])
+            n[1] += 1
+            n[0] += self.gen.counts.get((name, path), 0) > 0
+        lines = [
+            "<!-- generated by `python tests/host/pluto_annex_a.py --write` from a grammar run;"
+            " do not edit -->",
+            "",
+            "%d procedures generated from the grammar (seed %d), %d refused by the parser; %d of"
+            " them given to the reference parser too, %d refused by it. %d procedures one token"
+            " away from generated ones: the reference takes %d, the parser agrees on %d."
+            % (len(self.texts), SEED, len(self.refused), self.checked, len(self.outside),
+               self.mutants, self.reference_accepts, self.mutants - len(self.disagreements)),
+            "",
+            "| production | alternatives and optional clauses taken | expansions |",
+            "|---|---|---|",
+        ]  # fmt: skip
+        for name in self.prods:
+            if name in points:
+                taken = "%d of %d" % tuple(points[name])
+            elif name in LEXICAL or name == "Identifier":
+                taken = "a token"
+            else:
+                taken = "one form"
+            lines.append("| %s | %s | %d |" % (name, taken, self.gen.uses.get(name, 0)))
+        return "\n".join(lines) + "\n"
+
+
+def accepts(ref, text):
+    from lark.exceptions import LarkError
+
+    try:
+        ref.parse(text)
+        return True
+    except LarkError:
+        return False
+
+
+BEGIN = "<!-- annex-a run -->"
+END = "<!-- end annex-a run -->"
+PAGE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "docs", "pluto.md")
+
+
+def page_with(table, page):
+    head, rest = page.split(BEGIN + "\n", 1)
+    return head + BEGIN + "\n" + table + END + rest.split(END, 1)[1]
+
+
+def main(argv):
+    from obsw.pluto.exprs import RESERVED
+    from obsw.pluto.lexer import PlutoSyntaxError
+    from obsw.pluto.parser import parse
+
+    with open(PAGE) as f:
+        page = f.read()
+    text = page_with(Run(parse, PlutoSyntaxError, RESERVED).markdown(), page)
+    if "--check" in argv:
+        print("docs/pluto.md is %s" % ("current" if text == page else "stale"))
+        return 0 if text == page else 1
+    with open(PAGE, "w") as f:
+        f.write(text)
+    print("wrote docs/pluto.md")
+    return 0
+
+
 if __name__ == "__main__":
-    sys.exit(0)
+    sys.exit(main(sys.argv[1:]))

@@ -40,6 +40,7 @@ OBJECT_TYPES = (
     ("array",),
 )
 _KINDS = (("system", "element"), ("reporting", "data"), ("parameter",), ("activity",), ("event",))
+_TYPE_ENDS = ("of", "end", ",", "described", "with")
 _TYPE_FIRST = ("predefined", "activity", "system", "reporting", "variable", "parameter",
                "argument", "event", "step", "record", "array")  # fmt: skip
 RELOPS = ("=", "!=", "<", ">", "<=", ">=")
@@ -50,6 +51,18 @@ SUBJECT = ("subj", 0)  # the value a case statement tests, in its case tags
 # Deepest nesting of blocks, parentheses and operators the parser takes: the parser, the
 # checker and the interpreter walk the tree recursively, and a board's stack is small.
 MAX_NESTING = 12
+
+
+def _opens_constant(t, nt):
+    """True when token ``t`` (``nt`` after it) starts a constant: '+ 2' does, '+ x' not."""
+    if t[0] in (NUM, DIGITS, STR, ABST, RELT) or t[1] == "TRUE" or t[1] == "FALSE":
+        return True
+    return t[0] == OP and (t[1] == "+" or t[1] == "-") and nt[0] in (NUM, DIGITS, RELT)
+
+
+def _numeric(v):
+    t = type(v)
+    return t is int or t is float or isinstance(v, units.Quantity)
 
 
 def _show(tok):
@@ -263,7 +276,7 @@ class ExprParser:
             if v == "+" or v == "-":
                 self.i += 1
                 x = self.simple()
-                if x[0] == "c" and type(x[2]) is not bool and not isinstance(x[2], str):
+                if x[0] == "c" and _numeric(x[2]):
                     return ("c", p, units.neg(x[2]) if v == "-" else x[2])
                 return ("u", p, v, x)
         elif k == WORD:
@@ -378,6 +391,8 @@ class ExprParser:
             return ("c", p, units.Quantity(v, "s"))
         if k == OP and v in "+-":
             c = self.constant()
+            if not _numeric(c[2]):  # Annex A: a sign only before a number or a relative time
+                self.err("a sign needs a number, found %s" % _show(self.toks[self.i - 1]), p)
             return ("c", p, units.neg(c[2]) if v == "-" else c[2])
         if k != NUM:
             self.i -= 1
@@ -412,26 +427,12 @@ class ExprParser:
                 self.err("expected ']' to close the units")
             text = "".join(parts)
             self.i = j + 1
-        elif t[0] == WORD and t[1] not in RESERVED and units.symbol(t[1]):
-            text = t[1]
-            self.i += 1
-            while True:
-                t = self.toks[self.i]
-                nt = self.tok(1)
-                if t[0] == OP and t[1] == "^":
-                    j = self.i + 1
-                    sign = ""
-                    if self.toks[j][1] == "-":
-                        sign, j = "-", j + 1
-                    if self.toks[j][0] != DIGITS:
-                        self.err("expected an exponent after '^'")
-                    text += "^" + sign + str(self.toks[j][1])
-                    self.i = j + 1
-                elif t[0] == OP and t[1] in "./" and nt[0] == WORD and units.symbol(nt[1]):
-                    text += t[1] + nt[1]
-                    self.i += 2
-                else:
-                    break
+        elif self._unit_start(self.i):
+            start = self.i
+            text = self._unit_ref()
+            if text is None:
+                self.i = start
+                return None
         else:
             return None
         try:
@@ -439,6 +440,78 @@ class ExprParser:
         except units.UnitError as e:
             self.err(str(e), t[2])
         return text
+
+    # Annex B: <unit reference> = <product> ["/" <factor>]; <product> = <factor> {"." <factor>};
+    # <factor> = (<simple unit> | "(" <unit reference> ")") ["^" <exponent>]; as text, or None
+    # (the position then undefined) when the tokens here are no units
+    def _unit_start(self, j):
+        t = self.toks[j]
+        if t[0] == OP and t[1] == "(":
+            return self._unit_start(j + 1)
+        return t[0] == WORD and t[1] not in RESERVED and units.symbol(t[1]) is not None
+
+    def _unit_ref(self):
+        text = self._unit_product()
+        if text is not None and self.isop("/") and self._unit_start(self.i + 1):
+            save = self.i
+            self.i += 1
+            f = self._unit_factor()
+            if f is None:
+                self.i = save  # '10 m / (x + 1)': a division
+            else:
+                text += "/" + f
+        return text
+
+    def _unit_product(self):
+        text = self._unit_factor()
+        while text is not None and self.isop(".") and self._unit_start(self.i + 1):
+            self.i += 1
+            f = self._unit_factor()
+            if f is None:
+                return None
+            text += "." + f
+        return text
+
+    def _unit_factor(self):
+        t = self.toks[self.i]
+        if t[0] == OP and t[1] == "(":
+            self.i += 1
+            inner = self._unit_ref()
+            if inner is None or not self.isop(")"):
+                return None
+            self.i += 1
+            text = "(" + inner + ")"
+        elif t[0] == WORD and t[1] not in RESERVED and units.symbol(t[1]) is not None:
+            self.i += 1
+            text = t[1]
+        else:
+            return None
+        if self.isop("^"):
+            e = self._unit_exponent()
+            if e is None:
+                self.err("expected an exponent after '^'")
+            text += "^" + e
+        return text
+
+    def _unit_exponent(self):
+        self.i += 1
+        paren = self.isop("(")
+        if paren:
+            self.i += 1
+        sign = ""
+        if self.isop("-"):
+            sign, self.i = "-", self.i + 1
+        t = self.toks[self.i]
+        if t[0] != DIGITS:
+            return None
+        self.i += 1
+        if not paren:
+            return sign + t[1]
+        if not self.isop("/") or self.tok(1)[0] != DIGITS or self.tok(2)[1] != ")":
+            return None
+        d = self.tok(1)[1]
+        self.i += 3
+        return "(%s%s/%s)" % (sign, t[1], d)
 
     def typ(self):
         """A predefined type: 'b', 'i', 'u', 'r', 's', 'a', 'rt' or ('e', enumerated set name)."""
@@ -484,13 +557,41 @@ class ExprParser:
                 k = self.kind(False)
                 if k is None or self.tok()[0] == WORD and self.tok()[1] not in RESERVED:
                     t = self.object_type()
-                    parts.append((t + " " if t else "") + self.name("a property or an object"))
+                    start = self.i
+                    n = self.name("a property or an object")
+                    nt = self.tok()
+                    opens = _opens_constant(nt, self.tok(1))
+                    if constant and nt[0] != EOF and nt[1] not in _TYPE_ENDS and not opens:
+                        n = self.property_constant(start, n)
+                    parts.append((t + " " if t else "") + n)
                 else:
                     parts.append(k)
-                if constant and self.tok()[0] in (NUM, DIGITS, STR, ABST, RELT):
+                t = self.tok()
+                if constant and _opens_constant(t, self.tok(1)):
                     parts[-1] += " " + str(self.constant()[2])
             if not self.take("of"):
                 return " of ".join(parts)
+
+    def property_constant(self, start, n):
+        """'mode 2 V.s': the property mode and the constant 2 V.s when the constant reaches
+        past the name read (else the name as read); the constant is left to be read."""
+        end = self.i
+        k = start + 1
+        while k < end and self.toks[k][0] != DIGITS:
+            k += 1
+        if k == end:
+            return n
+        self.i = k
+        try:
+            self.constant()
+        except PlutoSyntaxError:
+            self.i = end
+            return n
+        if self.i <= end:
+            self.i = end
+            return n
+        self.i = start
+        return self.name("a property or an object", k - start)
 
     def kind(self, needed=True):
         for words in _KINDS:

@@ -267,6 +267,8 @@ def stage_cortex_m():
         print("skipped on the board (a file counts once):")
         for reason, n in sorted(reasons.items(), key=lambda kv: -kv[1]):
             print("  %3d  %s" % (n, reason))
+        q.close()  # the board tools start on a board as flashed: only the frozen modules
+        q = firmware.Qemu(elf)
         p, f = board_tools(q.pty)
         passed, failed = passed + p, failed + f
         p, f = board_update(q.pty)
@@ -277,22 +279,29 @@ def stage_cortex_m():
 
 
 def board_tools(pty):
-    """`obsw board deploy` and `obsw board test` against the QEMU board's pty, as against a
-    Pyboard: the deployed modules shadow the frozen ones; the results are read back."""
+    """`obsw board test` against the QEMU board's pty as flashed (the frozen modules), then
+    `obsw board deploy` and `obsw board test` again, as against a Pyboard: the deployed modules
+    shadow the frozen ones; the results are read back."""
     obsw = shutil.which("obsw") or str(ROOT / ".venv" / "bin" / "obsw")
-    t1 = time.monotonic()
+
+    def board_test(what):
+        t1 = time.monotonic()
+        r = subprocess.run([obsw, "board", "test", "--port", pty], capture_output=True, text=True)
+        c = _counts(r.stdout) or (0, 1, 0)
+        print("obsw board test --port %s (%s): %d passed, %d failed (%.1f s)"
+              % (pty, what, c[0], c[1], time.monotonic() - t1))  # fmt: skip
+        if r.returncode or c[1]:
+            print(r.stdout[-2000:] + r.stderr[-1000:])
+        return c
+
+    frozen = board_test("frozen modules, as flashed")
     r = subprocess.run([obsw, "board", "deploy", "--port", pty], capture_output=True, text=True)
     deployed = r.returncode == 0 and "modules deployed" in r.stdout
     print("obsw board deploy --port %s: %s" % (pty, r.stdout.strip().splitlines()[-1:]))
     if not deployed:
         print(r.stdout[-1500:] + r.stderr[-1500:])
-    r = subprocess.run([obsw, "board", "test", "--port", pty], capture_output=True, text=True)
-    c = _counts(r.stdout) or (0, 1, 0)
-    print("obsw board test --port %s: %d passed, %d failed (%.1f s)"
-          % (pty, c[0], c[1], time.monotonic() - t1))  # fmt: skip
-    if r.returncode or c[1]:
-        print(r.stdout[-2000:] + r.stderr[-1000:])
-    return c[0] + deployed, c[1] + (not deployed)
+    c = board_test("deployed modules")
+    return frozen[0] + c[0] + deployed, frozen[1] + c[1] + (not deployed)
 
 
 # on the board: the boot selector, with an application start that says which application

@@ -137,6 +137,28 @@ def arch_of(mpy):
     return MPY_ARCHS[code] if 0 < code < len(MPY_ARCHS) else None
 
 
+def reachable(port=None):
+    """Raise BoardError, in one line that says why, unless a board answers on ``port`` (or,
+    without one, on the USB serial port mpremote finds)."""
+    try:
+        r = subprocess.run(_mpremote(port) + ["exec", "pass"], capture_output=True, text=True,
+                           timeout=30)  # fmt: skip
+    except subprocess.TimeoutExpired:
+        r = None
+    if r is not None and r.returncode == 0:
+        return
+    if port is None:
+        raise BoardError("no board found on USB: plug the board in (a Pyboard appears as "
+                         "/dev/ttyACM0) or name its port with --port")  # fmt: skip
+    if port.startswith("/dev/") and not os.path.exists(port):
+        raise BoardError("no board on %s: no such device (is it plugged in? `ls /dev/ttyACM*` "
+                         "lists the boards on USB)" % port)  # fmt: skip
+    raise BoardError(
+        "the board on %s does not answer: another program may hold the port "
+        "(mpremote, screen, ModemManager), or the board is in DFU mode" % port
+    )
+
+
 def board_arch(port=None):
     """The connected board's native architecture, asked over mpremote, or None if it cannot
     say (no board, no native code): the modules' @micropython.native code must be its own
@@ -187,6 +209,7 @@ def deploy(
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="obsw-deploy-") as tmp:
             return deploy(port, runner, tmp, march, keys, insecure, progress, ids)
+    reachable(port)  # before minutes of compiling
     if march is None:
         march = board_arch(port) or PYBOARD_ARCH
     names = sorted(compile_application(out_dir, march, runner, say))
@@ -334,6 +357,7 @@ def flash(firmware, port=None, runner=subprocess.call):
 
 
 def repl(port=None, runner=subprocess.call):
+    reachable(port)
     _run(_mpremote(port) + ["repl"], runner)
 
 
@@ -345,6 +369,24 @@ BOARD_TESTS = (
     "test_frames_cltu.py",
     "test_spacecan_frames.py",
 )
+
+
+SUPPORT = ("models.py", "dekker_sim.py")  # host models some reconfiguration tests import
+
+
+def _needs_support(path):
+    with open(path) as f:
+        text = f.read()
+    return any("reconfig.%s import" % m[:-3] in text for m in SUPPORT)
+
+
+def _deployed_code(name):
+    """MicroPython that stops with a reason unless the modules were deployed to the flash."""
+    return (
+        "import os\n"
+        "if 'obsw' not in os.listdir():\n"
+        "    raise SystemExit('%s needs the modules on the flash: obsw board deploy first')" % name
+    )
 
 
 def _results(text):
@@ -375,16 +417,20 @@ def test(files, port=None, runner=_capture):
     root = repo_root()
     if not files:
         files = [os.path.join(root, "tests", "core", f) for f in BOARD_TESTS]
+    reachable(port)
     upy = os.path.join(root, "tools", "upy")
     support = os.path.join(root, "micropython", "obsw", "reconfig")
     totals = [0, 0, 0]
     for f in files:
         name = os.path.basename(f)
         cmd = _mpremote(port) + ["cp", os.path.join(upy, "unittest.py"), ":unittest.py", "+"]
-        for d in ("obsw", "obsw/reconfig"):
-            cmd += ["exec", _mkdir_code(d), "+"]
-        for m in ("models.py", "dekker_sim.py"):  # test support, not in the image
-            cmd += ["cp", os.path.join(support, m), ":obsw/reconfig/" + m, "+"]
+        if _needs_support(f):
+            # test support, not in the image: it joins the deployed obsw/ on the board's
+            # flash (a package is found in one place: an obsw/ folder made only for it would
+            # hide the frozen package from every test)
+            cmd += ["exec", _deployed_code(name), "+"]
+            for m in SUPPORT:
+                cmd += ["cp", os.path.join(support, m), ":obsw/reconfig/" + m, "+"]
         cmd += ["cp", os.path.join(upy, "obsw_run_tests.py"), ":obsw_run_tests.py", "+"]
         cmd += ["cp", f, ":" + name, "+", "exec"]
         cmd.append("import obsw_run_tests; obsw_run_tests.main([%r])" % name)

@@ -2,14 +2,18 @@
 
 import struct
 
+from obsw.errors import too_short
+
 
 class BitsTooShortError(ValueError):
-    """A read went past the end of the buffer; ``needed`` and ``available`` are in bits."""
+    """A read past the end of the buffer, ``needed`` and ``got`` in bits (``obsw.errors``: the
+    too-short kind)."""
 
-    def __init__(self, needed, available):
-        super().__init__("buffer too short: read needs %d bits, %d left" % (needed, available))
+    def __init__(self, what, needed, got):
+        super().__init__(too_short(what, needed, got, "bits"))
+        self.what = what
         self.needed = needed
-        self.available = available
+        self.got = got
 
 
 class BitsValueError(ValueError):
@@ -100,7 +104,7 @@ class Decoder:
         self.pos = bit_offset  # in bits
         self.end = len(buf) * 8
         if bit_offset < 0 or bit_offset > self.end:
-            raise BitsTooShortError(bit_offset, self.end)
+            raise BitsTooShortError("buffer", bit_offset, self.end)
 
     @property
     def bit_position(self):
@@ -118,7 +122,7 @@ class Decoder:
         if nbits < 0:
             raise ValueError("negative bit count %d" % nbits)
         if self.pos + nbits > self.end:
-            raise BitsTooShortError(nbits, self.end - self.pos)
+            raise BitsTooShortError("buffer", nbits, self.end - self.pos)
 
     def read(self, nbits):
         """Read an ``nbits`` wide unsigned integer."""
@@ -148,7 +152,7 @@ class Decoder:
         """``struct.unpack(fmt, ...)`` over the next ``size`` octets (``fmt`` big-endian)."""
         pos = self.pos
         if pos + size * 8 > self.end:
-            raise BitsTooShortError(size * 8, self.end - pos)
+            raise BitsTooShortError("buffer", size * 8, self.end - pos)
         if not pos & 7:
             self.pos = pos + size * 8
             return struct.unpack_from(fmt, self.buf, pos >> 3)

@@ -1,6 +1,7 @@
 """CCSDS Space Packet Protocol (133.0-B-2): headers, packets, counts, idle packets, streams."""
 
 from obsw.compat import Struct, const
+from obsw.errors import too_short
 
 PACKET_VERSION = const(0)  # the only packet version number 133.0-B-2 defines ('000')
 TYPE_TM = const(0)
@@ -26,12 +27,13 @@ class SppError(ValueError):
 
 
 class BytesTooShortError(SppError):
-    """Fewer bytes than a header or a packet needs; ``expected`` and ``actual`` in octets."""
+    """Fewer octets than a header or a packet needs (``obsw.errors``: the too-short kind)."""
 
-    def __init__(self, expected, actual, what="space packet"):
-        super().__init__("%s too short: %d bytes, needs %d" % (what, actual, expected))
-        self.expected = expected
-        self.actual = actual
+    def __init__(self, what, needed, got):
+        super().__init__(too_short(what, needed, got))
+        self.what = what
+        self.needed = needed
+        self.got = got
 
 
 class PacketVersionError(SppError):
@@ -127,7 +129,7 @@ class PrimaryHeader:
         """Decode the header at ``offset``; any version number is accepted here."""
         n = len(buf) - offset
         if n < HEADER_SIZE:
-            raise BytesTooShortError(HEADER_SIZE, n, "space packet primary header")
+            raise BytesTooShortError("space packet primary header", HEADER_SIZE, n)
         pid, psc, dlen = _HEADER.unpack_from(buf, offset)
         return cls(
             (pid >> 12) & 1,
@@ -221,13 +223,13 @@ class SpacePacket:
         """Decode the packet starting at ``offset``; returns ``(packet, end_offset)``."""
         n = len(buf) - offset
         if n < HEADER_SIZE:
-            raise BytesTooShortError(HEADER_SIZE, n, "space packet primary header")
+            raise BytesTooShortError("space packet primary header", HEADER_SIZE, n)
         pid, psc, dlen = _HEADER.unpack_from(buf, offset)
         if pid >> 13:
             raise PacketVersionError(pid >> 13)
         end = offset + dlen + 7
         if end > len(buf):
-            raise BytesTooShortError(dlen + 7, n)
+            raise BytesTooShortError("space packet", dlen + 7, n)
         pkt = cls(
             (pid >> 12) & 1,
             pid & 0x7FF,

@@ -3,6 +3,7 @@
 import struct
 
 from obsw.compat import const
+from obsw.errors import too_short
 
 # Time code identification (P-field bits 1-3).
 CODE_CUC_1958 = const(0b001)  # CUC, level 1: epoch 1958-01-01 TAI
@@ -19,10 +20,13 @@ class TimeCodeError(ValueError):
 
 
 class TimeCodeTooShortError(TimeCodeError):
-    def __init__(self, needed, available, what="time code"):
-        super().__init__("%s too short: %d bytes, needs %d" % (what, available, needed))
+    """Fewer bytes than a time code or its P-field needs (``obsw.errors``: the too-short kind)."""
+
+    def __init__(self, what, needed, got):
+        super().__init__(too_short(what, needed, got))
+        self.what = what
         self.needed = needed
-        self.available = available
+        self.got = got
 
 
 class PFieldMismatchError(TimeCodeError):
@@ -60,7 +64,7 @@ def _hex(b):
 def _check_pfield(buf, offset, pfield):
     n = len(pfield)
     if len(buf) - offset < n:
-        raise TimeCodeTooShortError(n, max(len(buf) - offset, 0), "P-field")
+        raise TimeCodeTooShortError("P-field", n, max(len(buf) - offset, 0))
     got = bytes(buf[offset : offset + n])
     if got != pfield:
         raise PFieldMismatchError(pfield, got)
@@ -141,7 +145,7 @@ class Cuc:
     def unpack(self, buf, offset=0):
         """(coarse, fine) from ``buf`` at ``offset``; checks length and the P-field."""
         if len(buf) - offset < self.size:
-            raise TimeCodeTooShortError(self.size, max(len(buf) - offset, 0), "CUC time")
+            raise TimeCodeTooShortError("CUC time", self.size, max(len(buf) - offset, 0))
         if self.explicit:
             _check_pfield(buf, offset, self._pfield)
             offset += len(self._pfield)
@@ -181,7 +185,7 @@ class Cuc:
         (seconds from 1958-01-01 TAI) supplies it.
         """
         if len(buf) - offset < 1:
-            raise TimeCodeTooShortError(1, 0, "CUC P-field")
+            raise TimeCodeTooShortError("CUC P-field", 1, 0)
         p1 = buf[offset]
         code = (p1 >> 4) & 7
         if code not in (CODE_CUC_1958, CODE_CUC_AGENCY):
@@ -191,7 +195,7 @@ class Cuc:
         size = 1
         if p1 & 0x80:
             if len(buf) - offset < 2:
-                raise TimeCodeTooShortError(2, 1, "CUC P-field")
+                raise TimeCodeTooShortError("CUC P-field", 2, 1)
             p2 = buf[offset + 1]
             if p2 & 0x80:
                 raise TimeCodeFormatError("CUC P-field: third octet is not defined", p2)
@@ -286,7 +290,7 @@ class Cds:
     def unpack(self, buf, offset=0):
         """(day, ms, sub) from ``buf`` at ``offset``; checks length, P-field and ranges."""
         if len(buf) - offset < self.size:
-            raise TimeCodeTooShortError(self.size, max(len(buf) - offset, 0), "CDS time")
+            raise TimeCodeTooShortError("CDS time", self.size, max(len(buf) - offset, 0))
         if self.explicit:
             _check_pfield(buf, offset, self._pfield)
             offset += 1
@@ -331,7 +335,7 @@ class Cds:
     def from_pfield(cls, buf, offset=0, agency_epoch=0):
         """(Cds, 1) described by the P-field at ``offset``; explicit=True."""
         if len(buf) - offset < 1:
-            raise TimeCodeTooShortError(1, 0, "CDS P-field")
+            raise TimeCodeTooShortError("CDS P-field", 1, 0)
         p1 = buf[offset]
         code = (p1 >> 4) & 7
         if code != CODE_CDS or p1 & 0x80:
@@ -346,7 +350,7 @@ class Cds:
 def from_pfield(buf, offset=0, agency_epoch=0):
     """(time code, P-field size) for any P-field this module knows (CUC or CDS)."""
     if len(buf) - offset < 1:
-        raise TimeCodeTooShortError(1, 0, "P-field")
+        raise TimeCodeTooShortError("P-field", 1, 0)
     code = (buf[offset] >> 4) & 7
     if code == CODE_CDS:
         return Cds.from_pfield(buf, offset, agency_epoch)

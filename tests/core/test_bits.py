@@ -115,7 +115,7 @@ class TestDecoder(unittest.TestCase):
         with self.assertRaises(BitsTooShortError) as cm:
             d.read(12)
         self.assertEqual(cm.exception.needed, 12)
-        self.assertEqual(cm.exception.available, 11)
+        self.assertEqual(cm.exception.got, 11)
         self.assertEqual(d.bit_position, 5)  # a failed read consumes nothing
         with self.assertRaises(BitsTooShortError):
             d.read_bytes(2)

@@ -148,7 +148,7 @@ class TestDecodeErrors(unittest.TestCase):
     def test_too_short_for_primary_header(self):
         with self.assertRaises(PusLengthError) as cm:
             PusTc.unpack(TC_17_1[:5])
-        self.assertEqual((cm.exception.expected, cm.exception.actual), (6, 5))
+        self.assertEqual((cm.exception.expected, cm.exception.got), (6, 5))
         self.assertIsNone(cm.exception.packet_id)
         self.assertIsNone(cm.exception.request_id())
         self.assertEqual(failure_code(cm.exception), messages.FAILURE_INVALID_LENGTH)
@@ -156,17 +156,17 @@ class TestDecodeErrors(unittest.TestCase):
     def test_truncated_and_overlong(self):
         with self.assertRaises(PusLengthError) as cm:
             PusTc.unpack(TC_20_3[:-1])
-        self.assertEqual((cm.exception.expected, cm.exception.actual), (17, 16))
+        self.assertEqual((cm.exception.expected, cm.exception.got), (17, 16))
         self.assertEqual(cm.exception.packet_id, 0x1900)
         with self.assertRaises(PusLengthError) as cm:
             PusTm.unpack(TM_3_25 + b"\x00")
-        self.assertEqual((cm.exception.expected, cm.exception.actual), (23, 24))
+        self.assertEqual((cm.exception.expected, cm.exception.got), (23, 24))
 
     def test_data_field_shorter_than_secondary_header(self):
         raw = _sealed("1873 c019 0003 2f 11")  # 4 octets: no room for header and PEC
         with self.assertRaises(PusLengthError) as cm:
             PusTc.unpack(raw)
-        self.assertEqual((cm.exception.expected, cm.exception.actual), (13, 10))
+        self.assertEqual((cm.exception.expected, cm.exception.got), (13, 10))
 
     def test_pus_version(self):
         raw = _sealed("1873 c019 0006 1f 11 01 0000")  # PUS version 1 (PUS-A)

@@ -4,7 +4,7 @@ import unittest
 
 from obsw.spacecan import encoding as enc
 from obsw.spacecan import ids
-from obsw.spacecan.timeframes import FieldRangeError, FrameLengthError, ScetTime, UtcTime
+from obsw.spacecan.timeframes import CanFrameLengthError, FieldRangeError, ScetTime, UtcTime
 
 
 def h(s):
@@ -52,10 +52,10 @@ class TestTimeFrames(unittest.TestCase):
         self.assertEqual(UtcTime.unpack(t.pack()), t)
 
     def test_lengths_checked(self):
-        with self.assertRaises(FrameLengthError) as cm:
+        with self.assertRaises(CanFrameLengthError) as cm:
             ScetTime.unpack(h("aabbcc112233"))
-        self.assertEqual((cm.exception.expected, cm.exception.actual), (7, 6))
-        with self.assertRaises(FrameLengthError):
+        self.assertEqual((cm.exception.expected, cm.exception.got), (7, 6))
+        with self.assertRaises(CanFrameLengthError):
             UtcTime.unpack(h("eeffaabbccdd112233"))
 
     def test_ranges_checked(self):
@@ -140,6 +140,6 @@ class TestEncoding(unittest.TestCase):
             enc.size("u12")
         with self.assertRaises(enc.EncodingError):
             enc.encode("u8,u8", (1,))
-        with self.assertRaises(enc.DecodeError) as cm:
+        with self.assertRaises(enc.ValueTooShortError) as cm:
             enc.decode("u32", h("0102"))
-        self.assertEqual((cm.exception.needed, cm.exception.available), (4, 2))
+        self.assertEqual((cm.exception.needed, cm.exception.got), (4, 2))

@@ -40,8 +40,8 @@ class TestPrimaryHeader(unittest.TestCase):
     def test_too_short(self):
         with self.assertRaises(spp.BytesTooShortError) as cm:
             spp.PrimaryHeader.unpack(b"\x00\x01\x02")
-        self.assertEqual(cm.exception.expected, 6)
-        self.assertEqual(cm.exception.actual, 3)
+        self.assertEqual(cm.exception.needed, 6)
+        self.assertEqual(cm.exception.got, 3)
 
     def test_pack_rejects_out_of_range(self):
         for kw in (
@@ -94,8 +94,8 @@ class TestSpacePacket(unittest.TestCase):
     def test_truncated_packet(self):
         with self.assertRaises(spp.BytesTooShortError) as cm:
             spp.SpacePacket.unpack(TC_VECTOR[:-1])
-        self.assertEqual(cm.exception.expected, 9)
-        self.assertEqual(cm.exception.actual, 8)
+        self.assertEqual(cm.exception.needed, 9)
+        self.assertEqual(cm.exception.got, 8)
 
     def test_wrong_version(self):
         bad = bytes([TC_VECTOR[0] | 0x20]) + TC_VECTOR[1:]

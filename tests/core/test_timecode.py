@@ -83,7 +83,7 @@ class TestCucTField(unittest.TestCase):
             c.pack(0, 256)
         with self.assertRaises(tc.TimeCodeTooShortError) as cm:
             c.unpack(b"\x15\x00\x00")
-        self.assertEqual((cm.exception.needed, cm.exception.available), (4, 3))
+        self.assertEqual((cm.exception.needed, cm.exception.got), (4, 3))
         with self.assertRaises(tc.PFieldMismatchError) as cm:
             c.unpack(b"\x1e\x00\x00\x00")
         self.assertEqual(cm.exception.expected, b"\x15")

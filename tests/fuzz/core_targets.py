@@ -29,7 +29,7 @@ from obsw.spacecan import packets as can_packets
 from obsw.spacecan.fragment import Reassembler, split
 from obsw.spacecan.nodedef import NodeDefinition
 from obsw.spacecan.responder import Responder
-from obsw.spacecan.timeframes import FrameLengthError, ScetTime, UtcTime
+from obsw.spacecan.timeframes import CanFrameLengthError, ScetTime, UtcTime
 from obsw.timecode import TimeCodeError
 
 # -- seeds ----------------------------------------------------------------------------------
@@ -562,7 +562,7 @@ def targets():
             "spacecan-payload",
             _can_payload_call,
             [b"\x00\x02\x01\x02", b"\x01\x01\x00\x01"],
-            (can_packets.ServicePacketError, FrameLengthError),
+            (can_packets.ServicePacketError, CanFrameLengthError),
         ),
         Target("spacecan-fragment", can.fragment_call, _can_seeds(), (), reset=can.reset),
         Target("spacecan-responder", can2.responder_call, _can_seeds(), (), reset=can2.reset),

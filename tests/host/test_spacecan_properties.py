@@ -6,7 +6,7 @@ from obsw.spacecan import encoding as enc
 from obsw.spacecan import packets as pk
 from obsw.spacecan.fragment import MAX_PACKET_SIZE, Reassembler, split
 from obsw.spacecan.nodedef import NodeDefinition
-from obsw.spacecan.timeframes import FrameLengthError, ScetTime, UtcTime
+from obsw.spacecan.timeframes import CanFrameLengthError, ScetTime, UtcTime
 
 NODE = NodeDefinition.from_dict(
     {
@@ -106,5 +106,5 @@ def test_time_frame_junk(data):
     for cls in (ScetTime, UtcTime):
         try:
             cls.unpack(data)
-        except FrameLengthError:
+        except CanFrameLengthError:
             pass

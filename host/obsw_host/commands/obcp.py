@@ -264,11 +264,20 @@ def _activate(args):
 
 def _step_activate(args):
     arguments = parse_arguments(args.arg)
-    return _run(args, lambda o: o.activate_and_step(args.name, arguments or None, args.level))
+    return _run(args, lambda o: _until_held(
+        o, args, o.activate_and_step(args.name, arguments or None, args.level)))  # fmt: skip
 
 
 def _step(args):
-    return _run(args, lambda o: o.resume_and_step(args.name))
+    return _run(args, lambda o: _until_held(o, args, o.resume_and_step(args.name)))
+
+
+def _until_held(o, args, tx):
+    """A step request returns once the OBCP holds again (or has ended), so the next `step`
+    finds it suspended."""
+    if tx.ok:
+        o.held(args.name, timeout=max(args.timeout, 10.0))
+    return tx
 
 
 def _simple(args):

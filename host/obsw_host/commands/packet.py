@@ -123,7 +123,7 @@ def describe(raw, config):
     if header.version != spp.PACKET_VERSION:
         raise spp.PacketVersionError(header.version)
     if len(raw) < header.packet_length:
-        raise spp.BytesTooShortError(header.packet_length, len(raw))
+        raise spp.BytesTooShortError("space packet", header.packet_length, len(raw))
     if len(raw) > header.packet_length:
         raise spp.SppError(
             "packet is %d bytes, packet data length field says %d"

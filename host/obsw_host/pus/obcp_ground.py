@@ -127,6 +127,19 @@ class ObcpGround:
             raise RuntimeError("no OBCP status report: %s" % "; ".join(explain(tx)))
         return {o["id"]: o for o in tx.reply["obcps"]}
 
+    def held(self, name, apid=None, timeout=10.0, period=0.1):
+        """Wait until OBCP ``name`` holds (suspended) or has ended (inactive), as after a step
+        request: the request's completion report comes as soon as the step starts. Its status
+        (TM[18,9]), or None if it still runs after ``timeout`` seconds."""
+        end = REAL_CLOCK.now() + timeout
+        while True:
+            o = self.status(apid).get(name)
+            if o is None or o["status"] in ("suspended", "inactive"):
+                return o
+            if REAL_CLOCK.now() > end:
+                return None
+            REAL_CLOCK.sleep(period)
+
     # -------------------------------------------------------------------------- events
 
     def events(self, timeout=0.0, until=None):

@@ -1,7 +1,8 @@
 metadata(
     version="0.1.0",
-    description="what every part needs: clocks, CRCs, bounded JSON, space packets, time codes",
+    description="what every part needs: clocks, CRCs, errors, bounded JSON, packets, time codes",
 )
 
-for _m in ("__init__.py", "compat.py", "crc.py", "jsonsafe.py", "spp.py", "utc.py", "timecode.py"):
-    module("obsw/" + _m, base_path="../../../micropython")
+_MODULES = ("__init__", "compat", "crc", "errors", "jsonsafe", "spp", "utc", "timecode")
+for _m in _MODULES:
+    module("obsw/%s.py" % _m, base_path="../../../micropython")

@@ -1,6 +1,7 @@
 """CFDP (CCSDS 727.0-B-5) numbers: PDU fields, condition codes, TLV types and decode errors."""
 
 from obsw.compat import const
+from obsw.errors import too_short
 
 VERSION = const(1)  # '001' = CFDP version 2 (727.0-B-4 and later)
 
@@ -117,10 +118,10 @@ class CfdpError(ValueError):
 
 
 class PduTooShortError(CfdpError):
-    """Fewer bytes than a PDU or field needs."""
+    """Fewer bytes than a PDU or field needs (``obsw.errors``: the too-short kind)."""
 
     def __init__(self, what, needed, got):
-        super().__init__("%s too short: %d bytes, needs %d" % (what, got, needed))
+        super().__init__(too_short(what, needed, got))
         self.what = what
         self.needed = needed
         self.got = got

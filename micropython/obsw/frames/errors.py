@@ -1,15 +1,17 @@
 """Errors raised by the frame decoders: narrow ValueError subclasses that carry what they saw."""
 
+from obsw.errors import too_short, wrong_length
+
 
 class FrameError(ValueError):
     """Base of every decode error in obsw.frames."""
 
 
 class FrameTooShortError(FrameError):
-    """Fewer bytes than the structure needs."""
+    """Fewer bytes than the structure needs (``obsw.errors``: the too-short kind)."""
 
     def __init__(self, what, needed, got):
-        super().__init__("%s too short: %d bytes, needs %d" % (what, got, needed))
+        super().__init__(too_short(what, needed, got))
         self.what = what
         self.needed = needed
         self.got = got
@@ -19,7 +21,7 @@ class FrameLengthError(FrameError):
     """A length field or a configured length that does not match the bytes."""
 
     def __init__(self, what, expected, got):
-        super().__init__("%s length: %d bytes, expected %d" % (what, got, expected))
+        super().__init__(wrong_length(what, expected, got))
         self.what = what
         self.expected = expected
         self.got = got

@@ -2,6 +2,7 @@
 
 from obsw.compat import Struct, const
 from obsw.crc import crc16_ccitt
+from obsw.errors import too_short, wrong_length
 from obsw.pus.config import DEFAULT
 from obsw.spp import SEQ_UNSEGMENTED, TYPE_TC, FieldRangeError, SppError
 
@@ -45,12 +46,23 @@ class PusError(SppError):
 
 
 class PusLengthError(PusError):
-    """Packet length inconsistent: ``expected`` and ``actual`` octets."""
+    """A packet whose length is not what ``what`` must be: ``expected`` and ``got`` octets
+    (``obsw.errors``: the length kind; ``message`` says more than the default)."""
 
-    def __init__(self, msg, expected, actual, packet_id=None, sequence_control=None):
-        super().__init__(msg, packet_id, sequence_control)
+    def __init__(self, what, expected, got, packet_id=None, sequence_control=None, message=None):
+        super().__init__(message or wrong_length(what, expected, got), packet_id, sequence_control)
+        self.what = what
         self.expected = expected
-        self.actual = actual
+        self.got = got
+
+
+class PusTooShortError(PusLengthError):
+    """Fewer octets than ``what`` needs (``obsw.errors``: the too-short kind)."""
+
+    def __init__(self, what, needed, got, packet_id=None, sequence_control=None):
+        message = too_short(what, needed, got)
+        super().__init__(what, needed, got, packet_id, sequence_control, message)
+        self.needed = needed
 
 
 class PusCrcError(PusError):
@@ -121,11 +133,7 @@ class RequestId:
     @classmethod
     def unpack(cls, buf, offset=0):
         if len(buf) - offset < 4:
-            raise PusLengthError(
-                "request ID too short: %d bytes, needs 4" % (len(buf) - offset),
-                4,
-                len(buf) - offset,
-            )
+            raise PusTooShortError("request ID", 4, len(buf) - offset)
         return cls.from_words(*_WORDS.unpack_from(buf, offset))
 
     def __eq__(self, other):
@@ -178,9 +186,7 @@ def _frame(what, buf, offset, config, exact, type_id, min_size):
     """Check everything up to the PEC; return (packet_id, seq_control, end, data_end)."""
     n = len(buf) - offset
     if n < 6:
-        raise PusLengthError(
-            "%s packet too short: %d bytes, primary header needs 6" % (what, n), 6, n
-        )
+        raise PusTooShortError("%s packet primary header" % what, 6, n)
     pid, psc, dlen = _HDR.unpack_from(buf, offset)
     total = dlen + 7
     if pid & 0xF800 != type_id:
@@ -190,31 +196,16 @@ def _frame(what, buf, offset, config, exact, type_id, min_size):
             raise PusHeaderError(what, "packet type", type_id >> 12 & 1, pid >> 12 & 1, pid, psc)
         raise PusHeaderError(what, "secondary header flag", 1, 0, pid, psc)
     if total > n or (exact and total != n):
-        raise PusLengthError(
-            "%s packet is %d bytes, packet data length field says %d" % (what, n, total),
-            total,
-            n,
-            pid,
-            psc,
-        )
+        says = "%s packet is %d bytes, packet data length field says %d" % (what, n, total)
+        raise PusLengthError("%s packet" % what, total, n, pid, psc, says)
     if total < min_size:
-        raise PusLengthError(
-            "%s packet too short: %d bytes, secondary header and PEC need %d"
-            % (what, total, min_size),
-            min_size,
-            total,
-            pid,
-            psc,
+        raise PusTooShortError(
+            "%s packet (secondary header, PEC)" % what, min_size, total, pid, psc
         )
     if total > config.max_packet_size:
-        raise PusLengthError(
-            "%s packet of %d bytes exceeds the mission maximum %d"
-            % (what, total, config.max_packet_size),
-            config.max_packet_size,
-            total,
-            pid,
-            psc,
-        )
+        most = "%s packet of %d bytes exceeds the mission maximum %d" % (
+            what, total, config.max_packet_size)  # fmt: skip
+        raise PusLengthError("%s packet" % what, config.max_packet_size, total, pid, psc, most)
     end = offset + total
     if config.pec:
         if crc16_ccitt(buf if exact else memoryview(buf)[offset:end]) != 0:

@@ -209,7 +209,7 @@ class Packet(FieldType):
         if dec.bits_left < size * 8:
             left = dec.bits_left
             dec.pos = start
-            raise BitsTooShortError(size * 8, left)
+            raise BitsTooShortError("buffer", size * 8, left)
         data = header + dec.read_bytes(size)
         self._check_header(data, data)
         if self.codec is not None:

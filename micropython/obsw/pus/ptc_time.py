@@ -164,7 +164,7 @@ class ExplicitTime(FieldType):
         if dec.bits_left < code.tsize * 8:
             left = dec.bits_left
             dec.pos = start
-            raise BitsTooShortError(code.tsize * 8, left)
+            raise BitsTooShortError("buffer", code.tsize * 8, left)
         comps = code.unpack(pfield + dec.read_bytes(code.tsize))
         return code, comps
 

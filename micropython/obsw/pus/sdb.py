@@ -37,6 +37,7 @@ A type is a name (``uint8`` .. ``uint64``, ``int8`` .. ``int64``, ``float32``, `
 """
 
 from obsw import jsonsafe
+from obsw.errors import UnknownNameError
 from obsw.pus.fields import field
 from obsw.pus.structure import Structure
 
@@ -415,7 +416,7 @@ class Sdb:
                 if candidate.name == key:
                     s = candidate
         if s is None:
-            raise KeyError("no mission service %r in the spacecraft database" % (key,))
+            raise UnknownNameError("mission service", key, known=_names(self.services.values()))
         return s
 
     def _load_functions(self, doc):
@@ -472,7 +473,7 @@ class Sdb:
         """The FunctionDef with this id or name ('SolarPanel.set_angle')."""
         f = self.functions.get(key) if isinstance(key, int) else self._functions_by_name.get(key)
         if f is None:
-            raise KeyError("no function %r in the spacecraft database" % (key,))
+            raise UnknownNameError("function", key, known=self._functions_by_name)
         return f
 
     def _load_files(self, doc):
@@ -508,7 +509,7 @@ class Sdb:
         try:
             return self.filestores[prefix]
         except KeyError:
-            raise KeyError("no filestore %r in the spacecraft database" % (prefix,)) from None
+            raise UnknownNameError("filestore", prefix, known=self.filestores) from None
 
     def _add_parameter(self, p):
         if p.id in self.parameters:
@@ -544,21 +545,21 @@ class Sdb:
         """The Parameter with this id or qualified name ('SolarPanel.angle')."""
         p = self.parameters.get(key) if isinstance(key, int) else self._params_by_name.get(key)
         if p is None:
-            raise KeyError("no parameter %r in the spacecraft database" % (key,))
+            raise UnknownNameError("parameter", key, known=self._params_by_name)
         return p
 
     def event(self, key):
         """The EventDef with this id or qualified name ('SolarPanel.angle_reached')."""
         e = self.events.get(key) if isinstance(key, int) else self._events_by_name.get(key)
         if e is None:
-            raise KeyError("no event %r in the spacecraft database" % (key,))
+            raise UnknownNameError("event", key, known=self._events_by_name)
         return e
 
     def apid(self, name):
         try:
             return self.apids[name]
         except KeyError:
-            raise KeyError("no APID named %r in the spacecraft database" % (name,)) from None
+            raise UnknownNameError("APID named", name, known=self.apids) from None
 
     def check_interfaces(self, interfaces):
         """Raise SdbError if an entry names an attribute or event its interface lacks."""
@@ -635,3 +636,7 @@ def _memory_objects(items, mid, size):
             raise SdbError("object %d of memory %d outside its %d octets" % (oid, mid, size))
         out[oid] = (o.get("name", "object%d" % oid), off, n)
     return out
+
+
+def _names(defs):
+    return [d.name for d in defs]

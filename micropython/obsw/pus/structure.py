@@ -148,7 +148,7 @@ class Repeated:
         item = self.item
         need = n * _min_bits(item)
         if need > dec.bits_left:
-            raise BitsTooShortError(need, dec.bits_left)
+            raise BitsTooShortError("buffer", need, dec.bits_left)
         if self._fmt is not None and n:
             return list(dec.read_struct(">%d%s" % (n, self._fmt), n * self._item_octets))
         if isinstance(item, FieldType):

@@ -3,6 +3,7 @@
 import struct
 
 from obsw.compat import micropython
+from obsw.errors import too_short
 
 # name -> (struct code, size, signed); bool is handled by hand (MicroPython's struct has no '?')
 _TABLE = {
@@ -47,14 +48,14 @@ class EncodingError(ValueError):
         self.value = value
 
 
-class DecodeError(ValueError):
-    """Too few bytes to decode a value."""
+class ValueTooShortError(ValueError):
+    """Too few bytes to decode a value (``obsw.errors``: the too-short kind)."""
 
-    def __init__(self, encoding, needed, available):
-        super().__init__("%s value needs %d bytes, only %d left" % (encoding, needed, available))
-        self.encoding = encoding
+    def __init__(self, what, needed, got):
+        super().__init__(too_short(what, needed, got))
+        self.what = what
         self.needed = needed
-        self.available = available
+        self.got = got
 
 
 def parts(encoding):
@@ -136,7 +137,7 @@ def encode(encoding, value):
 def _decode_one(name, buf, offset):
     width = _TABLE[name][1]
     if len(buf) - offset < width:
-        raise DecodeError(name, width, len(buf) - offset)
+        raise ValueTooShortError("%s value" % name, width, len(buf) - offset)
     packing = PACK.get(name)
     if packing is None:
         return buf[offset] != 0, offset + 1

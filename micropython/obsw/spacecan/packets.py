@@ -141,7 +141,7 @@ def unpack_values(nodedef, data):
             raise ServicePacketError("unknown parameter id %d in values at byte %d" % (pid, off))
         try:
             value, off = enc.decode(p.encoding, data, off + 1)
-        except enc.DecodeError as e:
+        except enc.ValueTooShortError as e:
             raise ServicePacketError("parameter %d: %s" % (pid, e))  # noqa: B904
         out.append((pid, value))
     if n != len(out):
@@ -173,7 +173,7 @@ def unpack_hk(nodedef, data):
     for pid in r.parameter_ids:
         try:
             value, off = enc.decode(nodedef.parameters[pid].encoding, data, off)
-        except enc.DecodeError as e:
+        except enc.ValueTooShortError as e:
             msg = "report %d parameter %d: %s" % (r.report_id, pid, e)
             raise ServicePacketError(msg)  # noqa: B904
         out.append((pid, value))
@@ -223,7 +223,7 @@ def unpack_function(nodedef, data):
                 raise ServicePacketError("function %d argument %d repeated" % (fid, data[off]))
             try:
                 args[a.argument_id], off = enc.decode(a.encoding, data, off + 1)
-            except enc.DecodeError as e:
+            except enc.ValueTooShortError as e:
                 msg = "function %d argument %d: %s" % (fid, a.argument_id, e)
                 raise ServicePacketError(msg)  # noqa: B904
     if n != len(args):

@@ -24,7 +24,7 @@ from obsw.spacecan.ids import (
     check_node_id,
 )
 from obsw.spacecan.redundancy import BusHealth, HeartbeatMonitor
-from obsw.spacecan.timeframes import FrameLengthError, ScetTime, UtcTime
+from obsw.spacecan.timeframes import CanFrameLengthError, ScetTime, UtcTime
 
 _CANNED_MAX = const(64)  # verification report frames kept ready
 _PING_REPORT_FRAME = split(bytes((pk.SERVICE_TEST, pk.PING_REPORT)))[0]
@@ -223,7 +223,7 @@ class Responder:
                 self._serve(packet, bus, now)
         elif can_id == ID_HEARTBEAT:
             if len(data):
-                self._bad(bus, can_id, now, FrameLengthError("heartbeat", 0, len(data)))
+                self._bad(bus, can_id, now, CanFrameLengthError("heartbeat", 0, len(data)))
                 return
             self._count_rx(bus, now)
             self.health[bus].heartbeats += 1
@@ -234,7 +234,7 @@ class Responder:
                 self._emit(ev.BUS_SWITCHED, now, old=old, new=self.monitor.active, reason=reason)
         elif can_id == ID_SYNC:
             if len(data):
-                self._bad(bus, can_id, now, FrameLengthError("sync", 0, len(data)))
+                self._bad(bus, can_id, now, CanFrameLengthError("sync", 0, len(data)))
                 return
             self._count_rx(bus, now)
             kinds = self.event_kinds

@@ -3,19 +3,21 @@
 import struct
 
 from obsw.compat import const
+from obsw.errors import wrong_length
 
 _SCET_LEN = const(7)
 _UTC_LEN = const(8)
 
 
-class FrameLengthError(ValueError):
-    """A frame whose data length does not match its identifier's format."""
+class CanFrameLengthError(ValueError):
+    """A CAN frame whose data length does not match its identifier's format (``obsw.errors``:
+    the length kind)."""
 
-    def __init__(self, what, expected, actual):
-        super().__init__("%s frame needs %d data bytes, got %d" % (what, expected, actual))
+    def __init__(self, what, expected, got):
+        super().__init__(wrong_length("%s frame data" % what, expected, got))
         self.what = what
         self.expected = expected
-        self.actual = actual
+        self.got = got
 
 
 class FieldRangeError(ValueError):
@@ -46,7 +48,7 @@ class ScetTime:
     @classmethod
     def unpack(cls, buf):
         if len(buf) != _SCET_LEN:
-            raise FrameLengthError("SCET", _SCET_LEN, len(buf))
+            raise CanFrameLengthError("SCET", _SCET_LEN, len(buf))
         hi, lo, coarse = struct.unpack(">BHI", buf)
         return cls(coarse, (hi << 16) | lo)
 
@@ -79,7 +81,7 @@ class UtcTime:
     @classmethod
     def unpack(cls, buf):
         if len(buf) != _UTC_LEN:
-            raise FrameLengthError("UTC", _UTC_LEN, len(buf))
+            raise CanFrameLengthError("UTC", _UTC_LEN, len(buf))
         sub_ms, ms, day = struct.unpack(">HIH", buf)
         return cls(day, ms, sub_ms)
 
@@ -98,4 +100,4 @@ class UtcTime:
 def check_empty(what, data):
     """Heartbeat and sync frames carry no data."""
     if len(data):
-        raise FrameLengthError(what, 0, len(data))
+        raise CanFrameLengthError(what, 0, len(data))

@@ -21,6 +21,7 @@ callables given to ``local``.
 """
 
 from obsw import cbor
+from obsw.errors import UnknownNameError
 from obsw.il.errors import CallTimeoutError, ComponentError, InteractionError, UnavailableError
 from obsw.pus.fields import field
 from obsw.pus.messages import SERVICE_FUNCTION_MANAGEMENT, TC_FUNCTION_PERFORM
@@ -204,7 +205,7 @@ class FunctionUser(ServiceUser):
         for f in self.table.values():
             if f.name == key:
                 return f
-        raise KeyError("no function %r in the spacecraft database" % (key,))
+        raise UnknownNameError("function", key, known=[f.name for f in self.table.values()])
 
     def pack(self, key, arguments=None):
         """The application data of TC[8,1]; ``arguments`` maps argument IDs or names to

@@ -1,6 +1,7 @@
 """PLUTO load-time checks of activity calls against their declared signatures (argument
 names, types and units from the spacecraft database or a simulated system's description)."""
 
+from obsw.errors import closest
 from obsw.pluto.exprcheck import (
     _DECLARED,
     NONE,
@@ -54,7 +55,7 @@ class SignatureChecker:
                 continue
             self.argument_type(path, decl, v, self.expr(v, scopes), q)
         for name, q in unknown:  # a misspelt name: say which declared one it resembles
-            near = closest(name, [d[0] for d in sig if d[0] not in given])
+            near = closest_argument(name, [d[0] for d in sig if d[0] not in given])
             hint = "; did you mean %s?" % near if near else ""
             if near:
                 given[near] = True  # named by this error: not reported missing as well
@@ -94,28 +95,14 @@ class SignatureChecker:
                       % (path, name, _a(want), self.operand(v, et), why), p)  # fmt: skip
 
 
-def distance(a, b):
-    """Edit distance (Levenshtein) between two strings."""
-    row = list(range(len(b) + 1))
-    for i, ca in enumerate(a):
-        prev, row[0] = row[0], i + 1
-        for j, cb in enumerate(b):
-            cur = row[j + 1]
-            row[j + 1] = min(cur + 1, row[j] + 1, prev + (ca != cb))
-            prev = cur
-    return row[-1]
-
-
-def closest(name, names):
+def closest_argument(name, names):
     """The one of ``names`` nearest to ``name`` when near enough to be a typo of it (at most a
-    third of its letters differ, spaces, underscores and case aside), else None."""
-    a = norm(name)
-    best, bd = None, 0
+    third differs, spaces, underscores and case aside), else None."""
+    forms = {}
     for n in names:
-        d = distance(a, norm(n))
-        if best is None or d < bd:
-            best, bd = n, d
-    return best if best is not None and bd <= max(1, len(a) // 3) else None
+        forms.setdefault(norm(n), n)
+    near = closest(norm(name), list(forms))
+    return None if near is None else forms[near]
 
 
 def _below_zero(v):

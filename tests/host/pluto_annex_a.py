@@ -740,7 +740,7 @@ def page_with(table, page):
 
 
 def main(argv):
-    from obsw.pluto.exprs import RESERVED
+    from obsw.pluto.syntax import RESERVED
     from obsw.pluto.lexer import PlutoSyntaxError
     from obsw.pluto.parser import parse
 

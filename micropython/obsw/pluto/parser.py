@@ -4,8 +4,10 @@ A procedure or step definition is ``("def", pos, decls, preconditions, main, wat
 confirmation)``; statements are tuples tagged by their first item (see README, PLUTO section).
 """
 
-from obsw.pluto.exprs import MAX_NESTING, RESERVED, SUBJECT, ExprParser, _show
+from obsw.pluto.arguments import ArgumentParser
+from obsw.pluto.exprs import SUBJECT
 from obsw.pluto.lexer import EOF, OP, STR, WORD, PlutoSyntaxError, line_col, tokenize
+from obsw.pluto.syntax import MAX_NESTING, _show
 
 # Deepest tree (tuples and lists) a procedure may give: long operator chains such as
 # 1 + 1 + ... + 1 nest without any parenthesis.
@@ -14,7 +16,6 @@ MAX_TREE_DEPTH = 6 * MAX_NESTING
 _STATUS = (("confirmed",), ("not", "confirmed"), ("aborted",))
 # words that carry an expression on: after 'wait for event X' they make it 'wait for <expr>'
 _GOES_ON = ("AND", "OR", "XOR", "between", "within", "in")
-_ARGUMENT_KINDS = ("activity", "parameter", "reporting data", "event", "system element")
 _MAIN_STOPS = ("end", "watchdog", "confirmation")
 _PROC_ONLY = (
     "only initiate, initiate and confirm, in parallel, inform user, log and in the context of"
@@ -50,7 +51,7 @@ def check_depth(tree):
                 stack.append((child, depth + 1, p))
 
 
-class Parser(ExprParser):
+class Parser(ArgumentParser):
     def procedure(self):
         self.expect("procedure", after="at the start of the text")
         node = self.definition(False, "procedure")
@@ -341,105 +342,6 @@ class Parser(ExprParser):
         if t[1] in ("=", "!=", "<", ">", "<=", ">=", "between", "within", "in"):
             return self.relational(SUBJECT)
         return ("cmp", t[2], "=", SUBJECT, self.term())  # a bare value means '= value'
-
-    def activity_call(self):
-        r = self.ref("an activity")
-        args, dirs = (), ()
-        if self.take("with", "arguments"):
-            args = self.arguments()
-            self.expect("end", "with", after="after the arguments")
-        elif self.take("with", "value", "set"):
-            args = (("value set", self.ref("a value set")),)
-            self.expect("end", "with", after="after the value set")
-        if self.take("with", "directives"):
-            dirs = [self.named_expr()]
-            while self.isop(","):
-                self.i += 1
-                dirs.append(self.named_expr())
-            dirs = tuple(dirs)
-            self.expect("end", "with", after="after the directives")
-        return (r, args, dirs)
-
-    def arguments_opt(self, opener):
-        if not self.take(*opener):
-            return ()
-        a = self.arguments()
-        self.expect("end", "with", after="after the arguments")
-        return a
-
-    def arguments(self, closer="with"):
-        """Arguments up to 'end <closer>'."""
-        out = [self.argument(closer)]
-        while self.isop(","):
-            self.i += 1
-            out.append(self.argument(closer))
-        return tuple(out)
-
-    def argument(self, closer):
-        """``[<name> :=] <expression>``, ``[<name>] record ... end record``, ``[<name>] array
-        ... end array``, ``activity <call>``, ``parameter <ref>``, ``event <ref>``...: the
-        forms overlap ('array X' is also a reference), so each that may start here is tried
-        until one ends where an argument ends."""
-        start = self.i
-        err = None
-        for form in (self._named, self._structured, self._typed, self._simple_argument):
-            self.i = start
-            try:
-                a = form()
-            except PlutoSyntaxError as e:
-                if err is None or (e.line, e.col) > (err.line, err.col):
-                    err = e
-                continue
-            if a is not None and (self.isop(",") or self.at("end", closer)):
-                return a
-        if err is None:
-            self.i = start
-            return self._simple_argument()
-        raise err
-
-    def _named(self):
-        if self.tok()[0] != WORD or self.tok()[1] in RESERVED:
-            return None
-        name = self.name()
-        if self.take(":="):  # 'name := record ...' too, an extension
-            if self.at("record") or self.at("array"):
-                return (name, self.structured(self.pos()))
-            return (name, self.expr())
-        if (self.at("record") or self.at("array")) and name not in _ARGUMENT_KINDS:
-            return (name, self.structured(self.pos()))  # 'activity array X' is an activity
-        return None
-
-    def _structured(self):
-        if self.at("record") or self.at("array"):
-            return (None, self.structured(self.pos()))
-        return None
-
-    def _typed(self):
-        p = self.pos()
-        if self.take("activity"):  # an activity, with its arguments, handed to the one called
-            return (None, ("act", p, self.activity_call()))
-        if self.take("parameter") or self.take("reporting", "data"):
-            r = self.ref()  # its value, as any reference to a parameter gives
-            r[3] = r[3] or "parameter"
-            return (None, r)
-        if self.take("event"):  # the reference itself, not a value
-            return (None, ("refarg", p, self.ref(), "event"))
-        if self.take("system", "element"):
-            return (None, ("refarg", p, self.ref(), "system element"))
-        return None
-
-    def _simple_argument(self):
-        return (None, self.expr())
-
-    def structured(self, p):
-        if self.take("record"):
-            v = ("rec", p, self.arguments("record"))
-            self.expect("end", "record")
-        else:
-            self.expect("array")
-            v = ("arr", p, self.arguments("array"))
-            self.expect("end", "array")
-        return v
 
     def parallel(self, p):
         every = True

@@ -740,9 +740,9 @@ def page_with(table, page):
 
 
 def main(argv):
-    from obsw.pluto.syntax import RESERVED
     from obsw.pluto.lexer import PlutoSyntaxError
     from obsw.pluto.parser import parse
+    from obsw.pluto.syntax import RESERVED
 
     with open(PAGE) as f:
         page = f.read()

@@ -10,9 +10,9 @@ import pluto_annex_a as annex
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from obsw.pluto.syntax import RESERVED
 from obsw.pluto.lexer import PlutoSyntaxError
 from obsw.pluto.parser import parse
+from obsw.pluto.syntax import RESERVED
 
 
 @pytest.fixture(scope="module")

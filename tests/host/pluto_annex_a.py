@@ -393,29 +393,42 @@ class Generator:
         words = [self.rng.choice(FIRST_WORDS)]
         more = self.rng.choice((0, 0, 1, 2))
         self._count("Identifier", (".1{0}", ".1{1}", ".1{n}")[more])
+        self.use("Identifier First Word", "Letter")
         for _ in range(more):
             words.append(self.rng.choice(NEXT_WORDS))
+            self.use("Identifier Subsequent Word", "Digit" if words[-1][0].isdigit() else "Letter")
         return " ".join(words)
+
+    def use(self, *names):
+        """Count the lexical productions a token was written from."""
+        for n in names:
+            self.uses[n] = self.uses.get(n, 0) + 1
 
     # the lexical level: one token each, within the ranges the standard's text gives
     def digits(self, lo=1, hi=4):
+        self.use("Digit")
         return "".join(self.rng.choice("0123456789") for _ in range(self.rng.randint(lo, hi)))
 
     def lexical(self, n):
         r = self.rng
         if n in ("String Constant", "Enumerated Constant"):
             s = r.choice(STRINGS)
+            self.use("Characters", "Letter")
             return '"%s"' % s
         if n == "Absolute Time Constant":
             y = "%04d" % r.randint(1970, 2099)
+            self.use("Year", "Hour", "Minute", "Second", "Fraction Of Second")
             if r.random() < 0.5:
+                self.use("Month", "Day Of Month")
                 date = "%s-%02d-%02d" % (y, r.randint(1, 12), r.randint(1, 28))
             else:
+                self.use("Day")
                 date = "%s-%03d" % (y, r.randint(1, 365))
             t = "T%02d:%02d:%02d.%s" % (r.randint(0, 23), r.randint(0, 59), r.randint(0, 59),
                                          self.digits(1, 6))  # fmt: skip
             return date + t + r.choice(("", "Z"))
         if n == "Hexadecimal Constant":
+            self.use("Hexadecimal Constant", "Hexadecimal Symbol", "Hexadecimal Digit")
             return "0x" + "".join(r.choice("0123456789ABCDEF") for _ in range(r.randint(1, 8)))
         if n == "Unit Simple Factor":
             out = []
@@ -429,8 +442,11 @@ class Generator:
         r = self.rng
         sign = r.choice(("", "", "-", "+"))
         if n == "Relative Time Constant":
+            if sign:
+                self.use("Sign")
             if r.random() < 0.3:
                 self._count(n, "|1")
+                self.use("Days", "Hour", "Minute", "Second", "Fraction Of Second")
                 text = "%s%d:%02d:%02d:%02d:%s" % (sign, r.randint(0, 400), r.randint(0, 23),
                                                    r.randint(0, 59), r.randint(0, 59),
                                                    self.digits(1, 3))  # fmt: skip
@@ -442,8 +458,10 @@ class Generator:
                 last = r.randint(first, 3)
                 for u in units[first : last + 1]:
                     if u == units[last] or r.random() < 0.6:
+                        self.use(("Days", "Hours", "Minutes", "Seconds")[units.index(u)])
                         parts.append(self.digits(1, 3) + u)
                 if units[last] == "s" and r.random() < 0.4:
+                    self.use("Fraction Of Second")
                     parts[-1] = parts[-1][:-1] + "." + self.digits(1, 3) + "s"
                 text = sign + "".join(parts)
             out.append(text)
@@ -454,6 +472,8 @@ class Generator:
             return
         if n == "Integer Constant":
             self._count(n, "|0")
+        if sign:
+            self.use("Sign")
         text = sign + self.digits(1, 5)
         if n == "Real Constant":
             if r.random() < 0.6:

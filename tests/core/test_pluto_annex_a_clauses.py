@@ -142,6 +142,12 @@ class TestTypes(unittest.TestCase):
         t = dry_run(src, SPEC)
         self.assertEqual((t["error"], t["log"]), (None, ["7 V3"]))
 
+    def test_property_value_set_forms(self):
+        for t in ("states of current parameter of mode 2", "parameter reference of mode 2 V",
+                  "states of current system element", "modes of current of OBC"):  # fmt: skip
+            proc = parse(step("log 1;", "variable x of type %s" % t))
+            self.assertEqual(proc[4][0][3][2][0][3][0], "sys")
+
     def test_enumerated_set_of_an_object(self):
         proc = parse(step("x := 1;", "variable x of type modes of OBC"))
         self.assertEqual(proc[4][0][3][2][0][3][0], "sys")
@@ -150,7 +156,7 @@ class TestTypes(unittest.TestCase):
 class TestSyntaxErrors(unittest.TestCase):
     def test_still_refused(self):
         for bad in ("wait for 1 s save context refer to x;", "log x with end with;",
-                    "log 1 within 2 V V2 of 3;"):  # fmt: skip
+                    "log 1 within 2 V V2 of 3;", "log 1 in (1);"):  # fmt: skip
             with self.assertRaises(PlutoSyntaxError):
                 parse(step(bad))
 

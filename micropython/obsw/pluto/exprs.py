@@ -67,6 +67,8 @@ class ExprParser(UnitTypeParser):
             while self.isop(","):
                 self.i += 1
                 items.append(self.term())
+            if len(items) < 2:  # Annex A: 'in (' <term> {',' <term>}- ')'
+                self.err("in (...) needs two values at least, found %s" % _show(self.tok()))
             self.expect(")")
             return ("in", p, left, tuple(items))
         if subject is not None:

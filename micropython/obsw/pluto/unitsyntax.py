@@ -148,33 +148,40 @@ class UnitTypeParser(TokenParser):
         if not self.at("of"):
             return ("e", n)
         self.i += 1  # the values a property of a system object may take
-        return ("sys", p, n + " of " + self.type_path(True))
+        return ("sys", p, n + " of " + self.type_path(False))
 
     def type_path(self, constant):
-        """``<property> {of <property>} of (<reference> | [current] <kind> [of ...])``, with a
-        constant after a property where ``constant``; as text."""
+        """``<property> {of <property>} of (<reference> | [current] <kind> [of (<property>
+        <constant> | <reference>)])`` as text: a constant may end the properties where
+        ``constant`` ('<kind> reference of <property> <constant>') and those after a kind."""
         parts = []
+        allow = constant
         while True:
-            if self.take("current"):
-                parts.append("current " + self.kind())
-            else:
-                k = self.kind(False)
-                if k is None or self.tok()[0] == WORD and self.tok()[1] not in RESERVED:
-                    t = self.object_type()
-                    start = self.i
-                    n = self.name("a property or an object")
-                    nt = self.tok()
-                    opens = _opens_constant(nt, self.tok(1))
-                    if constant and nt[0] != EOF and nt[1] not in _TYPE_ENDS and not opens:
-                        n = self.property_constant(start, n)
-                    parts.append((t + " " if t else "") + n)
-                else:
-                    parts.append(k)
-                t = self.tok()
-                if constant and _opens_constant(t, self.tok(1)):
+            save = self.i
+            current = self.take("current")
+            k = self.kind(False)
+            if k is not None and (current or not self._name_here()):
+                parts.append(("current " if current else "") + k)
+                allow = True
+            else:  # a property or an object: 'current', a kind, are words of its name here
+                self.i = save
+                t = self.object_type()
+                start = self.i
+                n = self.name("a property or an object")
+                nt = self.tok()
+                opens = _opens_constant(nt, self.tok(1))
+                if allow and nt[0] != EOF and nt[1] not in _TYPE_ENDS and not opens:
+                    n = self.property_constant(start, n)
+                parts.append((t + " " if t else "") + n)
+                if allow and _opens_constant(self.tok(), self.tok(1)):
                     parts[-1] += " " + str(self.constant()[2])
+                    return " of ".join(parts)  # a constant ends it
             if not self.take("of"):
                 return " of ".join(parts)
+
+    def _name_here(self):
+        t = self.tok()
+        return t[0] == WORD and t[1] not in RESERVED
 
     def property_constant(self, start, n):
         """'mode 2 V.s': the property mode and the constant 2 V.s when the constant reaches

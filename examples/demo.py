@@ -28,6 +28,11 @@ SECTIONS = (
         "spacelink_demo",
         "run",
     ),
+    (
+        "Operations across passes: orbit, store-and-forward, files across passes",
+        "passes_demo",
+        "run",
+    ),
 )
 
 

@@ -34,6 +34,7 @@ COMMANDS = {
     "il": "interaction layer: serve and use components",
     "pus": "PUS-C: the standard's message types the OBC serves",
     "packet": "decode or encode space packets",
+    "ops": "operations across passes: pass prediction, pass plans",
 }
 ANYWHERE = ("--json", "--debug")  # flags accepted at any position before "--"
 USAGE_ERROR = 2

@@ -67,6 +67,7 @@ _CORE_MODULES = (
     "obsw/__init__.py",
     "obsw/compat.py",
     "obsw/crc.py",
+    "obsw/errors.py",
     "obsw/spp.py",
     "obsw/utc.py",
     "obsw/timecode.py",

@@ -112,5 +112,29 @@ class TestStream(unittest.TestCase):
         self.assertEqual(dec.aborted, 1)
 
 
+class TestCltuBoundaries(unittest.TestCase):
+    def test_the_shortest_cltu_exactly(self):
+        # start sequence 2 + one codeblock 8 + tail sequence 8 = 18 octets at least
+        shortest = cltu.encode(b"\x01\x02\x03")
+        self.assertEqual(len(shortest), 18)
+        self.assertEqual(cltu.decode(shortest)[0][:3], b"\x01\x02\x03")
+        with self.assertRaises(CltuError):
+            cltu.decode(shortest[:17])
+
+    def test_a_start_then_a_tail_is_an_aborted_cltu(self):
+        d = cltu.CltuDecoder()
+        self.assertEqual(d.feed(cltu.START_SEQUENCE + cltu.TAIL_SEQUENCE), [])
+        self.assertEqual((d.cltus, d.aborted), (0, 1))
+
+    def test_a_start_sequence_split_across_feeds(self):
+        # the stream's last octet may be the first of a start sequence: it waits for the next
+        whole = cltu.encode(b"\x0a\x0b")
+        d = cltu.CltuDecoder()
+        self.assertEqual(d.feed(b"\x00\x00" + whole[:1]), [])
+        self.assertEqual(d.skipped, 2)
+        self.assertEqual([x[:2] for x in d.feed(whole[1:])], [b"\x0a\x0b"])
+        self.assertEqual((d.skipped, d.cltus), (2, 1))
+
+
 if __name__ == "__main__":
     unittest.main()

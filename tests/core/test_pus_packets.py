@@ -168,6 +168,20 @@ class TestDecodeErrors(unittest.TestCase):
             PusTc.unpack(raw)
         self.assertEqual((cm.exception.expected, cm.exception.got), (13, 10))
 
+    def test_the_shortest_tc_exactly(self):
+        # PUS-C TC: primary header 6 + secondary header 5 + PEC 2 = 13 octets at least; a
+        # 12-octet TC with a good checksum is refused (its source ID would be read from the
+        # checksum), on every decode path (accelerated, fast, careful)
+        short = _sealed("1873 c019 0005 2f 11 01 00")
+        self.assertEqual(len(short), 12)
+        for unpack in (PusTc.unpack, lambda b: PusTc._decode(b, 0, DEFAULT, True)[0]):
+            with self.assertRaises(PusLengthError) as cm:
+                unpack(short)
+            self.assertEqual((cm.exception.expected, cm.exception.got), (13, 12))
+            self.assertEqual(failure_code(cm.exception), messages.FAILURE_INVALID_LENGTH)
+            tc = unpack(TC_17_1)
+            self.assertEqual((len(TC_17_1), tc.service, tc.subtype, tc.source_id), (13, 17, 1, 0))
+
     def test_pus_version(self):
         raw = _sealed("1873 c019 0006 1f 11 01 0000")  # PUS version 1 (PUS-A)
         with self.assertRaises(PusVersionError) as cm:
@@ -342,6 +356,28 @@ class TestMessages(unittest.TestCase):
         codes = [getattr(messages, n) for n in dir(messages) if n.startswith("FAILURE_")]
         self.assertEqual(len(set(codes)), len(codes))
         self.assertEqual(messages.FAILURE_INCORRECT_CHECKSUM, 2)
+
+
+class TestRequestIdAndTypeBit(unittest.TestCase):
+    def test_the_fields_of_a_request_id(self):
+        r = RequestId.from_words(0x1873, 0xC019)
+        self.assertEqual((r.version, r.packet_type, r.sec_header_flag, r.apid), (0, 1, 1, 0x73))
+        self.assertEqual((r.seq_flags, r.seq_count), (3, 25))
+        self.assertEqual(RequestId.from_words(0x1073, 0xC019).sec_header_flag, 0)
+
+    def test_equal_only_when_both_words_are(self):
+        r = RequestId.from_words(0x1873, 0xC019)
+        self.assertEqual(r, RequestId.from_words(0x1873, 0xC019))
+        self.assertNotEqual(r, RequestId.from_words(0x1873, 0xC01A))
+        self.assertNotEqual(r, RequestId.from_words(0x1874, 0xC019))
+
+    def test_the_packet_type_bit_alone_chooses_tc_or_tm(self):
+        # APID 0x100 sets the lowest bit of the first octet, next to the type bit
+        tm = PusTm(0x100, 17, 2).pack()
+        self.assertEqual(tm[0] & 0x11, 0x01)
+        got = unpack_packet(tm)
+        self.assertTrue(isinstance(got, PusTm))
+        self.assertEqual((got.apid, got.service, got.subtype), (0x100, 17, 2))
 
 
 if __name__ == "__main__":

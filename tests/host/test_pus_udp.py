@@ -33,10 +33,14 @@ def system(tmp_path):
     onboard.stop()
 
 
-def test_port_convention():
+def test_port_convention(monkeypatch):
     sdb = load_sdb(SDB_PATH)
+    monkeypatch.delenv("OBSW_PORT_BASE", raising=False)  # the default base
     assert app_port(sdb.apid("pus")) == 5000 + sdb.apid("pus")
     assert Onboard(sdb).port == 5000 + sdb.apid("pus")
+    monkeypatch.setenv("OBSW_PORT_BASE", "23000")  # a base of this run's own
+    assert app_port(sdb.apid("pus")) == 23000 + sdb.apid("pus")
+    assert Onboard(sdb).port == 23000 + sdb.apid("pus")
 
 
 def test_ping_and_its_reports(system):

@@ -300,11 +300,6 @@ def codec_rates(n):
     return rows
 
 
-def median_of(fn, runs):
-    results = [fn() for _ in range(runs)]
-    return statistics.median(results)
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="1 MiB only, fewer runs")

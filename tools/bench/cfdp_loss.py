@@ -24,27 +24,14 @@ import sys
 import tempfile
 import time
 
+from measure import child_env, free_port  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
 MIB = 1 << 20
 SEGMENT = 1024
 GOAL = 1.5
-
-
-def _env():
-    path = os.pathsep.join([os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")])
-    return dict(os.environ, PYTHONPATH=path)
-
-
-def _free_port():
-    import socket
-
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def transfer(work, run, data, loss):
@@ -56,13 +43,13 @@ def transfer(work, run, data, loss):
     tx_root = os.path.join(work, "tx%d" % run)
     os.makedirs(rx_root)
     os.makedirs(tx_root)
-    rx_port, tx_port = _free_port(), _free_port()
+    rx_port, tx_port = free_port(), free_port()
     proc = subprocess.Popen(
         [sys.executable, "-m", "obsw_host.cfdp", "serve", "--id", "2", "--root", rx_root,
          "--port", str(rx_port), "--peer", "1=127.0.0.1:%d" % tx_port,
          "--mission", MISSION_DIR],
         stdout=subprocess.PIPE, text=True,
-        env=dict(_env(), OBSW_STATE=os.path.join(work, "state-rx%d" % run)),
+        env=dict(child_env(), OBSW_STATE=os.path.join(work, "state-rx%d" % run)),
     )  # fmt: skip
     try:
         line = proc.stdout.readline()

@@ -34,6 +34,8 @@ import sys
 import tempfile
 import time
 
+from measure import child_env, free_port, stop  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
@@ -43,31 +45,6 @@ TIMER = 1.0
 RCVBUF = 1 << 22
 PEER = "cfdp-py"
 MISSION_DIR = os.path.join(ROOT, "examples", "sample")  # the entity `obsw cfdp serve` runs
-
-
-def _env():
-    path = os.pathsep.join([os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")])
-    return dict(os.environ, PYTHONPATH=path)
-
-
-def _free_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
-def _stop(proc):
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(10)
-    if proc.stdout is not None:
-        proc.stdout.close()
 
 
 # --- obsw ------------------------------------------------------------------------------------
@@ -80,7 +57,7 @@ class Obsw:
         self.tx_root = os.path.join(work, "obsw-tx")
         os.makedirs(self.rx_root)
         os.makedirs(self.tx_root)
-        self.rx_port, self.tx_port = _free_port(), _free_port()
+        self.rx_port, self.tx_port = free_port(), free_port()
         self.proc = subprocess.Popen(
             [
                 sys.executable,
@@ -99,7 +76,7 @@ class Obsw:
                 "1=127.0.0.1:%d" % self.tx_port,
             ],
             stdout=subprocess.PIPE,
-            env=dict(_env(), OBSW_STATE=os.path.join(work, "obsw-state-rx")),
+            env=dict(child_env(), OBSW_STATE=os.path.join(work, "obsw-state-rx")),
             text=True,
         )
         line = self.proc.stdout.readline()  # the entity says it is listening
@@ -132,7 +109,7 @@ class Obsw:
         return dt, result.delivered and _same(os.path.join(self.rx_root, name), data)
 
     def close(self):
-        _stop(self.proc)
+        stop(self.proc)
 
 
 def _same(path, data):
@@ -233,7 +210,7 @@ class Peer:
         self.tx_root = os.path.join(work, "peer-tx")
         os.makedirs(self.rx_root)
         os.makedirs(self.tx_root)
-        self.rx_port, self.tx_port = _free_port(), _free_port()
+        self.rx_port, self.tx_port = free_port(), free_port()
         self.proc = subprocess.Popen(
             [
                 sys.executable,
@@ -243,7 +220,7 @@ class Peer:
                 str(self.tx_port),
             ],
             stdout=subprocess.PIPE,
-            env=_env(),
+            env=child_env(),
             text=True,
         )
         line = self.proc.stdout.readline()
@@ -310,7 +287,7 @@ class Peer:
         return dt, user.done and _same(dst_path, data)
 
     def close(self):
-        _stop(self.proc)
+        stop(self.proc)
 
 
 # --- main ------------------------------------------------------------------------------------

@@ -27,6 +27,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
+from measure import row  # noqa: E402
 from obsw_sim.chain import SWITCH, Chain  # noqa: E402
 
 
@@ -144,13 +145,7 @@ HOPS = (
 
 
 def _row(case, impl, seconds):
-    return {
-        "case": case,
-        "impl": impl,
-        "value": round(seconds * 1000, 3),
-        "unit": "ms",
-        "higher_is_better": False,
-    }
+    return row(case, impl, round(seconds * 1000, 3), "ms", False)
 
 
 def main(argv=None):

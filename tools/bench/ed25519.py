@@ -21,7 +21,6 @@ import json
 import pathlib
 import statistics
 import sys
-import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT / "micropython")]
@@ -30,6 +29,7 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import (  # noqa: E402
     Ed25519PrivateKey,
     Ed25519PublicKey,
 )
+from measure import rate  # noqa: E402
 from obsw.update import ed25519  # noqa: E402
 from obsw_host import firmware  # noqa: E402
 
@@ -99,23 +99,6 @@ def on_board(key, sig, quick):
             counts = [instructions(int(t)) for t in parts[4:]]
             return parts[1] == "True", int(parts[2]), int(parts[3]), counts
     raise SystemExit("the board's verify failed (exit %d):\n%s" % (rc, text))
-
-
-def rate(fn, seconds, repeats):
-    """Median calls per second of ``fn`` over ``repeats`` runs of about ``seconds`` each."""
-    fn()
-    results = []
-    for _ in range(repeats):
-        n = 0
-        t0 = time.perf_counter()
-        while True:
-            fn()
-            n += 1
-            dt = time.perf_counter() - t0
-            if dt >= seconds:
-                break
-        results.append(n / dt)
-    return statistics.median(results)
 
 
 def main(argv=None):

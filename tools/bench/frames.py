@@ -9,35 +9,17 @@ Peers measured in the same run where one exists: spacepackets (TM frame decode) 
 import argparse
 import json
 import pathlib
-import statistics
 import sys
-import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT / "micropython"), str(ROOT / "host")]
 
+from measure import rate  # noqa: E402
 from obsw.frames import asm, cltu, farm, sdls, tc, tm, tm_demux, tm_mux  # noqa: E402
 from obsw.frames import fop as F  # noqa: E402
 
 TC_LEN = 1024
 TM_LEN = 1115
-
-
-def rate(fn, seconds, repeats):
-    """Median calls per second of ``fn`` over ``repeats`` runs of about ``seconds`` each."""
-    fn()
-    results = []
-    for _ in range(repeats):
-        n = 0
-        t0 = time.perf_counter()
-        while True:
-            fn()
-            n += 1
-            dt = time.perf_counter() - t0
-            if dt >= seconds:
-                break
-        results.append(n / dt)
-    return statistics.median(results)
 
 
 def cases():

@@ -27,6 +27,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
+from measure import stop  # noqa: E402
 from obsw.il.interface import DATA, Attribute, Event, Interface, Operation  # noqa: E402
 
 BENCH = Interface(
@@ -71,15 +72,6 @@ def _child(*args):
         env=_env(),
         stdin=subprocess.DEVNULL,
     )
-
-
-def _stop(proc):
-    proc.terminate()
-    try:
-        proc.wait(10)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait(10)
 
 
 # ------------------------------------------------------------------------------ children
@@ -224,7 +216,7 @@ class ObswRemote:
 
     def close(self):
         self.transport.close()
-        _stop(self.proc)
+        stop(self.proc)
         shutil.rmtree(self.dir, ignore_errors=True)
 
 

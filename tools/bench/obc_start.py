@@ -36,6 +36,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
+from measure import row  # noqa: E402
 from obsw.pus.tc import PusTc  # noqa: E402
 from obsw.pus.tm import PusTm  # noqa: E402
 from obsw_host.il.processes import python_path  # noqa: E402
@@ -189,9 +190,7 @@ def main(argv=None):
 
 
 def _row(case, impl, value, **extra):
-    row = {"case": case, "impl": impl, "value": value, "unit": "s", "higher_is_better": False}
-    row.update(extra)
-    return row
+    return row(case, impl, value, "s", False, **extra)
 
 
 def _ping_note(ratio):

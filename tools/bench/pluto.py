@@ -9,13 +9,13 @@ describes, and tokenizing the text with str.split), to show the interpreter's ov
 import argparse
 import json
 import pathlib
-import statistics
 import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
 sys.path.insert(0, str(ROOT / "micropython"))
 
+from measure import median_of  # noqa: E402
 from obsw.pluto.interp import Procedure, load  # noqa: E402
 from obsw.pluto.system import SimulatedSystem  # noqa: E402
 
@@ -75,13 +75,6 @@ end procedure
 """
 
 
-def median_of(runs, fn):
-    out = []
-    for _ in range(runs):
-        out.append(fn())
-    return statistics.median(out)
-
-
 def bench_parse(src):
     t0 = time.perf_counter()
     load(src)
@@ -124,10 +117,10 @@ def main(argv=None):
     a = ap.parse_args(argv)
     runs, n = (5, 20000) if a.quick else (11, 200000)
     src = procedure_200_lines()
-    parse_s = median_of(runs, lambda: bench_parse(src))
-    ref_parse_s = median_of(runs, lambda: bench_parse_reference(src))
-    sps = median_of(runs, lambda: bench_run(n))
-    ref_sps = median_of(runs, lambda: bench_run_reference(n))
+    parse_s = median_of(lambda: bench_parse(src), runs)
+    ref_parse_s = median_of(lambda: bench_parse_reference(src), runs)
+    sps = median_of(lambda: bench_run(n), runs)
+    ref_sps = median_of(lambda: bench_run_reference(n), runs)
     rows = [
         {"case": "parse+check 200-line procedure", "impl": "obsw", "value": parse_s * 1000,
          "unit": "ms", "higher_is_better": False},

@@ -22,6 +22,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
+from measure import batch_size  # noqa: E402
 from obsw.crc import crc16_ccitt_update  # noqa: E402
 from obsw.pus.tc import PusTc  # noqa: E402
 from obsw.pus.tm import PusTm  # noqa: E402
@@ -246,26 +247,13 @@ IMPLS = (
 )
 
 
-def batch_size(run, seconds):
-    """Round trips that take roughly ``seconds``."""
-    n = 100
-    while True:
-        t0 = time.perf_counter()
-        run(n)
-        dt = time.perf_counter() - t0
-        if dt >= seconds / 4 or n >= 1 << 22:
-            break
-        n *= 4
-    return max(1, int(n * seconds / dt))
-
-
 def measure(runs, seconds, repeats):
     """Median round trips per second of each run, the timed batches interleaved.
 
     On a shared machine the load drifts; timing one batch of every implementation per repeat
     gives each the same conditions, so the ratios stay honest even when the absolute figures
     move."""
-    sizes = [batch_size(run, seconds) for run in runs]
+    sizes = [batch_size(run, seconds, start=100) for run in runs]
     rates = [[] for _ in runs]
     for _ in range(repeats):
         for run, n, out in zip(runs, sizes, rates):

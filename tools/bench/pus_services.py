@@ -20,6 +20,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
+from measure import batch_size  # noqa: E402
 from obsw.il.clock import SimClock  # noqa: E402
 from obsw.pus.app import ApplicationProcess  # noqa: E402
 from obsw.pus.fields import field  # noqa: E402
@@ -104,21 +105,9 @@ def puslib_server(raw):
 IMPLS = (("obsw", obsw_server), ("puslib", puslib_server))
 
 
-def batch_size(run, seconds):
-    n = 10
-    while True:
-        t0 = time.perf_counter()
-        run(n)
-        dt = time.perf_counter() - t0
-        if dt >= seconds / 4 or n >= 1 << 20:
-            break
-        n *= 4
-    return max(1, int(n * seconds / dt))
-
-
 def measure(runs, seconds, repeats):
     """Median requests per second of each run, the timed batches interleaved."""
-    sizes = [batch_size(run, seconds) for run in runs]
+    sizes = [batch_size(run, seconds, most=1 << 20) for run in runs]
     rates = [[] for _ in runs]
     for _ in range(repeats):
         for run, n, out in zip(runs, sizes, rates):

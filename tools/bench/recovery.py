@@ -25,6 +25,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
+from measure import row  # noqa: E402
 from obsw_sim.reconfig import ReconfigSim  # noqa: E402
 
 BOOT = 5.0  # s of simulated OBC boot (the OBC process sleeps this long before its first word)
@@ -113,8 +114,7 @@ _BUDGETS = {
 
 
 def _row(case, impl, value):
-    return {"case": case, "impl": impl, "value": round(value, 3), "unit": "s",
-            "higher_is_better": False}  # fmt: skip
+    return row(case, impl, round(value, 3), "s", False)
 
 
 if __name__ == "__main__":

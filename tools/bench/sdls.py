@@ -10,37 +10,19 @@ the boards take (there over cryptolib), against the same peer.
 import argparse
 import json
 import pathlib
-import statistics
 import sys
-import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT / "micropython"), str(ROOT / "host")]
 
 from cryptography.hazmat.primitives.ciphers.aead import AESGCM  # noqa: E402
+from measure import rate  # noqa: E402
 from obsw.frames import sdls, tc  # noqa: E402
 from obsw.frames.sdls_gcm import GcmSecurityAssociation, TmSecurity  # noqa: E402
 
 KEY = bytes(range(32))
 SCID = 0x2A
 TM_FIELD = 1115 - 6 - 4 - 2  # data field of the TM frame the frames benchmark uses
-
-
-def rate(fn, seconds, repeats):
-    """Median calls per second of ``fn`` over ``repeats`` runs of about ``seconds`` each."""
-    fn()
-    results = []
-    for _ in range(repeats):
-        n = 0
-        t0 = time.perf_counter()
-        while True:
-            fn()
-            n += 1
-            dt = time.perf_counter() - t0
-            if dt >= seconds:
-                break
-        results.append(n / dt)
-    return statistics.median(results)
 
 
 def _pure(sa):

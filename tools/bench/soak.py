@@ -40,6 +40,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
+from measure import row  # noqa: E402
 from obsw_host.il.processes import python_path  # noqa: E402
 from obsw_host.obc import memtrace  # noqa: E402
 from obsw_host.sample import MISSION_DIR  # noqa: E402
@@ -434,13 +435,7 @@ def main(argv=None):
 
 
 def _row(case, impl, value):
-    return {
-        "case": case,
-        "impl": impl,
-        "value": None if value is None else round(value, 1),
-        "unit": "kB per hour",
-        "higher_is_better": False,
-    }
+    return row(case, impl, None if value is None else round(value, 1), "kB per hour", False)
 
 
 if __name__ == "__main__":

@@ -7,9 +7,9 @@ responder failover after heartbeat loss, against the configured (max_miss + 1) *
 """
 
 import argparse
+import importlib.util
 import json
 import pathlib
-import statistics
 import sys
 import threading
 import time
@@ -21,6 +21,9 @@ ROOT = HERE.parents[1]
 # finds LibreCube's spacecan
 sys.path[:] = [p for p in sys.path if pathlib.Path(p or ".").resolve() != HERE]
 sys.path[:0] = [str(ROOT / "micropython"), str(ROOT / "host")]
+_spec = importlib.util.spec_from_file_location("bench_measure", HERE / "measure.py")
+measure = importlib.util.module_from_spec(_spec)  # this folder's shared helper, by its file
+_spec.loader.exec_module(measure)
 
 from obsw.spacecan.controller import Controller  # noqa: E402
 from obsw.spacecan.fragment import Reassembler, split  # noqa: E402
@@ -222,10 +225,6 @@ def theirs_failover(period, max_miss, commanded=False):
     return times["switch"] - t
 
 
-def median_of(fn, runs):
-    return statistics.median(fn() for _ in range(runs))
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true")
@@ -255,20 +254,20 @@ def main(argv=None):
                 }
             )
 
-    m = median_of(lambda: timed(ours_fragment, n), runs)
-    t = median_of(lambda: timed(theirs_fragment, n), runs) if peer else None
+    m = measure.median_of(lambda: timed(ours_fragment, n), runs)
+    t = measure.median_of(lambda: timed(theirs_fragment, n), runs) if peer else None
     pair("fragment+reassemble 64 B", "packets/s", m, t)
-    m = median_of(lambda: timed(ours_responder, n) * 4, runs)
-    t = median_of(lambda: timed(theirs_responder, n // 4) * 4, runs) if peer else None
+    m = measure.median_of(lambda: timed(ours_responder, n) * 4, runs)
+    t = measure.median_of(lambda: timed(theirs_responder, n // 4) * 4, runs) if peer else None
     pair("responder ping frames (1 in, 3 out)", "frames/s", m, t)
-    m = median_of(lambda: timed(ours_round_trips, n), runs)
-    t = median_of(lambda: timed(theirs_round_trips, n // 10), runs) if peer else None
+    m = measure.median_of(lambda: timed(ours_round_trips, n), runs)
+    t = measure.median_of(lambda: timed(theirs_round_trips, n // 10), runs) if peer else None
     pair("controller ping round trips", "round trips/s", m, t)
     period, max_miss = 0.05, 3
     deadline = period * (max_miss + 1)
     fr = 3 if a.quick else 5
-    m = median_of(lambda: ours_failover(period, max_miss), fr)
-    t = median_of(lambda: theirs_failover(period, max_miss), fr) if peer else None
+    m = measure.median_of(lambda: ours_failover(period, max_miss), fr)
+    t = measure.median_of(lambda: theirs_failover(period, max_miss), fr) if peer else None
     pair(
         "failover after heartbeat loss / configured deadline",
         "ratio",
@@ -285,8 +284,8 @@ def main(argv=None):
             "higher_is_better": False,
         }
     )
-    m = median_of(lambda: ours_failover(period, max_miss, True), fr)
-    t = median_of(lambda: theirs_failover(period, max_miss, True), fr) if peer else None
+    m = measure.median_of(lambda: ours_failover(period, max_miss, True), fr)
+    t = measure.median_of(lambda: theirs_failover(period, max_miss, True), fr) if peer else None
     pair(
         "responder follows commanded switch / configured deadline",
         "ratio",

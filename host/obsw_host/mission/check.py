@@ -116,6 +116,7 @@ class _Checker:
         self._components(doc)
         self._processes(doc)
         self._paths(doc)
+        self._orbit_and_stations(doc)
         return doc
 
     def _components(self, doc):
@@ -196,6 +197,35 @@ class _Checker:
         frames = doc.get("frames") if isinstance(doc.get("frames"), dict) else {}
         self._exists(frames.get("keys"), ["frames", "keys"], "a key file of obsw frames keygen")
         self._link(frames)
+
+    def _orbit_and_stations(self, doc):
+        """The orbit's TLE (checksums, elements SGP4 accepts) agrees with its stated epoch;
+        station names are unique."""
+        from obsw_host.ops.tle import TleError, format_time, parse, parse_time
+
+        orbit = doc.get("orbit")
+        if isinstance(orbit, dict) and not any(
+            p.path.startswith("$.orbit") for p in self.problems
+        ):
+            try:
+                tle = parse(orbit["tle"], orbit.get("name"))
+                stated = parse_time(orbit["epoch"])
+            except TleError as e:
+                self.add(self.file, ["orbit"], str(e))
+            else:
+                if abs((tle.epoch - stated).total_seconds()) > 0.001:
+                    self.add(self.file, ["orbit", "epoch"], "%s; expected the TLE's epoch %s"
+                             % (orbit["epoch"], format_time(tle.epoch)))  # fmt: skip
+        seen = set()
+        for i, st in _dicts(doc.get("stations")):
+            name = st.get("name")
+            if isinstance(name, str) and name in seen:
+                self.add(self.file, ["stations", i, "name"], "station %s named twice; expected "
+                         "one entry per station" % short(name))  # fmt: skip
+            seen.add(name)
+        if "stations" in doc and "orbit" not in doc:
+            self.add(self.file, ["stations"], "stations without an orbit; expected orbit.tle "
+                     "and orbit.epoch to predict their passes")  # fmt: skip
 
     def _link(self, frames):
         """The TM coding with the frame length: what the coder itself accepts."""

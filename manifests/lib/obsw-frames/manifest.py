@@ -15,6 +15,7 @@ package(
         "bch.py",
         "clcw.py",
         "cltu.py",
+        "contact.py",
         "conv.py",
         "dedup.py",
         "downlink.py",

@@ -70,3 +70,113 @@ class Spill:
                 packet = q.popleft()
                 channel.push(packet)
                 self.octets -= len(packet)
+
+
+class StoreForward:
+    """Store-and-forward across passes: what the radio sends, when, and from which store.
+
+    Every TM is kept in a packet store (``obsw.pus.services.packet_store``); ``stores`` lists
+    them by priority, highest first. Out of contact nothing leaves. In contact ``next(now)``
+    gives the next ``(store, seq, raw)`` to send: first the packets the ground asked for again
+    (``resend``: gaps it saw in the storage sequence numbers), then each store's packets in
+    sequence, in priority order, so real-time TM is the dump caught up with the present. A
+    packet leaves only when it fits in what the pass can still carry (``budget`` octets, from
+    the pass table's time left at ``bps``), so a dump is never cut at LOS: what does not fit
+    waits for the next pass. The forwarder's pointer (``next_seq``, apart from the stores'
+    ST[15] open retrieval, which stays the operator's) never goes back, and the ground's
+    acknowledgement (``acknowledge``) deletes what it has, so nothing is sent twice and
+    nothing is dropped while the stores have room.
+    """
+
+    def __init__(self, stores, contact, bps):
+        self.stores = list(stores)
+        self.contact = contact
+        self.bps = bps
+        self.sent = 0  # packets
+        self.sent_octets = 0
+        self.resent = 0
+        self.held = 0  # packets that waited for the next pass (did not fit in this one)
+        self._resend = deque((), 64)  # (store, seq)
+        # the next storage sequence number to send, per store: the forwarder's own pointer
+        # (the stores' ST[15] open retrieval stays the operator's, apart from it)
+        self.next_seq = {}
+        for st in self.stores:
+            self.next_seq[st.id] = 1
+
+    def store(self, sid):
+        for st in self.stores:
+            if st.id == sid:
+                return st
+        raise KeyError("no packet store %d" % sid)
+
+    def budget(self, now):
+        """Octets the radio can still send in this contact (its time left at the rate)."""
+        return self.contact.left(now) * self.bps / 8
+
+    def resend(self, sid, first, last):
+        """The ground lacks storage sequence numbers ``first`` to ``last`` of store ``sid``;
+        False when its queue is full (it asks again)."""
+        st = self.store(sid)
+        q = self._resend
+        for seq, _t, _raw in st.packets:
+            if first <= seq <= last:
+                if len(q) >= 64:
+                    return False
+                q.append((st, seq))
+        return True
+
+    def acknowledge(self, sid, seq):
+        """The ground has everything of store ``sid`` up to ``seq``: the room is free again."""
+        return self.store(sid).delete_through(seq)
+
+    def next(self, now, budget=None):
+        """The next ``(store, seq, raw)`` to send now, or None (out of contact, nothing to
+        send, or the next packet does not fit in ``budget`` octets: default ``budget(now)``)."""
+        if not self.contact.contact(now):
+            return None
+        room = self.budget(now) if budget is None else budget
+        while self._resend:
+            st, seq = self._resend[0]
+            raw = _find(st, seq)
+            if raw is None:  # deleted since: acknowledged meanwhile
+                self._resend.popleft()
+                continue
+            if len(raw) > room:
+                self.held += 1
+                return None
+            self._resend.popleft()
+            self.resent += 1
+            return self._out(st, seq, raw)
+        for st in self.stores:
+            first = self.next_seq[st.id]
+            for seq, _t, raw in st.packets:
+                if seq < first:
+                    continue
+                if len(raw) > room:
+                    self.held += 1
+                    return None  # the highest priority first: lower ones wait behind it
+                self.next_seq[st.id] = seq + 1
+                return self._out(st, seq, raw)
+        return None
+
+    def _out(self, st, seq, raw):
+        self.sent += 1
+        self.sent_octets += len(raw)
+        return st, seq, raw
+
+    def backlog(self):
+        """Octets stored and not yet sent, over all stores."""
+        n = 0
+        for st in self.stores:
+            first = self.next_seq[st.id]
+            for seq, _t, raw in st.packets:
+                if seq >= first:
+                    n += len(raw)
+        return n
+
+
+def _find(st, seq):
+    for s, _t, raw in st.packets:
+        if s == seq:
+            return raw
+    return None

@@ -114,6 +114,16 @@ class PacketStore:
             self.rewrite()
         return n
 
+    def delete_through(self, seq):
+        """Drop every packet up to storage sequence number ``seq`` (the ground has them)."""
+        keep = [p for p in self.packets if p[0] > seq]
+        n = len(self.packets) - len(keep)
+        if n:
+            self.packets = keep
+            self.used = sum(len(p[2]) for p in keep)
+            self.rewrite()
+        return n
+
     def clear(self):
         self.packets = []
         self.used = 0

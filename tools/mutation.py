@@ -1,0 +1,261 @@
+#!/usr/bin/env python3
+"""Mutation testing of the safety-critical core with cosmic-ray (PyPI): small realistic faults
+put into a module one at a time, the module's tests run against each; a mutant the tests do not
+notice (it survives) marks a behaviour nothing pins.
+
+    python tools/mutation.py [MODULE...] [--sample N] [--seed S] [--jobs J] [--write]
+
+MODULE is a name of TARGETS (default: all). The mutants are those a programmer makes: a
+comparison turned into its neighbour (< and <=, == and !=, in and not in), a constant off by
+one, + and - swapped, a condition negated, True and False swapped, and and or swapped, a loop
+that never runs, a break that continues, an except clause that catches something else. Each
+module is mutated in a copy of the tree of its own (cosmic-ray writes the mutant into the file),
+its tests run on CPython with pytest; a mutant that makes them fail or hang is killed.
+
+`--sample N` takes N mutants of each module, chosen by `--seed` (the `mutation` stage of
+tools/test runs a sample); the whole run (every mutant of every module: hours on two cores) is a
+job run by hand, `--write` then writes docs/mutation.md. Survivors that cannot be killed (the
+mutant does what the original does) are listed in EQUIVALENT with the reason. The last line is
+`N passed, N failed`: a module passes with at least GOAL of its mutants killed and every
+survivor explained.
+"""
+
+import argparse
+import concurrent.futures
+import json
+import os
+import random
+import shutil
+import sqlite3
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
+GOAL = 0.90  # of the mutants of each module killed
+TIMEOUT = 60.0  # seconds a mutant's tests may take (a hang kills it)
+
+# module -> the test files that pin it (tests/core: they also run on the unix port)
+TARGETS = {
+    "pus/packets.py": ["test_pus_packets.py", "test_errors.py"],
+    "pus/tc.py": ["test_pus_packets.py", "test_pus_random_requests.py"],
+    "frames/farm.py": ["test_frames_farm.py"],
+    "frames/fop.py": ["test_frames_fop.py"],
+    "frames/sdls.py": ["test_frames_sdls.py"],
+    "frames/cltu.py": ["test_frames_cltu.py"],
+    "frames/rs.py": ["test_frames_rs.py"],
+    "cfdp/receiver.py": [
+        "test_cfdp_class2.py",
+        "test_cfdp_faults.py",
+        "test_cfdp_nak_boundaries.py",
+    ],  # fmt: skip
+    "cfdp/sender.py": ["test_cfdp_class1.py", "test_cfdp_class2.py", "test_cfdp_faults.py"],
+    "pluto/evaluate.py": ["test_pluto_boundaries.py", "test_pluto_interp.py"],
+    "reconfig/recovery.py": ["test_reconfig_recovery.py"],
+    "update/package.py": ["test_update_package.py"],
+}
+
+# the kinds of mutant kept (cosmic-ray operator names, without "core/")
+OPERATORS = {
+    "ReplaceComparisonOperator_Lt_LtE", "ReplaceComparisonOperator_LtE_Lt",
+    "ReplaceComparisonOperator_Gt_GtE", "ReplaceComparisonOperator_GtE_Gt",
+    "ReplaceComparisonOperator_Eq_NotEq", "ReplaceComparisonOperator_NotEq_Eq",
+    "ReplaceComparisonOperator_In_NotIn", "ReplaceComparisonOperator_NotIn_In",
+    "ReplaceComparisonOperator_Is_IsNot", "ReplaceComparisonOperator_IsNot_Is",
+    "NumberReplacer", "ReplaceBinaryOperator_Add_Sub", "ReplaceBinaryOperator_Sub_Add",
+    "AddNot", "ReplaceTrueWithFalse", "ReplaceFalseWithTrue", "ReplaceAndWithOr",
+    "ReplaceOrWithAnd", "ZeroIterationForLoop", "ReplaceBreakWithContinue", "ExceptionReplacer",
+}  # fmt: skip
+
+# (module, line, operator) -> why the mutant cannot be told from the original
+EQUIVALENT = {}
+
+
+def copy_tree(dest):
+    """The files the tests need, copied (cosmic-ray mutates files in place)."""
+    files = subprocess.run(["git", "-C", ROOT, "ls-files", "-z", "micropython", "tests/core",
+                            "tests/conftest.py", "pyproject.toml"],
+                           capture_output=True, check=True).stdout.split(b"\0")  # fmt: skip
+    for f in files:
+        if f:
+            src = os.path.join(ROOT, f.decode())
+            dst = os.path.join(dest, f.decode())
+            os.makedirs(os.path.dirname(dst), exist_ok=True)
+            shutil.copy2(src, dst)
+
+
+def cosmic(args, cwd):
+    tool = os.path.join(os.path.dirname(sys.executable), "cosmic-ray")
+    return subprocess.run([tool] + args, cwd=cwd, capture_output=True, text=True)
+
+
+def run_module(module, sample, seed):
+    """Mutate ``module``: {'module', 'total', 'killed', 'survived': [...], 'seconds'}."""
+    t0 = time.monotonic()
+    with tempfile.TemporaryDirectory(prefix="obsw-mutation-") as work:
+        copy_tree(work)
+        tests = " ".join(os.path.join("tests", "core", t) for t in TARGETS[module])
+        config = os.path.join(work, "cr.toml")
+        with open(config, "w") as f:
+            f.write(
+                '[cosmic-ray]\nmodule-path = "micropython/obsw/%s"\ntimeout = %s\n'
+                "excluded-modules = []\n"
+                'test-command = "%s -m pytest -x -q -p no:cacheprovider %s"\n'
+                '[cosmic-ray.distributor]\nname = "local"\n'
+                % (module, TIMEOUT, sys.executable, tests)
+            )
+        session = os.path.join(work, "session.sqlite")
+        r = cosmic(["init", config, session], work)
+        if r.returncode:
+            raise RuntimeError("cosmic-ray init: %s" % r.stderr.strip()[-500:])
+        kept = choose(session, sample, seed)
+        r = cosmic(["exec", config, session], work)
+        if r.returncode:
+            raise RuntimeError("cosmic-ray exec: %s" % r.stderr.strip()[-500:])
+        return results(session, module, kept, time.monotonic() - t0)
+
+
+def choose(session, sample, seed):
+    """Keep the mutants of OPERATORS (a sample of ``sample`` of them); their count."""
+    db = sqlite3.connect(session)
+    rows = db.execute(
+        "select job_id, operator_name, start_pos_row, start_pos_col, occurrence "
+        "from mutation_specs"
+    ).fetchall()
+    # by place in the file, not by job id (a fresh random id each init): the same seed, the
+    # same sample
+    ordered = sorted((r[2], r[3], r[1], r[4], r[0]) for r in rows)
+    keep = [r[-1] for r in ordered if r[2].split("/", 1)[-1] in OPERATORS]
+    if sample:
+        keep = random.Random(seed).sample(keep, min(sample, len(keep)))
+    keep = set(keep)
+    drop = [(r[0],) for r in rows if r[0] not in keep]
+    db.executemany("delete from mutation_specs where job_id = ?", drop)
+    db.executemany("delete from work_items where job_id = ?", drop)
+    db.commit()
+    db.close()
+    return len(keep)
+
+
+def results(session, module, total, seconds):
+    db = sqlite3.connect(session)
+    rows = db.execute(
+        "select s.operator_name, s.start_pos_row, r.test_outcome, r.worker_outcome, r.diff "
+        "from mutation_specs s join work_results r on s.job_id = r.job_id"
+    ).fetchall()
+    db.close()
+    survived, killed, ran = [], 0, 0
+    for op, line, test, worker, diff in rows:
+        test, worker = (test or "").lower(), (worker or "").lower()  # enum names: "SURVIVED"
+        if worker not in ("normal", "timeout"):  # the mutant could not be made or run
+            raise RuntimeError("line %d %s: cosmic-ray %s" % (line, op, worker))
+        if test == "incompetent":  # not valid Python: no mutant at all
+            continue
+        ran += 1
+        if test == "survived" and worker == "normal":
+            op = op.split("/", 1)[-1]
+            why = EQUIVALENT.get((module, line, op))
+            change = [d for d in (diff or "").splitlines() if d.startswith(("-", "+"))
+                      and not d.startswith(("---", "+++"))]  # fmt: skip
+            survived.append({"line": line, "operator": op, "change": change, "equivalent": why})
+        else:  # the tests failed, or hung (a timeout)
+            killed += 1
+    return {"module": module, "total": total, "killed": killed, "ran": ran,
+            "survived": sorted(survived, key=lambda s: s["line"]), "seconds": seconds}  # fmt: skip
+
+
+def verdict(r):
+    unexplained = [s for s in r["survived"] if not s["equivalent"]]
+    rate = r["killed"] / r["ran"] if r["ran"] else 1.0
+    return rate, rate >= GOAL and not unexplained
+
+
+def page(results_, sample):
+    out = [
+        "# Mutation testing",
+        "",
+        "Written by `tools/mutation.py --write` (cosmic-ray); nothing on this page is typed by",
+        "hand. Each module of the safety-critical core is mutated one realistic fault at a time",
+        "(a comparison turned into its neighbour, a constant off by one, `+` and `-` swapped, a",
+        "condition negated, `True` and `False` or `and` and `or` swapped, a loop that never runs,",
+        "a `break` that continues, an `except` that catches something else) and its tests run",
+        "against each mutant. Goal: at least %d %% of each module's mutants killed, every"
+        % round(GOAL * 100),
+        "survivor killed or explained as equivalent.",
+        "",
+        "Run: %s%s."
+        % (
+            time.strftime("%Y-%m-%d", time.gmtime()),
+            ", a sample of %d mutants per module" % sample if sample else ", every mutant",
+        ),  # fmt: skip
+        "",
+        "| module | mutants | killed | survived | killed % | goal |",
+        "|---|---|---|---|---|---|",
+    ]
+    for r in results_:
+        rate, ok = verdict(r)
+        out.append("| `%s` | %d | %d | %d | %.1f | %s |" % (
+            r["module"], r["ran"], r["killed"], len(r["survived"]), 100 * rate,
+            "met" if ok else "MISSED"))  # fmt: skip
+    for r in results_:
+        if not r["survived"]:
+            continue
+        out += ["", "## Survivors in `micropython/obsw/%s`" % r["module"], ""]
+        for s in r["survived"]:
+            change = "; ".join("`%s`" % c.strip() for c in s["change"][:2])
+            why = " (equivalent: %s)" % s["equivalent"] if s["equivalent"] else ""
+            out.append("- line %d, %s: %s%s" % (s["line"], s["operator"], change, why))
+    return "\n".join(out) + "\n"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("modules", nargs="*", metavar="MODULE", help="of: " + ", ".join(TARGETS))
+    ap.add_argument("--sample", type=int, default=0, help="mutants per module (0: all)")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--jobs", type=int, default=2, help="modules mutated at once")
+    ap.add_argument("--write", action="store_true", help="write docs/mutation.md")
+    ap.add_argument("--json", action="store_true", help="print the results as JSON")
+    args = ap.parse_args(argv)
+    unknown = [m for m in args.modules if m not in TARGETS]
+    if unknown:
+        ap.error("unknown module %s (of: %s)" % (", ".join(unknown), ", ".join(TARGETS)))
+    if not os.path.exists(os.path.join(os.path.dirname(sys.executable), "cosmic-ray")):
+        print("cosmic-ray not installed: pip install cosmic-ray (a dev dependency)")
+        print("0 passed, 1 failed")
+        return 1
+    modules = args.modules or list(TARGETS)
+    done, passed, failed = [], 0, 0
+    with concurrent.futures.ThreadPoolExecutor(max(1, args.jobs)) as pool:
+        futures = {pool.submit(run_module, m, args.sample, args.seed): m for m in modules}
+        for fut in concurrent.futures.as_completed(futures):
+            m = futures[fut]
+            try:
+                r = fut.result()
+            except Exception as e:  # a module that cannot be mutated is a failure, said once
+                failed += 1
+                print("FAIL %-22s %s" % (m, e))
+                continue
+            done.append(r)
+            rate, ok = verdict(r)
+            passed, failed = passed + ok, failed + (not ok)
+            print("%-4s %-22s %4d mutants, %4d killed, %3d survived (%5.1f %%) %6.0f s" % (
+                "ok" if ok else "MISS", m, r["ran"], r["killed"], len(r["survived"]),
+                100 * rate, r["seconds"]))  # fmt: skip
+            for s in r["survived"]:
+                if not s["equivalent"]:
+                    change = " / ".join(c.strip() for c in s["change"])
+                    print("       line %d %s: %s" % (s["line"], s["operator"], change))
+    done.sort(key=lambda r: modules.index(r["module"]))
+    if args.write:
+        with open(os.path.join(ROOT, "docs", "mutation.md"), "w") as f:
+            f.write(page(done, args.sample))
+    if args.json:
+        print(json.dumps(done))
+    print("%d passed, %d failed" % (passed, failed))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,6 +1,7 @@
 """PLUTO constructs of the ECSS-E-ST-70-32C Annex A grammar added to the interpreter (save
-context, status properties), and a procedure written from the grammar that uses every
-production (docs/pluto.md lists the productions and where each is tested)."""
+context, status properties), and a procedure written by hand from the grammar that loads and
+runs (the productions themselves are generated and counted by tests/host/test_pluto_annex_a.py;
+docs/pluto.md shows that run)."""
 
 import json
 import unittest
@@ -84,7 +85,7 @@ class TestSaveContext(unittest.TestCase):
 
     def test_syntax(self):
         for bad in ("save context refer mode of OBC by m;", "save context refer to mode of OBC;",
-                    "save context refer to mode of OBC by m, to x by y;"):  # fmt: skip
+                    "save context refer to mode of OBC by m, x by y;"):  # fmt: skip
             with self.assertRaises(PlutoSyntaxError):
                 parse(step(bad))
         with self.assertRaises(PlutoSyntaxError) as c:

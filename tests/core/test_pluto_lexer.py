@@ -3,7 +3,18 @@
 import unittest
 
 from obsw.pluto import units
-from obsw.pluto.lexer import ABST, NUM, OP, RELT, STR, WORD, PlutoSyntaxError, line_col, tokenize
+from obsw.pluto.lexer import (
+    ABST,
+    DIGITS,
+    NUM,
+    OP,
+    RELT,
+    STR,
+    WORD,
+    PlutoSyntaxError,
+    line_col,
+    tokenize,
+)
 
 
 def kinds(src):
@@ -24,9 +35,13 @@ class TestLexer(unittest.TestCase):
         self.assertEqual(line_col(toks[1][2]), (2, 3))
 
     def test_glued_units_split_from_numbers(self):
-        self.assertEqual(kinds("10s"), [(NUM, 10), (WORD, "s")])
-        self.assertEqual(kinds("1d2h"), [(NUM, 1), (WORD, "d"), (NUM, 2), (WORD, "h")])
-        self.assertEqual(kinds("5eV"), [(NUM, 5), (WORD, "eV")])
+        self.assertEqual(kinds("10s"), [(DIGITS, "10"), (WORD, "s")])
+        self.assertEqual(kinds("1d2h"), [(DIGITS, "1"), (WORD, "d"), (DIGITS, "2"), (WORD, "h")])
+        self.assertEqual(kinds("5eV"), [(DIGITS, "5"), (WORD, "eV")])
+
+    def test_digits_keep_their_text(self):
+        # a run of digits is an integer or a word of a name ("Heater 07"): the parser decides
+        self.assertEqual(kinds("Heater 07 1.5"), [(WORD, "Heater"), (DIGITS, "07"), (NUM, 1.5)])
 
     def test_absolute_and_colon_relative_times(self):
         t = tokenize("2025-01-01T00:01:00.500Z 1:02:03:04:5")

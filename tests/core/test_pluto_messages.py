@@ -5,6 +5,8 @@ import unittest
 
 from obsw.pluto.checker import PlutoTypeError
 from obsw.pluto.interp import Procedure, load
+from obsw.pluto.lexer import PlutoError
+from obsw.pluto.signatures import closest_argument
 from obsw.pluto.system import SimulatedSystem, run_virtual
 
 SPEC = {"parameters": {"speed of Wheel": {"value": 5, "unit": "deg/s"}, "mode of OBC": "SAFE"}}
@@ -96,3 +98,72 @@ class TestAtRunTime(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestNumbersWithoutUnits(unittest.TestCase):
+    """A number without units is dimensionless: against a value with units it is refused at
+    load time (it would silently take that value's units)."""
+
+    SPEC = {"parameters": {"coil_temp of Magnetorquer": {"value": 21, "unit": "degC"},
+                           "count of X": 3}}  # fmt: skip
+
+    def rejected(self, main):
+        try:
+            load(step(main), SimulatedSystem(self.SPEC))
+        except PlutoTypeError as e:
+            return "%d:%d %s" % (e.line, e.col, e.msg)
+        raise AssertionError("accepted " + main)
+
+    def test_parameter_with_units_against_a_bare_number(self):
+        self.assertEqual(
+            self.rejected("wait until coil_temp of Magnetorquer < 1800;"),
+            "5:38 cannot compare coil_temp of Magnetorquer (degC) with 1800: units degC and none"
+            " differ (a number without units is dimensionless)",
+        )
+
+    def test_either_side_and_every_relation(self):
+        for rel in ("1800 > coil_temp of Magnetorquer", "coil_temp of Magnetorquer between 0"
+                    " and 50 degC", "coil_temp of Magnetorquer in (20 degC, 21)",
+                    "count of X = 3 V"):  # fmt: skip
+            self.assertIn(" none", self.rejected("log %s;" % rel))
+
+    def test_with_units_loads(self):
+        load(step("log coil_temp of Magnetorquer < 1800 mdegC, count of X > 2;"),
+             SimulatedSystem(self.SPEC))  # fmt: skip
+
+
+class TestMisspeltArgument(unittest.TestCase):
+    SPEC = {
+        "activities": {
+            "take image of Camera": {
+                "arguments": [
+                    {"name": "Exposure Time", "type": "relative time"},
+                    {"name": "gain", "type": "real"},
+                ]
+            }
+        }
+    }
+
+    def errors(self, args):
+        src = step("initiate and confirm take image of Camera with arguments %s end with;" % args)
+        try:
+            load(src, SimulatedSystem(self.SPEC))
+        except PlutoError as e:
+            return [x.msg for x in e.errors]
+        raise AssertionError("accepted " + args)
+
+    def test_the_wrong_name_with_the_closest_declared(self):
+        self.assertEqual(self.errors("Exposure Tme := 10 ms, gain := 2.0"), [
+            "activity take image of Camera has no argument Exposure Tme; did you mean Exposure"
+            " Time? (takes: Exposure Time, gain)"])  # fmt: skip
+
+    def test_no_guess_when_nothing_is_close(self):
+        self.assertEqual(self.errors("shutter := 10 ms, gain := 2.0"), [
+            "activity take image of Camera has no argument shutter (takes: Exposure Time, gain)",
+            "activity take image of Camera needs argument Exposure Time (takes: Exposure Time,"
+            " gain)"])  # fmt: skip
+
+    def test_closest_ignores_spaces_underscores_and_case(self):
+        self.assertEqual(closest_argument("Exposure_tme", ["gain", "Exposure Time"]),
+                         "Exposure Time")  # fmt: skip
+        self.assertIsNone(closest_argument("mode", ["limit"]))

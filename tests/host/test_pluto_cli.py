@@ -85,3 +85,48 @@ def test_run_argument_with_units(tmp_path, capsys):
     ns.arg = ['limit={"value": 1, "unit": "parsec"}']
     with pytest.raises(UserError):
         cmd.run_cmd(ns)
+
+
+def check_args(tmp_path, text, **options):
+    f = tmp_path / "p.plt"
+    f.write_text(text)
+    ns = argparse.Namespace(file=str(f), sdb=None, system=None, mission=None, syntax_only=False)
+    for k, v in options.items():
+        setattr(ns, k, v)
+    return cmd.check_cmd(ns)
+
+
+def test_check_against_a_mission(tmp_path, capsys):
+    text = ("procedure initiate and confirm step Check main wait until coil_temp of Magnetorquer"
+            " < 1800 timeout 5 s; initiate and confirm enable of Magnetorquer; end main end step;"
+            " end procedure")  # fmt: skip
+    assert check_args(tmp_path, text, mission="examples/aurora") == 1
+    out = capsys.readouterr().out
+    assert ("p.plt:1:85: type_error: cannot compare coil_temp of Magnetorquer (degC) with 1800:"
+            " units degC and none differ") in out  # fmt: skip
+    assert check_args(tmp_path, text.replace("1800", "80 degC"), mission="examples/aurora") == 0
+    assert check_args(tmp_path, text.replace("enable", "enabel"), mission="examples/aurora") == 1
+    assert "unknown activity enabel of Magnetorquer" in capsys.readouterr().out
+
+
+def test_check_syntax_only(tmp_path, capsys):
+    # references nothing resolves still pass: the grammar alone is checked
+    assert check_args(tmp_path, "procedure initiate and confirm fly of Nowhere; end procedure",
+                      syntax_only=True) == 0  # fmt: skip
+    assert "ok (syntax)" in capsys.readouterr().out
+    assert check_args(tmp_path, "procedure\n  log 1 +;\nend procedure", syntax_only=True) == 1
+    assert capsys.readouterr().out.endswith(
+        "p.plt:2:10: syntax_error: expected an expression, found ';'\n"
+    )
+
+
+def test_check_takes_one_source_of_references(tmp_path):
+    with pytest.raises(UserError) as e:
+        check_args(tmp_path, "procedure log 1; end procedure", mission="m", syntax_only=True)
+    assert "--mission and --syntax-only" in str(e.value)
+
+
+def test_a_mission_that_does_not_load_is_named(tmp_path):
+    with pytest.raises(UserError) as e:
+        check_args(tmp_path, "procedure log 1; end procedure", mission=str(tmp_path))
+    assert str(tmp_path) in str(e.value)

@@ -6,6 +6,7 @@ import sys
 from obsw.pluto.dryrun import dry_run
 from obsw.pluto.interp import load
 from obsw.pluto.lexer import PlutoError
+from obsw.pluto.parser import parse
 from obsw.pluto.system import SimulatedSystem, SystemSpecError, argument_code, value_of
 from obsw.pluto.units import Quantity
 
@@ -23,6 +24,16 @@ def add_parser(sub):
     c.add_argument("file", help="procedure text")
     c.add_argument("--sdb", help="spacecraft database JSON: check system references")
     c.add_argument("--system", help="simulated system JSON: check system references")
+    c.add_argument(
+        "--mission",
+        metavar="DIR",
+        help="mission folder: check references against its database and components",
+    )
+    c.add_argument(
+        "--syntax-only",
+        action="store_true",
+        help="the grammar only (ECSS-E-ST-70-32C Annex A): no references, no types",
+    )
     c.set_defaults(func=check_cmd)
     r = s.add_parser("run", help="run against a simulated system on a virtual clock")
     r.add_argument("file", help="procedure text")
@@ -89,9 +100,62 @@ def _errors(e):
     return getattr(e, "errors", None) or [e]
 
 
+class CatalogResolver:
+    """Answers the checker's questions from a checked mission: its database and the
+    interfaces of its components (``obsw.pluto.names.Catalog``)."""
+
+    def __init__(self, mission):
+        from obsw.pluto.names import Catalog
+
+        self.catalog = Catalog(mission.sdb, list(mission.interfaces.values()))
+
+    def describe(self, path):
+        from obsw.pluto.names import CODE, KIND, UNIT
+
+        e = self.catalog.find(path)
+        if e is None:
+            return None
+        if e[KIND] == "parameter":
+            return ("parameter", e[CODE] or "?", e[UNIT])
+        return (e[KIND], None, None)
+
+    def signature(self, path):
+        from obsw.pluto.names import KIND, SIGNATURE
+
+        e = self.catalog.find(path)
+        return e[SIGNATURE] if e is not None and e[KIND] == "activity" else None
+
+
+def _mission_resolver(folder):
+    from obsw_host.mission.check import load as load_mission
+    from obsw_host.mission.errors import MissionError
+
+    try:
+        return CatalogResolver(load_mission(folder))
+    except MissionError as e:
+        raise UserError("mission %s does not load: %s" % (folder, e),
+                        expected="a mission `obsw mission check` passes") from None  # fmt: skip
+
+
 def check_cmd(args):
     resolver = None
-    if args.sdb:
+    given = [o for o in ("sdb", "system", "mission") if getattr(args, o, None)]
+    if getattr(args, "syntax_only", False):
+        given.append("syntax-only")
+    if len(given) > 1:
+        raise UserError("--%s and --%s: one of them" % (given[0], given[1]),
+                        expected="one source of references, or --syntax-only")  # fmt: skip
+    if getattr(args, "syntax_only", False):
+        try:
+            parse(_read(args.file))
+        except PlutoError as e:
+            print("%s:%d:%d: %s: %s" % (args.file, e.line, e.col, e.kind, e.msg))
+            return 1
+        print("%s: ok (syntax)" % args.file)
+        return 0
+    if getattr(args, "mission", None):
+        resolver = _mission_resolver(args.mission)
+    elif args.sdb:
         from obsw_host.sample import load_sdb
 
         resolver = SdbResolver(load_sdb(args.sdb))

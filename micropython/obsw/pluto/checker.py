@@ -55,7 +55,9 @@ class Checker(ExprChecker, SignatureChecker):
                 self.n += 1
                 key = "%d.%s" % (self.n, d[2])
                 t, unit, vals = d[3], d[4], None
-                if isinstance(t, tuple):
+                if isinstance(t, tuple) and t[0] == "sys":  # a system property's values:
+                    typ = ANY  # known to the system only, checked when the procedure runs
+                elif isinstance(t, tuple):
                     e = self.lookup(scopes, t[1], ("enum",))
                     if e is None:
                         self.fail(PlutoReferenceError, "unknown type %s" % t[1], d[1])
@@ -147,6 +149,8 @@ class Checker(ExprChecker, SignatureChecker):
                 self.want_rel(s[3], scopes, "wait for")
             else:
                 self.event_ref(s[3], scopes)
+            if len(s) > 5 and s[5]:  # values saved when the wait ends
+                self.save_context(("save", s[1], s[5]), scopes)
             self.timeout(s[4], scopes)
         elif k in ("init", "conf"):
             self.activity(s[2], scopes)
@@ -298,6 +302,16 @@ class Checker(ExprChecker, SignatureChecker):
 
     def ref(self, r, scopes):
         """Resolve a reference node in place and return its type."""
+        t = self._ref(r, scopes)
+        if len(r) > 6:  # an object property request's arguments: only the system's properties
+            for _, e in r[6]:
+                self.expr(e, scopes)
+            if r[4] != "p":
+                self.fail(PlutoTypeError, "%s takes no arguments: only a system object's"
+                          " property may" % " of ".join(r[2]), r[1])  # fmt: skip
+        return t
+
+    def _ref(self, r, scopes):
         names = r[2]
         if names[0] == "value" and len(names) > 1:
             names = names[1:]

@@ -212,7 +212,13 @@ class Evaluator:
         if kind == "p":
             path, unit = r[5]
             try:
-                v = self.system.get(path)
+                if len(r) > 6:
+                    args = {}
+                    for i, (n, e) in enumerate(r[6]):
+                        args[n or "arg%d" % (i + 1)] = self.eval(e)
+                    v = self.system.request(path, args)
+                else:
+                    v = self.system.get(path)
             except (KeyError, ValueError, OSError) as x:
                 raise PlutoRuntimeError("cannot read %s: %s" % (path, x)) from None
             if unit and type(v) in _NUMS:

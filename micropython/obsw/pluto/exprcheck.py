@@ -140,7 +140,10 @@ class ExprChecker:
             t = self.expr(e[2], scopes)
             tol = type_of_value(e[3][2])
             self.comparable(e, t, self.expr(e[5], scopes), "<", e[2], e[5])
-            if (
+            if len(e[3]) > 3 or not _num(tol):
+                self.fail(PlutoTypeError, "within needs a number as its tolerance, with units"
+                          " at most once: found %s" % source(e[3]), e[3][1])  # fmt: skip
+            elif (
                 not _num(t)
                 or (e[4] and tol[1] != NONE)
                 or (not e[4] and tol[1] != NONE and t[0] != "?" and tol[1] != t[1])
@@ -163,7 +166,19 @@ class ExprChecker:
             if e[3] is not None:
                 self.expr(e[3], scopes)
             t = e[4]
-            return ("e", None) if isinstance(t, tuple) else type_of_code(t or "s")
+            if isinstance(t, tuple):
+                return ANY if t[0] == "sys" else ("e", None)
+            return type_of_code(t or "s")
+        if k == "act":  # an activity handed as an argument: its name (and arguments)
+            self.activity(e[2], scopes)
+            return ANY
+        if k == "refarg":  # an event or a system element handed as an argument: its name
+            r = e[2]
+            if e[3] == "event":
+                self.event_ref(r, scopes)
+            else:
+                r[4], r[5] = "ctx", " of ".join(self._ctx_names(r[2]))
+            return STRING
         return ANY
 
     def unit_name(self, e, t):
@@ -190,7 +205,16 @@ class ExprChecker:
         x = e[3] if x is None else x
         y = e[4] if y is None else y
         if _num(a) and _num(b):
-            if a[1] == b[1] or a[1] == NONE or b[1] == NONE:
+            if a[1] == b[1]:
+                return
+            if a[1] == NONE or b[1] == NONE:
+                # a number without units is dimensionless (Annex A: units are part of a
+                # constant): '< 1800' against degC would silently mean 1800 degC
+                ua = "none" if a[1] == NONE else self.unit_name(x, a)
+                ub = "none" if b[1] == NONE else self.unit_name(y, b)
+                self.fail(PlutoTypeError, "cannot compare %s with %s: units %s and %s differ (a"
+                          " number without units is dimensionless)" % (self.operand(x, a),
+                          self.operand(y, b), ua, ub), e[1])  # fmt: skip
                 return
             self.fail(PlutoTypeError, "cannot compare %s with %s: units %s and %s differ"
                       % (self.operand(x, a), self.operand(y, b), self.unit_name(x, a),

@@ -1,114 +1,26 @@
-"""PLUTO expression parser: token helpers, names, references, constants with units, operators."""
+"""PLUTO expression parser: constants with units, operators by precedence, function calls,
+object property requests; names and references come from ``obsw.pluto.syntax``, units and
+types from ``obsw.pluto.unitsyntax``."""
 
 from obsw.pluto import units
 from obsw.pluto.builtins import FIRST_WORDS, FUNCTIONS, MAX_NAME_WORDS
-from obsw.pluto.lexer import ABST, EOF, NUM, OP, RELT, STR, WORD, PlutoSyntaxError, line_col
+from obsw.pluto.lexer import ABST, DIGITS, NUM, OP, RELT, STR, WORD
+from obsw.pluto.syntax import _TYPE_FIRST, RESERVED, _show
+from obsw.pluto.unitsyntax import UnitTypeParser
 
-# Words that end a multi-word name: every keyword that may follow a name or open a statement.
-RESERVED = set(
-    (
-        "of with end then do to by is and or timeout raise refer default expect described"
-        " until else otherwise in initiate if while for repeat wait log inform main watchdog"
-        " confirmation preconditions declare step procedure event variable enumerated between"
-        " within ask record array AND OR XOR NOT TRUE FALSE"
-    ).split()
-)
-OBJECT_TYPES = ("variable", "parameter", "argument", "activity", "event", "step")
 RELOPS = ("=", "!=", "<", ">", "<=", ">=")
 _LOGIC = {"OR": 1, "XOR": 2, "AND": 3}
 _ARITH = {"+": 1, "-": 1, "*": 2, "/": 2, "**": 3}
 _TIME_ORDER = ("d", "h", "min", "s")
 SUBJECT = ("subj", 0)  # the value a case statement tests, in its case tags
-# Deepest nesting of blocks, parentheses and operators the parser takes: the parser, the
-# checker and the interpreter walk the tree recursively, and a board's stack is small.
-MAX_NESTING = 12
 
 
-def _show(tok):
-    if tok[0] == EOF:
-        return "end of text"
-    if tok[0] == STR:
-        return 'string "%s"' % tok[1]
-    return "'%s'" % (tok[1],)
+def _numeric(v):
+    t = type(v)
+    return t is int or t is float or isinstance(v, units.Quantity)
 
 
-class ExprParser:
-    def __init__(self, tokens):
-        self.toks = tokens
-        self.i = 0
-        self.depth = 0
-
-    def enter(self):
-        """One level deeper (a block, a parenthesis, an operator); refused past the limit."""
-        self.depth += 1
-        if self.depth > MAX_NESTING:
-            self.err("nesting deeper than %d levels" % MAX_NESTING)
-
-    # token helpers
-    def tok(self, k=0):
-        j = self.i + k
-        return self.toks[j] if j < len(self.toks) else self.toks[-1]
-
-    def pos(self):
-        return self.toks[self.i][2]
-
-    def err(self, msg, p=None):
-        raise PlutoSyntaxError(msg, *line_col(self.pos() if p is None else p))
-
-    def at(self, *words):
-        for k, w in enumerate(words):
-            t = self.tok(k)
-            if t[1] != w or t[0] not in (WORD, OP):
-                return False
-        return True
-
-    def take(self, *words):
-        if self.at(*words):
-            self.i += len(words)
-            return True
-        return False
-
-    def expect(self, *words, after=""):
-        if not self.take(*words):
-            self.err(
-                "expected '%s'%s, found %s"
-                % (" ".join(words), " " + after if after else "", _show(self.tok()))
-            )
-
-    def isop(self, sym):
-        t = self.toks[self.i]
-        return t[0] == OP and t[1] == sym
-
-    def name(self, what="a name"):
-        """A multi-word identifier: the run of non-reserved words here."""
-        words = []
-        while True:
-            t = self.toks[self.i]
-            if t[0] != WORD or t[1] in RESERVED:
-                break
-            words.append(t[1])
-            self.i += 1
-        if not words:
-            self.err("expected %s, found %s" % (what, _show(self.tok())))
-        return " ".join(words)
-
-    def ref(self, what="a reference"):
-        """Object reference ``[type] name {of name}`` as a mutable node the checker resolves:
-        ['r', pos, names, object type, kind, target]."""
-        p = self.pos()
-        otype = None
-        t = self.tok()
-        if t[0] == WORD and t[1] in OBJECT_TYPES and self.tok(1)[0] == WORD:
-            nxt = self.tok(1)[1]
-            if nxt not in RESERVED or nxt == "event":
-                otype = t[1]
-                self.i += 1
-        names = [self.name(what)]
-        while self.at("of"):
-            self.i += 1
-            names.append(self.name(what))
-        return ["r", p, tuple(names), otype, None, None]
-
+class ExprParser(UnitTypeParser):
     # expressions: OR < XOR < AND < relational < + - < * / < ** < unary, left associative
     # but **. Precedence climbing keeps the Python calls per parenthesis to four (expr,
     # relational, _arith, _simple): each costs C stack on MicroPython, and a Pyboard has 15 KiB.
@@ -140,6 +52,13 @@ class ExprParser:
             if self.isop("%"):
                 self.i += 1
                 pct = True
+            else:  # 'within 5 [mV] of': units may follow any constant; twice is a load error
+                u = self.unit()
+                if u is not None:
+                    v = tol[2]
+                    t = type(v)
+                    tol = ("c", tol[1], units.Quantity(v, u)) if t is int or t is float else (
+                        "c", tol[1], v, u)  # fmt: skip
             self.expect("of", after="in within")
             return ("wi", p, left, tol, pct, self.term())
         if self.at("in") and self.tok(1)[1] == "(":
@@ -148,6 +67,8 @@ class ExprParser:
             while self.isop(","):
                 self.i += 1
                 items.append(self.term())
+            if len(items) < 2:  # Annex A: 'in (' <term> {',' <term>}- ')'
+                self.err("in (...) needs two values at least, found %s" % _show(self.tok()))
             self.expect(")")
             return ("in", p, left, tuple(items))
         if subject is not None:
@@ -189,7 +110,7 @@ class ExprParser:
     def _simple(self):
         t = self.toks[self.i]
         k, v, p = t
-        if k == NUM or k == RELT or k == ABST or k == STR:
+        if k == NUM or k == DIGITS or k == RELT or k == ABST or k == STR:
             return self.constant()
         if k == OP:
             if v == "(":
@@ -200,7 +121,7 @@ class ExprParser:
             if v == "+" or v == "-":
                 self.i += 1
                 x = self.simple()
-                if x[0] == "c" and type(x[2]) is not bool and not isinstance(x[2], str):
+                if x[0] == "c" and _numeric(x[2]):
                     return ("c", p, units.neg(x[2]) if v == "-" else x[2])
                 return ("u", p, v, x)
         elif k == WORD:
@@ -223,7 +144,12 @@ class ExprParser:
             if self.take("confirmation", "status", "of"):  # 'confirmation' opens a body too
                 r = self.ref()
                 r[2] = ("confirmation status",) + r[2]
-                return r
+                return self.with_arguments(r)
+            if v in _TYPE_FIRST and v in RESERVED:  # 'step X', 'event X', 'array X' ...
+                save = self.i
+                if self.object_type() is not None:
+                    self.i = save
+                    return self.with_arguments(self.ref())
             if v not in RESERVED:
                 if v == "get" and self.tok(1)[0] == WORD and self.tok(1)[1] not in RESERVED:
                     self.i += 1
@@ -232,8 +158,33 @@ class ExprParser:
                 if self.isop("("):
                     return self.call(n, p)
                 self.i = save
-                return self.ref()
+                return self.with_arguments(self.ref())
         self.err("expected an expression, found %s" % _show(t))
+
+    def with_arguments(self, r):
+        """An object property request may give arguments: ``<reference> with [<name> :=]
+        <expression> {, ...} end with``; they are kept on the reference node (r[6])."""
+        if not self.at("with") or self.tok(1)[1] in ("arguments", "value", "directives", "units"):
+            return r
+        self.i += 1
+        args = [self.named_expr()]
+        while self.isop(","):
+            self.i += 1
+            args.append(self.named_expr())
+        self.expect("end", "with", after="after the arguments of %s" % " of ".join(r[2]))
+        r.append(tuple(args))
+        return r
+
+    def named_expr(self):
+        """``[<name> :=] <expression>``."""
+        save = self.i
+        if self.tok()[0] == WORD and self.tok()[1] not in RESERVED:
+            n = self.name()
+            if self.isop(":="):
+                self.i += 1
+                return (n, self.expr())
+        self.i = save
+        return (None, self.expr())
 
     def function_name(self):
         """The longest standard function name (Annex C, words such as 'to' or 'of' included)
@@ -273,14 +224,20 @@ class ExprParser:
     def constant(self):
         k, v, p = self.toks[self.i]
         self.i += 1
+        if k == DIGITS:
+            k, v = NUM, int(v)
         if k == STR:
             return ("c", p, v)
+        if k == WORD and (v == "TRUE" or v == "FALSE"):
+            return ("c", p, v == "TRUE")
         if k == ABST:
             return ("c", p, units.AbsTime(v))
         if k == RELT:
             return ("c", p, units.Quantity(v, "s"))
         if k == OP and v in "+-":
             c = self.constant()
+            if not _numeric(c[2]):  # Annex A: a sign only before a number or a relative time
+                self.err("a sign needs a number, found %s" % _show(self.toks[self.i - 1]), p)
             return ("c", p, units.neg(c[2]) if v == "-" else c[2])
         if k != NUM:
             self.i -= 1
@@ -290,70 +247,14 @@ class ExprParser:
             return ("c", p, v)
         if u in _TIME_ORDER:  # relative time chain such as "1 d 2 h" or "2min30s"
             total, last, fl = v * units.parse(u)[0], _TIME_ORDER.index(u), False
-            while self.toks[self.i][0] == NUM:
+            while self.toks[self.i][0] in (DIGITS, NUM):
                 nt = self.tok(1)
                 if nt[0] != WORD or nt[1] not in _TIME_ORDER[last + 1 :]:
                     break
-                total += self.toks[self.i][1] * units.parse(nt[1])[0]
+                n = self.toks[self.i][1]
+                total += (int(n) if type(n) is str else n) * units.parse(nt[1])[0]
                 last, fl = _TIME_ORDER.index(nt[1]), True
                 self.i += 2
             if fl:
                 return ("c", p, units.Quantity(total, "s"))
         return ("c", p, units.Quantity(v, u))
-
-    def unit(self):
-        """Engineering units written after a number or after 'with units', as text, or None."""
-        t = self.toks[self.i]
-        if t[0] == OP and t[1] == "[":
-            j = self.i + 1
-            parts = []
-            while self.toks[j][0] != EOF and self.toks[j][1] != "]":
-                parts.append(str(self.toks[j][1]))
-                j += 1
-            if self.toks[j][0] == EOF:
-                self.err("expected ']' to close the units")
-            text = "".join(parts)
-            self.i = j + 1
-        elif t[0] == WORD and t[1] not in RESERVED and units.symbol(t[1]):
-            text = t[1]
-            self.i += 1
-            while True:
-                t = self.toks[self.i]
-                nt = self.tok(1)
-                if t[0] == OP and t[1] == "^":
-                    j = self.i + 1
-                    sign = ""
-                    if self.toks[j][1] == "-":
-                        sign, j = "-", j + 1
-                    if self.toks[j][0] != NUM:
-                        self.err("expected an exponent after '^'")
-                    text += "^" + sign + str(self.toks[j][1])
-                    self.i = j + 1
-                elif t[0] == OP and t[1] in "./" and nt[0] == WORD and units.symbol(nt[1]):
-                    text += t[1] + nt[1]
-                    self.i += 2
-                else:
-                    break
-        else:
-            return None
-        try:
-            units.parse(text)
-        except units.UnitError as e:
-            self.err(str(e), t[2])
-        return text
-
-    def typ(self):
-        """A predefined type: 'b', 'i', 'u', 'r', 's', 'a', 'rt' or ('e', enumerated set name)."""
-        for words, code in (
-            (("Boolean",), "b"),
-            (("signed", "integer"), "i"),
-            (("unsigned", "integer"), "u"),
-            (("integer",), "i"),
-            (("real",), "r"),
-            (("string",), "s"),
-            (("absolute", "time"), "a"),
-            (("relative", "time"), "rt"),
-        ):
-            if self.take(*words):
-                return code
-        return ("e", self.name("a type"))

@@ -10,6 +10,8 @@ OP = "o"
 ABST = "t"  # absolute time literal, value in seconds since the Unix epoch
 RELT = "r"  # colon-form relative time literal (d:hh:mm:ss[:fff]), value in seconds
 EOF = "e"
+DIGITS = "d"  # a run of decimal digits, value its text: an integer, or a word of a name
+
 
 _OPS2 = (":=", "**", "<=", ">=", "!=")
 _OPS1 = "=<>+-*/(),;:[].^%"
@@ -43,7 +45,7 @@ def line_col(p):
     return p >> 12, p & 4095
 
 
-_KINDS = WORD + NUM + STR + OP + ABST + RELT + EOF
+_KINDS = WORD + NUM + STR + OP + ABST + RELT + EOF + DIGITS
 
 
 class Tokens:
@@ -291,8 +293,11 @@ def _number(b, i, n, out, p):
         raise PlutoSyntaxError(
             "numeric constant of %d characters, at most %d" % (j - i, _MAX_DIGITS), *line_col(p)
         )
-    v = float(_text(b, i, j)) if real else int(_text(b, i, j))
-    if real and (v - v != 0):  # inf: beyond the largest real
+    if not real:  # "Wheel 2" names a wheel: the parser decides what the digits are
+        out.append((DIGITS, _text(b, i, j), p))
+        return j
+    v = float(_text(b, i, j))
+    if v - v != 0:  # inf: beyond the largest real
         raise PlutoSyntaxError("real constant out of range: %s" % _text(b, i, j), *line_col(p))
     out.append((NUM, v, p))
     return j

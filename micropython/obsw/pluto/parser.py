@@ -4,14 +4,18 @@ A procedure or step definition is ``("def", pos, decls, preconditions, main, wat
 confirmation)``; statements are tuples tagged by their first item (see README, PLUTO section).
 """
 
-from obsw.pluto.exprs import MAX_NESTING, SUBJECT, ExprParser, _show
-from obsw.pluto.lexer import EOF, STR, WORD, PlutoSyntaxError, line_col, tokenize
+from obsw.pluto.arguments import ArgumentParser
+from obsw.pluto.exprs import SUBJECT
+from obsw.pluto.lexer import EOF, OP, STR, WORD, PlutoSyntaxError, line_col, tokenize
+from obsw.pluto.syntax import MAX_NESTING, _show
 
 # Deepest tree (tuples and lists) a procedure may give: long operator chains such as
 # 1 + 1 + ... + 1 nest without any parenthesis.
 MAX_TREE_DEPTH = 6 * MAX_NESTING
 
 _STATUS = (("confirmed",), ("not", "confirmed"), ("aborted",))
+# words that carry an expression on: after 'wait for event X' they make it 'wait for <expr>'
+_GOES_ON = ("AND", "OR", "XOR", "between", "within", "in")
 _MAIN_STOPS = ("end", "watchdog", "confirmation")
 _PROC_ONLY = (
     "only initiate, initiate and confirm, in parallel, inform user, log and in the context of"
@@ -47,7 +51,7 @@ def check_depth(tree):
                 stack.append((child, depth + 1, p))
 
 
-class Parser(ExprParser):
+class Parser(ArgumentParser):
     def procedure(self):
         self.expect("procedure", after="at the start of the text")
         node = self.definition(False, "procedure")
@@ -73,7 +77,10 @@ class Parser(ExprParser):
             while True:
                 if not self.at("initiate", "and", "confirm", "step"):
                     self.err("a watchdog body holds 'initiate and confirm step' statements")
-                wd.append(self.statement(True))
+                st = self.statement(True)
+                if st[0] != "step":
+                    self.err("a watchdog body holds steps, found an activity", st[1])
+                wd.append(st)
                 self.expect(";", after="after the watchdog step")
                 self.take("watchdog")
                 if self.take("end", "watchdog"):
@@ -167,15 +174,13 @@ class Parser(ExprParser):
 
     def statement(self, step):
         p = self.pos()
-        if self.take("initiate", "and", "confirm", "step"):
-            n = self.name("a step name")
-            d = self.definition(True, "step")
-            self.expect("end", "step")
-            return ("step", p, n, d, self.continuation())
+        if self.at("initiate", "and", "confirm", "step"):
+            # always a step: Annex A also reads 'initiate and confirm step X;' as an activity
+            # whose reference has object type step, which no activity has
+            self.i += 3
+            return self.step_statement(p)
         if self.take("initiate", "and", "confirm"):
-            c = self.activity_call()
-            r = self.name() if self.take("refer", "by") else None
-            return ("conf", p, c, r, self.continuation())
+            return self.confirm_activity(p)
         if self.take("initiate"):
             c = self.activity_call()
             return ("init", p, c, self.name() if self.take("refer", "by") else None)
@@ -232,35 +237,78 @@ class Parser(ExprParser):
             if self.take("until"):
                 mode, x = "until", self.expr()
             elif self.take("for"):
+                mode, x = "for", None
+                start = self.i
                 if self.take("event"):
                     mode, x = "event", self.ref("an event")
-                else:
-                    mode, x = "for", self.expr()
+                    t = self.tok()
+                    if t[0] == OP and t[1] != ";" or t[1] in _GOES_ON:
+                        # 'wait for event X AND Y': the expression 'event X AND Y' is waited
+                        self.i, mode = start, "for"
+                if mode == "for":
+                    x = self.expr()
             else:
                 self.err("expected 'until' or 'for' after 'wait', found %s" % _show(self.tok()))
-            return ("wait", p, mode, x, self.timeout())
+            saved = self.save_items() if self.take("save", "context", "refer") else None
+            return ("wait", p, mode, x, self.timeout(), saved)
         if self.tok()[0] != WORD:
             self.err("expected a statement, found %s" % _show(self.tok()))
         r = self.ref("a statement")
         if self.take(":="):
             return ("set", p, r, self.expr())
+        if self.tok()[0] == WORD and self.object_type_here():  # 'open variable x': 'of' left out
+            r[2] = r[2] + tuple(self.ref("an object")[2])
         return ("op", p, r, self.arguments_opt(("with",)))
 
+    def step_statement(self, p):
+        self.expect("step")
+        n, d = self.named_step()
+        self.expect("end", "step")
+        return ("step", p, n, d, self.continuation())
+
+    def confirm_activity(self, p):
+        c = self.activity_call()
+        r = self.name() if self.take("refer", "by") else None
+        return ("conf", p, c, r, self.continuation())
+
+    def named_step(self):
+        """A step's name and definition. Without 'main', 'step A B x := 1;' may be step 'A B'
+        or step 'A' doing 'B x := 1': when the body cannot start right after the name, its
+        last words are given to the body, one at a time."""
+        start = self.i
+        self.name("a step name")
+        limit = self.i - start
+        while True:
+            self.i = start
+            n = self.name("a step name", limit)
+            body = self.i
+            try:
+                return n, self.definition(True, "step")
+            except PlutoSyntaxError as e:
+                if limit == 1 or line_col(self.toks[body][2]) != (e.line, e.col):
+                    raise
+                limit -= 1
+
     def save_context(self, p):
-        """``save context refer to <reference> by <name> {, refer to ... by ...} [end context]``:
-        entries are [reference, name, variable key (set by the checker)]."""
+        """``save context refer to <reference> by <name> {, to <reference> by <name>}
+        [end context]``."""
+        items = self.save_items()
+        self.take("end", "context")
+        return ("save", p, items)
+
+    def save_items(self):
+        """The pairs of a save context (after 'save context refer'), as [reference, name,
+        variable key (set by the checker)]; 'refer' may be repeated after ','."""
         items = []
         while True:
             self.expect("to", after="after 'save context refer'")
             r = self.ref("a reporting data reference")
             self.expect("by", after="after the saved reference")
             items.append([r, self.name("a name for the saved value"), None])
-            if not self.isop(","):
-                break
+            if not (self.isop(",") and self.tok(1)[1] in ("to", "refer")):
+                return items
             self.i += 1
-            self.expect("refer", after="after ',' in save context")
-        self.take("end", "context")
-        return ("save", p, items)
+            self.take("refer")
 
     def expr_list(self):
         out = [self.expr()]
@@ -294,57 +342,6 @@ class Parser(ExprParser):
         if t[1] in ("=", "!=", "<", ">", "<=", ">=", "between", "within", "in"):
             return self.relational(SUBJECT)
         return ("cmp", t[2], "=", SUBJECT, self.term())  # a bare value means '= value'
-
-    def activity_call(self):
-        r = self.ref("an activity")
-        args, dirs = (), ()
-        if self.take("with", "arguments"):
-            args = self.arguments()
-            self.expect("end", "with", after="after the arguments")
-        elif self.take("with", "value", "set"):
-            args = (("value set", self.ref("a value set")),)
-            self.expect("end", "with", after="after the value set")
-        if self.take("with", "directives"):
-            dirs = self.arguments()
-            self.expect("end", "with", after="after the directives")
-        return (r, args, dirs)
-
-    def arguments_opt(self, opener):
-        if not self.take(*opener):
-            return ()
-        a = self.arguments()
-        self.expect("end", "with", after="after the arguments")
-        return a
-
-    def arguments(self):
-        out = [self.argument()]
-        while self.isop(","):
-            self.i += 1
-            out.append(self.argument())
-        return tuple(out)
-
-    def argument(self):
-        name = None
-        save = self.i
-        if self.tok()[0] == WORD and not self.at("record") and not self.at("array"):
-            try:
-                name = self.name()
-            except ValueError:
-                name = None
-            if not (self.isop(":=") or self.at("record") or self.at("array")):
-                name, self.i = None, save
-            else:
-                self.take(":=")
-        p = self.pos()
-        if self.take("record"):
-            v = ("rec", p, self.arguments())
-            self.expect("end", "record")
-        elif self.take("array"):
-            v = ("arr", p, self.arguments())
-            self.expect("end", "array")
-        else:
-            v = self.expr()
-        return (name, v)
 
     def parallel(self, p):
         every = True

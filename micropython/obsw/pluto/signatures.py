@@ -1,6 +1,7 @@
 """PLUTO load-time checks of activity calls against their declared signatures (argument
 names, types and units from the spacecraft database or a simulated system's description)."""
 
+from obsw.errors import closest
 from obsw.pluto.exprcheck import (
     _DECLARED,
     NONE,
@@ -22,6 +23,7 @@ class SignatureChecker:
         """Arguments against the activity's declared signature: names, count, types, units."""
         takes = ", ".join([a[0] for a in sig]) or "none"
         given = {}
+        unknown = []  # (name, value, position) of arguments the activity does not declare
         for i, (name, v) in enumerate(args):
             q = v[1] if isinstance(v, tuple) else p
             if name is None:
@@ -37,8 +39,7 @@ class SignatureChecker:
                     if norm(d[0]) == norm(name):
                         decl = d
                 if decl is None:
-                    self.fail(PlutoReferenceError, "activity %s has no argument %s (takes: %s)"
-                              % (path, name, takes), q)  # fmt: skip
+                    unknown.append((name, q))
                     self.argument(v, scopes)
                     continue
             if decl[0] in given:
@@ -53,10 +54,18 @@ class SignatureChecker:
                                  " record" if v[0] == "rec" else "n array"), q)  # fmt: skip
                 continue
             self.argument_type(path, decl, v, self.expr(v, scopes), q)
+        for name, q in unknown:  # a misspelt name: say which declared one it resembles
+            near = closest_argument(name, [d[0] for d in sig if d[0] not in given])
+            hint = "; did you mean %s?" % near if near else ""
+            if near:
+                given[near] = True  # named by this error: not reported missing as well
+            self.fail(PlutoReferenceError, "activity %s has no argument %s%s (takes: %s)"
+                      % (path, name, hint, takes), q)  # fmt: skip
+        at = unknown[0][1] if unknown else p  # after the misspelt names, that come first
         for d in sig:
             if d[0] not in given:
                 self.fail(PlutoTypeError, "activity %s needs argument %s (takes: %s)"
-                          % (path, d[0], takes), p)  # fmt: skip
+                          % (path, d[0], takes), at)  # fmt: skip
 
     def argument_type(self, path, decl, v, et, p):
         name, code, unit = decl
@@ -84,6 +93,16 @@ class SignatureChecker:
         if why:
             self.fail(PlutoTypeError, "activity %s: argument %s takes %s, got %s: %s"
                       % (path, name, _a(want), self.operand(v, et), why), p)  # fmt: skip
+
+
+def closest_argument(name, names):
+    """The one of ``names`` nearest to ``name`` when near enough to be a typo of it (at most a
+    third differs, spaces, underscores and case aside), else None."""
+    forms = {}
+    for n in names:
+        forms.setdefault(norm(n), n)
+    near = closest(norm(name), list(forms))
+    return None if near is None else forms[near]
 
 
 def _below_zero(v):

@@ -116,11 +116,7 @@ class Statements(Evaluator):
         elif k == "ctx":
             yield from self._block(s[3])
         elif k == "save":
-            vals = []
-            for item in s[2]:  # every value read first: one consistent snapshot
-                vals.append(self.eval(item[0]))
-            for i, item in enumerate(s[2]):
-                self.vars[item[2]] = vals[i]
+            self._save(s[2])
 
     def _push(self, to, owner):
         e = [self.now + seconds(self.eval(to[0])), to[1], self.ts[1], owner]
@@ -183,6 +179,18 @@ class Statements(Evaluator):
                 lst.remove(e)
 
     def _wait(self, s, own=False):
+        yield from self._wait_until(s)
+        if len(s) > 5 and s[5]:  # save context: the values as they are when the wait ends
+            self._save(s[5])
+
+    def _save(self, items):
+        vals = []
+        for item in items:  # every value read first: one consistent snapshot
+            vals.append(self.eval(item[0]))
+        for i, item in enumerate(items):
+            self.vars[item[2]] = vals[i]
+
+    def _wait_until(self, s):
         mode, x, to = s[2], s[3], s[4]
         lst = e = None
         if to:
@@ -236,6 +244,15 @@ class Statements(Evaluator):
             return out
         if v[0] == "r" and v[4] == "act":
             return v[5]
+        if v[0] == "refarg":
+            return v[2][5]
+        if v[0] == "act":  # an activity handed on: its name, with its arguments if any
+            call, args = v[2], {}
+            for i, (name, x) in enumerate(call[1]):
+                args[name or "arg%d" % (i + 1)] = yield from self._argument(x)
+            if not args:
+                return call[0][5]
+            return {"activity": call[0][5], "arguments": args}
         x = self._val(v)
         if x is _PENDING:
             x = yield from self._ev(v)

@@ -20,6 +20,11 @@ class System:
         """Current value of a parameter: bool, int, float, str or Quantity."""
         raise NotImplementedError
 
+    def request(self, path, args):
+        """A property read with arguments (an object property request's 'with ... end
+        with'); none of this system's properties takes any."""
+        raise ValueError("%s takes no arguments" % path)
+
     def initiate(self, path, args, confirm=False):
         """Start an activity with a dict of evaluated arguments; returns a handle."""
         raise NotImplementedError

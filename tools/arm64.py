@@ -154,7 +154,7 @@ def install(rootfs):
     rootfs.chroot("%s/bin/pip install -q %s pytest hypothesis" % (VENV, SRC))  # + the tests
     machine = "import platform; print(platform.machine())"
     out = rootfs.chroot("%s/bin/obsw --version; %s/bin/python -c '%s'" % (VENV, VENV, machine))
-    return out.replace("\n", ", ")
+    return ", ".join(out.split())
 
 
 def pi_mission(rootfs):

@@ -126,6 +126,13 @@ class Catalog:
             sig = None
             if op.signature is not None:
                 sig = [(n, argument_code(t), _unit(u)) for n, t, u in op.signature]
+                f = sdb._functions_by_name.get(op.qualified)
+                if f is not None and f.labels:  # an enumeration: its labels, or their numbers
+                    ids = {a[1]: a[0] for a in f.arguments}
+                    for i, (n, _code, u) in enumerate(sig):
+                        labels = f.labels.get(ids.get(n))
+                        if labels:
+                            sig[i] = (n, ("labels", labels), u)
             self.add("activity", op.component, op.name, None, None, list(op.arguments), sig)
         for e in sdb.events.values():
             if e.component:

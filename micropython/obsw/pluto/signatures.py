@@ -69,6 +69,8 @@ class SignatureChecker:
 
     def argument_type(self, path, decl, v, et, p):
         name, code, unit = decl
+        if type(code) is tuple:  # ("labels", {raw: label}): an enumerated argument
+            return self.label_argument(path, name, code[1], v, et, p)
         if code == "?" or et[0] == "?":
             return
         want = _DECLARED[code] + (" in " + unit if unit and code != "rt" else "")
@@ -93,6 +95,27 @@ class SignatureChecker:
         if why:
             self.fail(PlutoTypeError, "activity %s: argument %s takes %s, got %s: %s"
                       % (path, name, _a(want), self.operand(v, et), why), p)  # fmt: skip
+
+
+    def label_argument(self, path, name, labels, v, et, p):
+        """A label of the enumeration (a string constant checked at load time), a number of
+        it, or a string the procedure computes (checked when it runs)."""
+        known = list(labels.values())
+        if v[0] == "c" and type(v[2]) is str:
+            if v[2] in known:
+                return
+            near = closest(v[2], known)
+            why = "no label %r%s" % (v[2], "; did you mean %r?" % near if near else "")
+        elif v[0] == "c" and type(v[2]) is int:
+            if v[2] in labels:
+                return
+            why = "no label numbered %d" % v[2]
+        elif et[0] in "seiu?":
+            return
+        else:
+            why = "types %s and label differ" % _show(et)
+        self.fail(PlutoTypeError, "activity %s: argument %s takes one of %s, got %s: %s"
+                  % (path, name, ", ".join(known), self.operand(v, et), why), p)  # fmt: skip
 
 
 def closest_argument(name, names):

@@ -473,6 +473,10 @@ class Sdb:
             fd = FunctionDef(fid, name, args, _labels(f.get("arguments", ()), "id", name))
             self.functions[fid] = fd
             self._functions_by_name[name] = fd
+            if "." in name and name not in self.operations:  # PLUTO checks its arguments
+                sig = [(a["name"], a["type"], a.get("unit")) for a in f.get("arguments", ())]
+                comp, op = name.split(".", 1)
+                self.operations[name] = OperationDef(comp, op, [(s[0], s[2]) for s in sig], sig)
 
     def _load_spacecraft(self, doc):
         pos = doc.get("position_scheduling")

@@ -3,10 +3,9 @@ find_events on the same TLE, a week of passes over three stations, AOS, culminat
 within 2 s, and no pass missing or extra."""
 
 import pytest
+import skyfield.api as skyfield_api
 from obsw_host.ops.passes import Predictor, Station
 from obsw_host.ops.tle import TleError, checksum, parse
-
-skyfield_api = pytest.importorskip("skyfield.api", reason="skyfield is the oracle (dev extra)")
 
 LINE1 = "1 99001U 26001A   26332.50000000  .00001000  00000-0  50000-4 0  9999"
 LINE2 = "2 99001  97.4000 330.0000 0001000  90.0000 270.0000 15.20000000   105"

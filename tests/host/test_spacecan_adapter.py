@@ -4,10 +4,8 @@ import importlib.util
 import pathlib
 import uuid
 
+import can as can
 import pytest
-
-can = pytest.importorskip("can")
-
 from obsw.spacecan import events as ev  # noqa: E402
 from obsw.spacecan.controller import COMPLETED, TIMEOUT, Controller, FailoverPolicy  # noqa: E402
 from obsw.spacecan.nodedef import NodeDefinition  # noqa: E402

@@ -6,10 +6,8 @@ import json
 import os
 import uuid
 
+import can as can
 import pytest
-
-can = pytest.importorskip("can")
-
 from obsw.il.errors import ComponentError  # noqa: E402
 from obsw.il.node import Node  # noqa: E402
 from obsw.spacecan.equipment import Equipment, equipment_interface  # noqa: E402

@@ -2,15 +2,13 @@
 
 import struct
 
-import pytest
+import puslib.parameter as puslib_parameter
+import puslib.time as puslib_time
+import spacepackets.ccsds.time as sp_time
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from obsw.pus.fields import field
 from obsw.timecode import Cds, Cuc
-
-puslib_parameter = pytest.importorskip("puslib.parameter")
-puslib_time = pytest.importorskip("puslib.time")
-sp_time = pytest.importorskip("spacepackets.ccsds.time")
 
 SETTINGS = settings(max_examples=200, deadline=None)
 P = puslib_parameter

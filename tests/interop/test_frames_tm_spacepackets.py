@@ -1,9 +1,6 @@
 """TM transfer frames against spacepackets' TmTransferFrame, in both directions."""
 
-import pytest
-
-pytest.importorskip("spacepackets")
-
+import spacepackets  # noqa: F401
 from obsw.crc import crc16_ccitt  # noqa: E402
 from obsw.frames.clcw import Clcw  # noqa: E402
 from obsw.frames.tm import TmFrame  # noqa: E402

@@ -6,15 +6,13 @@ import asyncio
 import threading
 import time
 
-import pytest
+import kiss as kiss
+import kiss.util as kiss_util
 from obsw.frames import kiss as ours
 from obsw.frames.cltu import encode as cltu_encode
 from obsw.frames.tm_coding import TmDecoder, TmEncoder
 from obsw_host.frames.ground import Ground
 from obsw_host.frames.radio import KissTcpServer
-
-kiss = pytest.importorskip("kiss", reason="kiss3 (PyPI) is the KISS peer")
-kiss_util = pytest.importorskip("kiss.util")
 
 SCID = 0x2A
 LENGTH = 128

@@ -1,12 +1,9 @@
 """Interop with puslib (PyPI) as an oracle: PUS-C TCs and TMs in several layouts, both ways."""
 
-import pytest
+import puslib.packet as pl_packet
+import puslib.time as pl_time
 from hypothesis import given
 from hypothesis import strategies as st
-
-pl_packet = pytest.importorskip("puslib.packet")
-pl_time = pytest.importorskip("puslib.time")
-
 from obsw.pus.config import PusConfig  # noqa: E402
 from obsw.pus.tc import PusTc  # noqa: E402
 from obsw.pus.tm import PusTm  # noqa: E402

@@ -3,13 +3,11 @@
 import struct
 
 import pytest
+import spacepackets.ccsds.spacepacket as sp_ccsds
+import spacepackets.ecss.tc as sp_tc
+import spacepackets.ecss.tm as sp_tm
 from hypothesis import given
 from hypothesis import strategies as st
-
-sp_ccsds = pytest.importorskip("spacepackets.ccsds.spacepacket")
-sp_tc = pytest.importorskip("spacepackets.ecss.tc")
-sp_tm = pytest.importorskip("spacepackets.ecss.tm")
-
 from obsw import spp  # noqa: E402
 from obsw.pus.config import PusConfig  # noqa: E402
 from obsw.pus.tc import PusTc  # noqa: E402

@@ -13,11 +13,9 @@ import time
 import types
 import uuid
 
+import can as can
 import pytest
-
-can = pytest.importorskip("can")
-spacecan = pytest.importorskip("spacecan")
-
+import spacecan as spacecan
 from obsw.spacecan import events as ev  # noqa: E402
 from obsw.spacecan.controller import COMPLETED, REJECTED, TIMEOUT, Controller  # noqa: E402
 from obsw.spacecan.nodedef import NodeDefinition  # noqa: E402

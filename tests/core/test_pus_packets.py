@@ -364,6 +364,8 @@ class TestRequestIdAndTypeBit(unittest.TestCase):
         self.assertEqual((r.version, r.packet_type, r.sec_header_flag, r.apid), (0, 1, 1, 0x73))
         self.assertEqual((r.seq_flags, r.seq_count), (3, 25))
         self.assertEqual(RequestId.from_words(0x1073, 0xC019).sec_header_flag, 0)
+        self.assertEqual(RequestId.from_words(0x3873, 0xC019).version, 1)  # its 3 top bits
+        self.assertEqual(RequestId.from_words(0xF873, 0xC019).version, 7)
 
     def test_equal_only_when_both_words_are(self):
         r = RequestId.from_words(0x1873, 0xC019)

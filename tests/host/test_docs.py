@@ -144,6 +144,7 @@ def test_the_obc_configurations_shown_are_accepted(tmp_path):
         "boards/raspberry-pi/mission.json",
         "docs/mission.md",
         "docs/fly-your-own-spacecraft.md",
+        "docs/plug-ins.md",
     }
     for page, doc in configs:
         config = MissionConfig(doc, str(tmp_path / "mission.json"))

@@ -207,14 +207,22 @@ def dims(text):
     return parse(text)[1] if text else NONE
 
 
+# this interpreter's float: double on CPython and the unix port, single on a board, where
+# 1/1e-3 is 999.99994: a change of decimal prefix is rounded to the digits the float holds
+_SINGLE = 1.0 + 1e-9 == 1.0
+_DIGITS = "%.6g" if _SINGLE else "%.15g"
+_EPS = 1e-6 if _SINGLE else 1e-12
+
+
 def _decimal(ratio):
-    """True when ``ratio`` is a power of ten (a change of decimal prefix only)."""
+    """True when ``ratio`` is a power of ten (a change of decimal prefix only), to the
+    precision of the interpreter's float."""
     p = 1.0
     n = 0
-    while p < ratio and n < 40:  # no float literal beyond single precision: boards freeze this
+    while p < ratio * (1 - _EPS) and n < 40:  # no float literal beyond single precision
         p *= 10
         n += 1
-    return p == ratio
+    return abs(p - ratio) <= _EPS * p
 
 
 class Quantity:
@@ -245,7 +253,7 @@ class Quantity:
             v = self.value / ratio
         if not off and type(v) is float and v - v == 0 and _decimal(ratio):
             # decimal prefixes are not exact in binary: 3300 mV is 3.3 V, not 3.3000000000000003
-            v = float("%.15g" % v)
+            v = float(_DIGITS % v)
         if type(self.value) is int and v == int(v):
             v = int(v)
         return Quantity(v, unit)

@@ -101,6 +101,7 @@ CORTEX_M_SKIPS = {
     "test_pluto_il.py::TestNames::test_describe_from_sdb_document": FLOAT,
     "test_pluto_il.py::TestParameters::test_wait_until_parameter": FLOAT,
     "test_pluto_interp.py": FLOAT,
+    "test_pluto_annex_a_clauses.py": FLOAT,
     "test_pluto_lexer.py::TestUnits::test_conversion_and_offset": FLOAT,
     "test_pluto_lexer.py::TestUnits::test_iso_round_trip": FLOAT,
     "test_pus_fields_numeric.py::TestReal::test_ieee": FLOAT,

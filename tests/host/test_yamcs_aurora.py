@@ -145,7 +145,6 @@ class Aurora:
         self.startup = time.monotonic() - t0
         self.client = YamcsClient("127.0.0.1:%d" % self.http)
         self.processor = self.client.get_processor(self.instance, "realtime")
-        self.commands = self.processor.create_command_connection()
         self.values, self.events, self.transfers = Watch(), Watch(), Watch()
 
         def on_values(data):
@@ -162,8 +161,14 @@ class Aurora:
         self.subscriptions.append(files.create_transfer_subscription(on_data=self.transfers))
 
     def issue(self, name, args=None):
-        cmd = self.commands.issue("/%s/%s" % (self.instance, name), args=args)
-        cmd.await_complete(timeout=TIMEOUT)
+        # a command connection of its own (a websocket) per command: a long-lived one was
+        # found closed under load after the long CFDP upload, its completion never heard
+        commands = self.processor.create_command_connection()
+        try:
+            cmd = commands.issue("/%s/%s" % (self.instance, name), args=args)
+            cmd.await_complete(timeout=TIMEOUT)
+        finally:
+            commands.cancel()  # its websocket closed
         return cmd
 
     def close(self):

@@ -131,11 +131,16 @@ def obc(tmp_path):
     proc, out, err = start("obc", "serve", mission, env=env)
     both = Lines.merged(out, err)
     both.until(lambda line: " up: " in line)
+    before = ENV.get("OBSW_MISSION")
     ENV["OBSW_MISSION"] = str(mission)  # the ground commands of the test use this mission
     try:
         yield base + 10, both
     finally:
-        ENV.pop("OBSW_MISSION", None)
+        # as it was: the tests after it in this process use the sample (tests/conftest.py)
+        if before is None:
+            ENV.pop("OBSW_MISSION", None)
+        else:
+            ENV["OBSW_MISSION"] = before
         stop(proc)
 
 

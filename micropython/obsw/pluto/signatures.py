@@ -96,7 +96,6 @@ class SignatureChecker:
             self.fail(PlutoTypeError, "activity %s: argument %s takes %s, got %s: %s"
                       % (path, name, _a(want), self.operand(v, et), why), p)  # fmt: skip
 
-
     def label_argument(self, path, name, labels, v, et, p):
         """A label of the enumeration (a string constant checked at load time), a number of
         it, or a string the procedure computes (checked when it runs)."""

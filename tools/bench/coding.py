@@ -15,28 +15,16 @@ import pathlib
 import random
 import statistics
 import sys
-import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT / "micropython"), str(ROOT / "tests" / "interop")]
 
+from measure import rate  # noqa: E402
 from obsw.frames import conv, rs, viterbi  # noqa: E402
 
 LINK = 2_000_000  # channel bit/s of the S-band goal
 GROUND_SHARE = 1.0  # one core
 OBC_SHARE = 0.05
-
-
-def timed(fn, seconds):
-    """Calls per second of ``fn`` over about ``seconds``."""
-    n = 0
-    t0 = time.perf_counter()
-    while True:
-        fn()
-        n += 1
-        dt = time.perf_counter() - t0
-        if dt >= seconds:
-            return n / dt
 
 
 def cases(quick):
@@ -116,10 +104,10 @@ def main(argv=None):
         if peer is not None:
             peer()
         for _ in range(repeats):
-            o = timed(fn, seconds)
+            o = rate(fn, seconds, 1)
             ours_runs.append(o)
             if peer is not None:
-                t = timed(peer, seconds)
+                t = rate(peer, seconds, 1)
                 theirs_runs.append(t)
                 ratios.append(o / t)
         if name.endswith("Python loop"):  # measured on 64 octets: per CADU

@@ -17,7 +17,6 @@ from rich.live import Live
 from rich.table import Table
 
 from obsw_host.commands import session
-from obsw_host.commands.ground_console import LOS_AFTER
 from obsw_host.errors import user_message
 from obsw_host.mission import ids as mission_ids
 from obsw_host.obc.state import default_state
@@ -34,7 +33,7 @@ CONSOLE_KEYS = ("func", "action", "history", "once", "count", "every", "seconds"
 # ------------------------------------------------------------------------------ watch
 
 
-def render(picture, los_after=LOS_AFTER):
+def render(picture, los_after):
     """The picture as rich tables: values, events, commands; at loss of signal the values are
     dimmed and their limit column says so. What came from the spacecraft is escaped: no
     control character and no rich markup of its own reaches the terminal."""

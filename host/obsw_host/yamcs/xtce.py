@@ -9,9 +9,11 @@
 - the parameters in one sub-system per component (``/MISSION/SolarPanel/angle``) with their
   types, units, calibrations and alarm limits where the database gives them;
 - the telecommands: an abstract ``pus_tc`` whose verifiers follow the service 1 reports
-  (acceptance, start, completion, by APID and sequence count), services 3, 5, 8 (one command
-  per function with its typed arguments), 11, 12 (a limit check for each parameter with
-  limits), 17, 18, 20 (one set command per writable parameter, its range checked) and 23;
+  (acceptance, start, completion, by APID and sequence count); the standard services'
+  commands, each walked from the layout the OBC decodes it with (``command_layouts``); from
+  the database, services 8 (one command per function with its typed arguments), 12 (a limit
+  check for each parameter with limits) and 20 (one set command per writable parameter, its
+  range checked);
 - the mission's own services (types 128..255): a command per request, a container per report.
 """
 
@@ -20,11 +22,15 @@ import xml.etree.ElementTree as ET
 from obsw.pus import messages as M
 from obsw.pus.calibration import CalibrationError, Values
 from obsw.pus.config import PusConfig
-from obsw.pus.fields import field
+from obsw.pus.fields import PTC_UNSIGNED, field
 from obsw.pus.packets import ACK_ALL
+from obsw.pus.ptc_strings import OctetString
+from obsw.pus.ptc_time import AbsoluteTime
 from obsw.pus.services.s01_verification import FAILURE_NAMES
 from obsw.pus.services.s12_layouts import STATUS_NAMES
+from obsw.pus.structure import Repeated, Structure
 
+from obsw_host.yamcs.command_layouts import APID, COMMANDS, Arg, Fixed
 from obsw_host.yamcs.report_layouts import report_layouts
 from obsw_host.yamcs.xtce_reports import CHECK_ALARMS, PID, TRANSITION, ReportWriter
 from obsw_host.yamcs.xtce_types import (
@@ -33,11 +39,13 @@ from obsw_host.yamcs.xtce_types import (
     octets_argument_type,
     octets_type,
     parameter_type,
+    text_argument_type,
 )
 
 XTCE_NS = "http://www.omg.org/spec/XTCE/20180204"
 U8, U16, U32, E8, E16 = (3, 4), (3, 12), (3, 14), (2, 8), (2, 16)
 SEVERITY_LEVELS = {1: "watch", 2: "warning", 3: "distress", 4: "critical"}
+_UNSIGNED_PFC = {8: 4, 16: 12, 24: 13, 32: 14}  # PTC 3: PFC by width in bits
 
 
 class XtceNameError(ValueError):
@@ -148,6 +156,11 @@ class Generator:
         self.entries = {}  # parameter id -> its container entries (a length before octets)
         self.apid = sc.required_apid("pus")
         self.source_id = ids.source_id if ids is not None else 0
+        self.labels = {  # the values of a command argument by their names in the mission
+            "sid": {s.sid: "sid_%d" % s.sid for s in sc.structures} or None,
+            "event": {e.id: _label(e.qualified) for e in sc.events.values()},
+            "parameter": {pid: _label(p.qualified) for pid, p in sc.params.items()},
+        }
 
     # ------------------------------------------------------------------ helpers
     def system_of(self, parts):
@@ -463,230 +476,54 @@ class Generator:
         system.commands.append(cmd)
 
     def service_commands(self):
-        sc = self.sc
+        """The standard services' commands, each walked from the layout the OBC decodes it
+        with (``command_layouts``)."""
         pus = self.root.child("PUS")
-        sid_labels = {s.sid: "sid_%d" % s.sid for s in sc.structures}
-        ev_labels = {e.id: _label(e.qualified) for e in sc.events.values()}
+        for name, msg_type, layout, description, arguments in COMMANDS:
+            fields = self.layout_fields(layout.fields, arguments, top=True)
+            self.command(pus, name, msg_type, fields, description)
 
-        def sid_arg():
-            return ("arg", "sid", argument_type("", U16, labels=sid_labels or None))
+    def layout_fields(self, fields, arguments, top=False):
+        """The command entries of a layout's ``fields`` (see ``command_layouts``)."""
+        out = []
+        for fname, ftype in fields:
+            spec = arguments.get(fname, fname)
+            if isinstance(spec, str):
+                spec = Arg(spec)
+            if isinstance(ftype, Repeated):
+                count = 0 if isinstance(spec, Fixed) else 1
+                first = top and not any(f[1] == "n" for f in out)
+                counter = "n" if first else getattr(spec, "name", fname) + "_count"
+                out.append(("fixed", counter, count, ftype.counter.bits))
+                if count:
+                    item = ftype.item
+                    item = item.fields if isinstance(item, Structure) else item
+                    if isinstance(item, list):
+                        out += self.layout_fields(item, arguments)
+                    else:
+                        out += self.layout_fields([(fname, item)], arguments)
+            elif isinstance(spec, Fixed):
+                value = self.apid if spec.value == APID else spec.value
+                out.append(("fixed", fname, value, ftype.bits))
+            elif isinstance(ftype, AbsoluteTime):  # CUC: the seconds, a fraction of 0
+                code = ftype.code
+                seconds = field(PTC_UNSIGNED, _UNSIGNED_PFC[8 * code.coarse])
+                out.append(("arg", spec.name + "_seconds", self.argument(seconds, spec)))
+                out.append(("fixed", spec.name + "_fraction", 0, 8 * code.fine))
+            else:
+                out.append(("arg", spec.name, self.argument(ftype, spec)))
+        return out
 
-        one16 = ("fixed", "n", 1, 16)
-        one8 = ("fixed", "n", 1, 8)
-        self.command(pus, "ping", M.TC_TEST_ARE_YOU_ALIVE, description="TC[17,1] are you alive")
-        self.command(
-            pus,
-            "connection_test",
-            M.TC_TEST_ON_BOARD_CONNECTION,
-            [("arg", "target_apid", argument_type("", U16, valid=(0, 2047)))],
-            "TC[17,3] on-board connection test",
-        )
-        self.command(pus, "hk_enable", M.TC_HK_ENABLE_HK_REPORTS, [one16, sid_arg()])
-        self.command(pus, "hk_disable", M.TC_HK_DISABLE_HK_REPORTS, [one16, sid_arg()])
-        self.command(pus, "hk_one_shot", M.TC_HK_ONE_SHOT_HK, [one16, sid_arg()])
-        self.command(
-            pus,
-            "hk_interval",
-            M.TC_HK_MODIFY_HK_INTERVAL,
-            [one16, sid_arg(), ("arg", "interval", argument_type("", U16, valid=(1, 65535)))],
-        )
-
-        def ev():
-            return ("arg", "event", argument_type("", E16, labels=ev_labels))
-
-        self.command(pus, "event_enable", M.TC_EVENT_ENABLE, [one8, ev()])
-        self.command(pus, "event_disable", M.TC_EVENT_DISABLE, [one8, ev()])
-        self.command(pus, "event_report_disabled", M.TC_EVENT_REPORT_DISABLED)
-        for name, mt in (
-            ("schedule_enable", M.TC_SCHED_ENABLE),
-            ("schedule_disable", M.TC_SCHED_DISABLE),
-            ("schedule_reset", M.TC_SCHED_RESET),
-            ("schedule_detail_all", M.TC_SCHED_DETAIL_REPORT_ALL),
-            ("schedule_summary_all", M.TC_SCHED_SUMMARY_REPORT_ALL),
-            ("monitoring_enable", M.TC_MON_ENABLE_PARAMETER_MONITORING_FUNCTION),
-            ("monitoring_disable", M.TC_MON_DISABLE_PARAMETER_MONITORING_FUNCTION),
-            ("monitors_report", M.TC_MON_REPORT_PARAMETER_MONITORING),
-            ("obcp_abort_all", M.TC_OBCP_ABORT_ALL),
-        ):
-            self.command(pus, name, mt)
-
-        def pmon():
-            return ("arg", "pmon", argument_type("", U16))
-
-        self.command(pus, "monitor_enable", M.TC_MON_ENABLE_PARAMETER_MONITORING, [one16, pmon()])
-        self.command(
-            pus, "monitor_disable", M.TC_MON_DISABLE_PARAMETER_MONITORING, [one16, pmon()]
-        )
-        param_labels = {pid: _label(p.qualified) for pid, p in sc.params.items()}
-        self.command(
-            pus,
-            "parameters_report",
-            M.TC_PARAM_REPORT_VALUES,
-            [one8, ("arg", "parameter", argument_type("", U16, labels=param_labels))],
-            "TC[20,1] report one parameter's value",
-        )
-        self.obcp_commands(pus)
-        self.file_commands(pus)
-        self.memory_storage_commands(pus)
-
-    def obcp_commands(self, pus):
-        def obcp():
-            return ("arg", "obcp", argument_type("", (8, 8)))
-
-        levels = {0: "none", 1: "procedure", 2: "step", 3: "statement"}
-        no_args = ("fixed", "argument_count", 0, 8)
-        self.command(
-            pus,
-            "obcp_load",
-            M.TC_OBCP_LOAD_DIRECT,
-            [obcp(), ("arg", "code", argument_type("", (8, 0))), no_args],
-            "TC[18,1] load a PLUTO procedure given as text",
-        )
-        self.command(
-            pus,
-            "obcp_activate",
-            M.TC_OBCP_ACTIVATE,
-            [obcp(), ("arg", "level", argument_type("", E8, labels=levels)), no_args],
-        )
-        for name, mt in (
-            ("obcp_unload", M.TC_OBCP_UNLOAD),
-            ("obcp_stop", M.TC_OBCP_STOP),
-            ("obcp_suspend", M.TC_OBCP_SUSPEND),
-            ("obcp_resume", M.TC_OBCP_RESUME),
-            ("obcp_abort", M.TC_OBCP_ABORT),
-        ):
-            self.command(pus, name, mt, [obcp()])
-
-    def file_commands(self, pus):
-        def path(name):
-            return ("arg", name, argument_type("", (8, 0)))
-
-        self.command(
-            pus,
-            "file_create",
-            M.TC_FILE_CREATE,
-            [path("repository"), path("file"), ("arg", "max_size", argument_type("", U32))],
-        )
-        self.command(pus, "file_delete", M.TC_FILE_DELETE, [path("repository"), path("file")])
-        self.command(
-            pus,
-            "file_copy",
-            M.TC_FILE_COPY,
-            [
-                ("arg", "operation", argument_type("", U16)),
-                path("source_repository"),
-                path("source_file"),
-                path("target_repository"),
-                path("target_file"),
-            ],
-            "TC[23,14] copy a file (by CFDP between SAT: and GROUND:)",
-        )
-
-    # ------------------------------------------------------------------ services 6, 15, 21, 22
-    def memory_storage_commands(self, pus):
-        """Service 6 (the loads that carry their data in the TC are the CLI's: XTCE loads
-        from files), 15 (copy by time window, diagnostic storage control), 21 (sequences by
-        reference) and 22 (orbit number)."""
-
-        def u(name, pair):
-            return ("arg", name, argument_type("", pair))
-
-        def path(name):
-            return ("arg", name, argument_type("", (8, 0)))
-
-        one = ("fixed", "n", 1, 8)
-
-        def mem():  # each command gets its own argument type elements
-            return u("memory", U16)
-
-        def obj():
-            return u("object", U16)
-
-        def rng(first="address"):
-            return [u(first, U32), u("length", U32)]
-
-        def files():
-            return [path("repository"), path("file")]
-
-        self.command(pus, "memory_abort_dumps", M.TC_MEM_ABORT_ALL_DUMPS, (), "TC[6,12]")
-        for name, mt in (
-            ("memory_scrub_enable", M.TC_MEM_ENABLE_SCRUBBING),
-            ("memory_scrub_disable", M.TC_MEM_DISABLE_SCRUBBING),
-            ("memory_protect", M.TC_MEM_ENABLE_WRITE_PROTECTION),
-            ("memory_unprotect", M.TC_MEM_DISABLE_WRITE_PROTECTION),
-        ):
-            self.command(pus, name, mt, [mem()], "TC[%d,%d]" % mt)
-        for name, mt, fields in (
-            ("memory_dump", M.TC_MEM_DUMP_RAW, lambda: [mem(), one] + rng()),
-            ("memory_check", M.TC_MEM_CHECK_RAW, lambda: [mem(), one] + rng()),
-            (
-                "memory_dump_object",
-                M.TC_MEM_DUMP_OBJECT,
-                lambda: [mem(), obj(), one] + rng("offset"),
-            ),
-            (
-                "memory_check_object",
-                M.TC_MEM_CHECK_OBJECT,
-                lambda: [mem(), obj(), one] + rng("offset"),
-            ),
-            ("memory_check_whole_object", M.TC_MEM_CHECK_OBJECT_WHOLE, lambda: [mem(), obj()]),
-            (
-                "memory_load_file",
-                M.TC_MEM_LOAD_RAW_BY_REFERENCE,
-                lambda: [mem(), one, u("address", U32)] + files() + [u("crc", U16)],
-            ),
-            (
-                "memory_dump_file",
-                M.TC_MEM_DUMP_RAW_TO_FILE,
-                lambda: [mem(), one] + rng() + files(),
-            ),
-            (
-                "memory_load_object_file",
-                M.TC_MEM_LOAD_OBJECT_BY_REFERENCE,
-                lambda: [mem(), obj(), one, u("offset", U32)] + files() + [u("crc", U16)],
-            ),
-            (
-                "memory_dump_object_file",
-                M.TC_MEM_DUMP_OBJECT_TO_FILE,
-                lambda: [mem(), obj(), one] + rng("offset") + files(),
-            ),
-        ):
-            self.command(pus, name, mt, fields(), "TC[%d,%d]" % mt)
-        # ST[15]: time tags as the CUC coarse (seconds) and fine (1/65536 s) parts
-        windows = {0: "from_to", 1: "after", 2: "before"}
-        self.command(
-            pus,
-            "store_copy",
-            M.TC_STORE_COPY_BY_TIME_WINDOW,
-            [
-                ("arg", "window", argument_type("", E8, labels=windows)),
-                u("tag1_seconds", U32),
-                ("fixed", "tag1_fraction", 0, 16),
-                u("tag2_seconds", U32),
-                ("fixed", "tag2_fraction", 0, 16),
-                u("source", U16),
-                u("target", U16),
-            ],
-            "TC[15,24] copy the packets of a time window into an empty store",
-        )
-        for name, mt in (
-            ("store_diag_add", M.TC_STORE_ADD_DIAG_STRUCTURES),
-            ("store_diag_delete", M.TC_STORE_DELETE_DIAG_STRUCTURES),
-        ):
-            fields = [u("store", U16), one, ("fixed", "apid", self.apid, 16)]
-            fields += [("fixed", "sid_count", 1, 8), u("sid", U16)]
-            self.command(pus, name, mt, fields, "TC[%d,%d]" % mt)
-        self.command(
-            pus, "store_diag_report", M.TC_STORE_REPORT_DIAG_STRUCTURES, [u("store", U16)]
-        )
-        # ST[21] sequences from files, ST[22] the orbit number
-        for name, mt in (
-            ("sequence_load_file", M.TC_SEQUENCE_LOAD_BY_REFERENCE),
-            ("sequence_load_file_activate", M.TC_SEQUENCE_LOAD_AND_ACTIVATE),
-        ):
-            fields = [("arg", "sequence", argument_type("", (8, 8)))]
-            self.command(pus, name, mt, fields + files())
-        self.command(pus, "position_set_orbit", M.TC_POS_SCHED_SET_ORBIT_NUMBER, [u("orbit", U32)])
+    def argument(self, ftype, spec):
+        """The argument type of a field: its PTC/PFC, the mission's labels, its valid range; a
+        variable string of characters or octets is text after its leading length (the
+        operator types a path or a procedure; binary loads are the CLI's)."""
+        if isinstance(ftype, OctetString) and not ftype.pfc:
+            return text_argument_type("", ftype.length_bits)
+        labels = spec.labels
+        if isinstance(labels, str):
+            labels = self.labels[labels]
+        return argument_type("", (ftype.ptc, ftype.pfc), valid=spec.valid, labels=labels)
 
     def parameter_commands(self):
         for pid in sorted(self.sc.params):
@@ -865,7 +702,7 @@ class Generator:
         self.function_commands()
         self.functional_monitoring()
         self.parameter_definitions()
-        self.services_2_3_9_14()
+        self.time_reports()
         self.mission_services()
         return self.root.element()
 
@@ -898,11 +735,9 @@ class Generator:
                 self.report(_label(rep.qualified), (stype, sub), refs)
 
     # ------------------------------------------------------------------ services 2, 3, 9, 14
-    def services_2_3_9_14(self):
-        """Commands of device access, diagnostics, functional reporting, time and diagnostic
-        forwarding, one item per command (N = 1); the time reports (their other reports come
-        from their layouts: ``reports``)."""
-        r = self.root
+    def time_reports(self):
+        """The time reports and the diagnostic report's header (the other reports come from
+        their layouts: ``reports``)."""
         exponent = self.header_param("time_rate_exponent", 8)
         status = self.header_param("time_reference_status", 8)
         cuc = [self.header_param("cuc_coarse", 32), self.header_param("cuc_fine", 16)]
@@ -911,92 +746,6 @@ class Generator:
         self.report("cds_time_report", M.TM_TIME_CDS_REPORT, [exponent] + cds + [status])
         diag_sid = self.header_param("diag_structure_id", 16)
         self.report("diag_report", M.TM_HK_DIAG_REPORT, [diag_sid])
-
-        pus = r.child("PUS")
-        one8, one16 = ("fixed", "n", 1, 8), ("fixed", "n", 1, 16)
-        none16 = ("fixed", "nfa", 0, 16)
-        pids = {pid: _label(p.qualified) for pid, p in self.sc.params.items()}
-
-        def arg(name, pair, valid=None, labels=None):
-            return ("arg", name, argument_type("", pair, valid=valid, labels=labels))
-
-        self.command(
-            pus,
-            "time_rate",
-            M.TC_TIME_SET_REPORT_RATE,
-            [arg("exponent", U8, (0, 16))],
-            "TC[9,1] a report every 2**exponent s",
-        )
-        self.command(
-            pus,
-            "device_on_off",
-            M.TC_DEVICE_ON_OFF,
-            [one8, arg("address", U16)],
-            "TC[2,1] on/off device command",
-        )
-        self.command(
-            pus,
-            "device_register_load",
-            M.TC_DEVICE_REGISTER_LOAD,
-            [one8, arg("address", U32), arg("value", U32)],
-            "TC[2,2] register load",
-        )
-        self.command(
-            pus,
-            "device_register_dump",
-            M.TC_DEVICE_REGISTER_DUMP,
-            [one8, arg("address", U32)],
-            "TC[2,5] register dump",
-        )
-        self.command(
-            pus,
-            "device_cpdu",
-            M.TC_DEVICE_CPDU,
-            [one8, arg("line", U16), arg("duration_ms", U16)],
-            "TC[2,4] CPDU command",
-        )
-        for name, msg_type in (
-            ("diag_enable", M.TC_HK_ENABLE_DIAG_REPORTS),
-            ("diag_disable", M.TC_HK_DISABLE_DIAG_REPORTS),
-            ("diag_one_shot", M.TC_HK_ONE_SHOT_DIAG),
-            ("diag_delete", M.TC_HK_DELETE_DIAG_STRUCTURES),
-            ("diag_structures", M.TC_HK_REPORT_DIAG_STRUCTURES),
-            ("diag_properties", M.TC_HK_REPORT_DIAG_PERIODIC_PROPERTIES),
-        ):
-            self.command(pus, name, msg_type, [one16, arg("sid", U16)])
-        self.command(
-            pus,
-            "diag_interval",
-            M.TC_HK_MODIFY_DIAG_INTERVAL,
-            [one16, arg("sid", U16), arg("interval", U16, (1, 65535))],
-        )
-        for name, msg_type in (
-            ("hk_append", M.TC_HK_APPEND_HK_PARAMETERS),
-            ("diag_append", M.TC_HK_APPEND_DIAG_PARAMETERS),
-        ):
-            self.command(
-                pus,
-                name,
-                msg_type,
-                [arg("sid", U16), one16, arg("parameter", U16, labels=pids), none16],
-            )
-        for name, msg_type in (
-            ("functional_apply", M.TC_HK_APPLY_FUNCTIONAL_REPORTING),
-            ("functional_delete", M.TC_HK_DELETE_FUNCTIONAL_REPORTING),
-            ("functional_report", M.TC_HK_REPORT_FUNCTIONAL_REPORTING),
-        ):
-            self.command(pus, name, msg_type, [one16, arg("definition", U16)])
-        for name, msg_type in (
-            ("forward_diag_add", M.TC_FWD_ADD_DIAG_STRUCTURES),
-            ("forward_diag_delete", M.TC_FWD_DELETE_DIAG_STRUCTURES),
-        ):
-            self.command(
-                pus,
-                name,
-                msg_type,
-                [one8, arg("apid", U16, (0, 2047)), ("fixed", "n2", 1, 8), arg("sid", U16)],
-            )
-        self.command(pus, "forward_diag_report", M.TC_FWD_REPORT_DIAG_STRUCTURES)
 
 
 def _value_argument(p):

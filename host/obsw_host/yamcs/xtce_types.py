@@ -179,6 +179,14 @@ def octets_argument_type(name, pair, length_arg=None):
     )
 
 
+def text_argument_type(name, length_bits=16):
+    """A variable string argument: UTF-8 octets after a ``length_bits`` wide leading length."""
+    t = ET.Element("StringArgumentType", name=name)
+    _units(t, None)
+    _string_encoding(t, length_bits)
+    return t
+
+
 def argument_type(name, pair, unit=None, valid=None, labels=None, calibration=None):
     """An argument type; ``valid`` (low, high) bounds the values a user may give; a linear
     ``calibration`` makes it an engineering value that Yamcs turns into the raw one."""

@@ -4,6 +4,7 @@ import unittest
 
 from obsw import spp
 from obsw.pus import messages
+from obsw.pus.any_packet import unpack_packet
 from obsw.pus.config import DEFAULT, PusConfig
 from obsw.pus.packets import (
     ACK_ACCEPTANCE,
@@ -15,7 +16,6 @@ from obsw.pus.packets import (
     PusVersionError,
     RequestId,
     failure_code,
-    unpack_packet,
 )
 from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm

@@ -18,8 +18,9 @@ from obsw.frames.tc import TcFrame, parse_control_command, set_vr_command
 from obsw.frames.tm import TmFrame
 from obsw.pluto.lexer import PlutoError, tokenize
 from obsw.pluto.parser import parse
+from obsw.pus.any_packet import unpack_packet
 from obsw.pus.fields import FieldValueError, field
-from obsw.pus.packets import PusError, unpack_packet
+from obsw.pus.packets import PusError
 from obsw.pus.sdb import SdbError
 from obsw.pus.sdb import loads as sdb_loads
 from obsw.pus.structure import Repeated, Structure

@@ -4,8 +4,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 from obsw import spp
 from obsw.crc import crc16_ccitt
+from obsw.pus.any_packet import unpack_packet
 from obsw.pus.config import PusConfig
-from obsw.pus.packets import PusError, unpack_packet
+from obsw.pus.packets import PusError
 from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm
 from obsw.timecode import Cds, Cuc

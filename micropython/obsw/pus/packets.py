@@ -1,7 +1,9 @@
-"""What PUS-C TC and TM packets share: PUS version, errors, request IDs, length and PEC checks."""
+"""What PUS-C TC and TM packets share: the ``PusPacket`` base (primary header fields, framing,
+length and PEC checks, refused fields), PUS version, errors, request IDs."""
 
 from obsw.compat import Struct, const
 from obsw.crc import crc16_ccitt
+from obsw.crc import crc16_ccitt_update as _crc
 from obsw.errors import too_short, wrong_length
 from obsw.pus.config import DEFAULT
 from obsw.spp import SEQ_UNSEGMENTED, TYPE_TC, FieldRangeError, SppError
@@ -155,68 +157,109 @@ class RequestId:
         )
 
 
-def _range(field, value, maximum):
+def check_range(field, value, maximum):
+    """FieldRangeError unless ``value`` is an integer in 0..``maximum``."""
     if not isinstance(value, int) or value < 0 or value > maximum:
         raise FieldRangeError(field, value, maximum)
 
 
-def _refused(p, config, total):
-    """Why struct.pack refused ``p``: FieldRangeError for an integer out of range, TypeError for
-    a value that is no integer, or None (the caller then re-raises struct's own error)."""
-    try:
-        p._check(config, total)
-    except FieldRangeError as e:
-        if isinstance(e.value, int):
-            return e
-        return TypeError("%s must be an integer, not %r" % (e.field, e.value))
-    except Exception:  # a malformed value the checks themselves trip over
-        pass
-    return None
+class PusPacket:
+    """What a PUS-C TC and TM have alike: the primary header's fields and words, framing and
+    its checks, the PEC, and how a refused field is reported. ``PusTc`` and ``PusTm`` add
+    their secondary headers; ``KIND`` is "TC" or "TM", ``ID`` the packet ID without the APID
+    (version 0, the packet type, secondary header flag 1)."""
+
+    __slots__ = ()
+    KIND = ""
+    ID = 0
+
+    @property
+    def packet_id(self):
+        return self.ID | self.apid
+
+    @property
+    def sequence_control(self):
+        return (self.seq_flags << 14) | self.seq_count
+
+    @property
+    def message_type(self):
+        return (self.service, self.subtype)
+
+    @classmethod
+    def unpack_from(cls, buf, offset=0, config=DEFAULT):
+        """Decode the packet at ``offset``; returns ``(packet, end_offset)``."""
+        return cls._decode(buf, offset, config, False)
+
+    def _check_primary(self):
+        check_range("APID", self.apid, 0x7FF)
+        check_range("sequence count", self.seq_count, 0x3FFF)
+        check_range("sequence flags", self.seq_flags, 3)
+        check_range("service type", self.service, 255)
+        check_range("message subtype", self.subtype, 255)
+
+    def _refused(self, config, total):
+        """Why struct.pack refused this packet: FieldRangeError for an integer out of range,
+        TypeError for a value that is no integer, or None (the caller then re-raises struct's
+        own error)."""
+        try:
+            self._check(config, total)
+        except FieldRangeError as e:
+            if isinstance(e.value, int):
+                return e
+            return TypeError("%s must be an integer, not %r" % (e.field, e.value))
+        except Exception:  # a malformed value the checks themselves trip over
+            pass
+        return None
+
+    def _sealed(self, c, total, head):
+        """The packed packet: ``head`` within the mission's size, then its PEC."""
+        if total > c.max_packet_size:
+            raise FieldRangeError(self.KIND + " packet length", total, c.max_packet_size)
+        if c.pec:
+            return head + _PEC_PACK(_crc(head, 0xFFFF))
+        return head
+
+    @classmethod
+    def _frame(cls, buf, offset, config, exact, min_size):
+        """Check everything up to the PEC; return (packet_id, seq_control, end, data_end)."""
+        what = cls.KIND
+        type_id = cls.ID
+        n = len(buf) - offset
+        if n < 6:
+            raise PusTooShortError("%s packet primary header" % what, 6, n)
+        pid, psc, dlen = _HDR.unpack_from(buf, offset)
+        total = dlen + 7
+        if pid & 0xF800 != type_id:
+            if pid >> 13:
+                raise PusHeaderError(what, "packet version number", 0, pid >> 13, pid, psc)
+            if (pid ^ type_id) & 0x1000:
+                raise PusHeaderError(
+                    what, "packet type", type_id >> 12 & 1, pid >> 12 & 1, pid, psc
+                )
+            raise PusHeaderError(what, "secondary header flag", 1, 0, pid, psc)
+        if total > n or (exact and total != n):
+            says = "%s packet is %d bytes, packet data length field says %d" % (what, n, total)
+            raise PusLengthError("%s packet" % what, total, n, pid, psc, says)
+        if total < min_size:
+            raise PusTooShortError(
+                "%s packet (secondary header, PEC)" % what, min_size, total, pid, psc
+            )
+        if total > config.max_packet_size:
+            most = "%s packet of %d bytes exceeds the mission maximum %d" % (
+                what, total, config.max_packet_size)  # fmt: skip
+            raise PusLengthError("%s packet" % what, config.max_packet_size, total, pid, psc, most)
+        end = offset + total
+        if config.pec:
+            if crc16_ccitt(buf if exact else memoryview(buf)[offset:end]) != 0:
+                got = _PEC.unpack_from(buf, end - 2)[0]
+                computed = crc16_ccitt(memoryview(buf)[offset : end - 2])
+                raise PusCrcError(what, computed, got, pid, psc)
+            return pid, psc, end, end - 2
+        return pid, psc, end, end
 
 
-def _check_common(p):
-    _range("APID", p.apid, 0x7FF)
-    _range("sequence count", p.seq_count, 0x3FFF)
-    _range("sequence flags", p.seq_flags, 3)
-    _range("service type", p.service, 255)
-    _range("message subtype", p.subtype, 255)
-
-
-def _frame(what, buf, offset, config, exact, type_id, min_size):
-    """Check everything up to the PEC; return (packet_id, seq_control, end, data_end)."""
-    n = len(buf) - offset
-    if n < 6:
-        raise PusTooShortError("%s packet primary header" % what, 6, n)
-    pid, psc, dlen = _HDR.unpack_from(buf, offset)
-    total = dlen + 7
-    if pid & 0xF800 != type_id:
-        if pid >> 13:
-            raise PusHeaderError(what, "packet version number", 0, pid >> 13, pid, psc)
-        if (pid ^ type_id) & 0x1000:
-            raise PusHeaderError(what, "packet type", type_id >> 12 & 1, pid >> 12 & 1, pid, psc)
-        raise PusHeaderError(what, "secondary header flag", 1, 0, pid, psc)
-    if total > n or (exact and total != n):
-        says = "%s packet is %d bytes, packet data length field says %d" % (what, n, total)
-        raise PusLengthError("%s packet" % what, total, n, pid, psc, says)
-    if total < min_size:
-        raise PusTooShortError(
-            "%s packet (secondary header, PEC)" % what, min_size, total, pid, psc
-        )
-    if total > config.max_packet_size:
-        most = "%s packet of %d bytes exceeds the mission maximum %d" % (
-            what, total, config.max_packet_size)  # fmt: skip
-        raise PusLengthError("%s packet" % what, config.max_packet_size, total, pid, psc, most)
-    end = offset + total
-    if config.pec:
-        if crc16_ccitt(buf if exact else memoryview(buf)[offset:end]) != 0:
-            got = _PEC.unpack_from(buf, end - 2)[0]
-            computed = crc16_ccitt(memoryview(buf)[offset : end - 2])
-            raise PusCrcError(what, computed, got, pid, psc)
-        return pid, psc, end, end - 2
-    return pid, psc, end, end
-
-
-def _int(buf, offset, size):
+def read_int(buf, offset, size):
+    """The big-endian unsigned integer of ``size`` octets at ``offset`` (0 for none)."""
     return int.from_bytes(bytes(buf[offset : offset + size]), "big") if size else 0
 
 
@@ -229,14 +272,3 @@ def failure_code(error):
     if isinstance(error, (PusVersionError, PusHeaderError)):
         return 6  # FAILURE_UNSUPPORTED_HEADER
     return 5  # FAILURE_ILLEGAL_APP_DATA
-
-
-def unpack_packet(buf, config=DEFAULT):
-    """A PusTc or PusTm, chosen by the packet type bit of the primary header."""
-    if len(buf) >= 1 and buf[0] & 0x10:
-        from obsw.pus.tc import PusTc
-
-        return PusTc.unpack(buf, config)
-    from obsw.pus.tm import PusTm
-
-    return PusTm.unpack(buf, config)

@@ -4,16 +4,13 @@ from obsw.compat import STRUCT_CHECKS_RANGES, const, pus_accelerator
 from obsw.crc import crc16_ccitt_update as _crc
 from obsw.pus.config import DEFAULT
 from obsw.pus.packets import (
-    _PEC_PACK,
     ACK_ALL,
     PUS_VERSION,
+    PusPacket,
     PusVersionError,
     RequestId,
-    _check_common,
-    _frame,
-    _int,
-    _range,
-    _refused,
+    check_range,
+    read_int,
 )
 from obsw.spp import SEQ_UNSEGMENTED, TYPE_TC, FieldRangeError
 
@@ -25,7 +22,7 @@ _c_pack = _C.tc_pack_slots if _C is not None else None
 _c_unpack = _C.tc_unpack if _C is not None else None
 
 
-class PusTc:
+class PusTc(PusPacket):
     """A PUS-C telecommand: primary header, TC secondary header, application data, PEC."""
 
     __slots__ = (
@@ -40,6 +37,8 @@ class PusTc:
         "config",
     )
     packet_type = TYPE_TC
+    KIND = "TC"
+    ID = _TC_ID
 
     def __init__(
         self,
@@ -62,18 +61,6 @@ class PusTc:
         self.source_id = source_id
         self.seq_flags = seq_flags
         self.config = config
-
-    @property
-    def packet_id(self):
-        return _TC_ID | self.apid
-
-    @property
-    def sequence_control(self):
-        return (self.seq_flags << 14) | self.seq_count
-
-    @property
-    def message_type(self):
-        return (self.service, self.subtype)
 
     def request_id(self):
         return RequestId.from_words(_TC_ID | self.apid, (self.seq_flags << 14) | self.seq_count)
@@ -113,15 +100,11 @@ class PusTc:
                 + data
             )
         except Exception:
-            e = _refused(self, c, total)
+            e = self._refused(c, total)
             if e is None:
                 raise
             raise e from None
-        if total > c.max_packet_size:
-            raise FieldRangeError("TC packet length", total, c.max_packet_size)
-        if c.pec:
-            return head + _PEC_PACK(_crc(head, 0xFFFF))
-        return head
+        return self._sealed(c, total, head)
 
     def _pack_fields(self, c, total):
         # layouts without one struct for the whole header (3-octet source ID, spare octets)
@@ -141,10 +124,7 @@ class PusTc:
             head += self.source_id.to_bytes(c.source_id_size, "big")
         if c.tc_spare:
             head += bytes(c.tc_spare)
-        head += self.data
-        if c.pec:
-            return head + _PEC_PACK(_crc(head, 0xFFFF))
-        return head
+        return self._sealed(c, total, head + self.data)
 
     def _lax(self, c):
         # True if a value is negative or too wide for its octets: what struct.pack refuses on
@@ -158,9 +138,9 @@ class PusTc:
 
     def _check(self, c, total=0):
         # every field in turn, then the packet length: the first that is wrong raises
-        _check_common(self)
-        _range("acknowledgement flags", self.ack, 15)
-        _range("source ID", self.source_id, c.source_id_max)
+        self._check_primary()
+        check_range("acknowledgement flags", self.ack, 15)
+        check_range("source ID", self.source_id, c.source_id_max)
         if total > c.max_packet_size:
             raise FieldRangeError("TC packet length", total, c.max_packet_size)
 
@@ -199,21 +179,14 @@ class PusTc:
         return cls._decode(buf, 0, config, True)[0]
 
     @classmethod
-    def unpack_from(cls, buf, offset=0, config=DEFAULT):
-        """Decode the TC at ``offset``; returns ``(tc, end_offset)``."""
-        return cls._decode(buf, offset, config, False)
-
-    @classmethod
     def _decode(cls, buf, offset, config, exact):
-        pid, psc, end, data_end = _frame(
-            "TC", buf, offset, config, exact, _TC_ID, config.tc_min_size
-        )
+        pid, psc, end, data_end = cls._frame(buf, offset, config, exact, config.tc_min_size)
         s = config.tc_struct
         if s is not None:
             b0, svc, sub, src = s.unpack_from(buf, offset)[3:]
         else:
             b0, svc, sub = config.tc_common.unpack_from(buf, offset)[3:]
-            src = _int(buf, offset + 9, config.source_id_size)
+            src = read_int(buf, offset + 9, config.source_id_size)
         if b0 >> 4 != PUS_VERSION:
             raise PusVersionError("TC", b0 >> 4, pid, psc)
         tc = cls(

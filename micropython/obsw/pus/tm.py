@@ -4,15 +4,12 @@ from obsw.compat import STRUCT_CHECKS_RANGES, const, pus_accelerator
 from obsw.crc import crc16_ccitt_update as _crc
 from obsw.pus.config import DEFAULT
 from obsw.pus.packets import (
-    _PEC_PACK,
     PUS_VERSION,
     PusHeaderError,
+    PusPacket,
     PusVersionError,
-    _check_common,
-    _frame,
-    _int,
-    _range,
-    _refused,
+    check_range,
+    read_int,
 )
 from obsw.spp import SEQ_UNSEGMENTED, TYPE_TM, FieldRangeError
 from obsw.timecode import TimeCodeError
@@ -26,7 +23,7 @@ _c_pack = _C.tm_pack_slots if _C is not None else None
 _c_unpack = _C.tm_unpack if _C is not None else None
 
 
-class PusTm:
+class PusTm(PusPacket):
     """A PUS-C telemetry packet: primary header, TM secondary header, source data, PEC.
 
     ``time`` is the tuple the configured time code packs, e.g. ``(coarse, fine)`` for CUC;
@@ -47,6 +44,8 @@ class PusTm:
         "config",
     )
     packet_type = TYPE_TM
+    KIND = "TM"
+    ID = _TM_ID
 
     def __init__(
         self,
@@ -74,30 +73,18 @@ class PusTm:
         self.seq_flags = seq_flags
         self.config = config
 
-    @property
-    def packet_id(self):
-        return _TM_ID | self.apid
-
-    @property
-    def sequence_control(self):
-        return (self.seq_flags << 14) | self.seq_count
-
-    @property
-    def message_type(self):
-        return (self.service, self.subtype)
-
     def _check(self, c, total=0, time=True):
         # every header field in turn, the packet length, then the time: the first wrong raises
-        _check_common(self)
-        _range("time reference status", self.time_ref, 15)
-        _range("message type counter", self.message_counter, c.message_counter_max)
-        _range("destination ID", self.destination_id, c.destination_id_max)
+        self._check_primary()
+        check_range("time reference status", self.time_ref, 15)
+        check_range("message type counter", self.message_counter, c.message_counter_max)
+        check_range("destination ID", self.destination_id, c.destination_id_max)
         if total > c.max_packet_size:
             raise FieldRangeError("TM packet length", total, c.max_packet_size)
         tf = c.time_fields
         if time and tf is not None and self.time is not None:
-            _range("time coarse", self.time[0], (1 << tf[0]) - 1)
-            _range("time fine", self.time[1], (1 << tf[1]) - 1)
+            check_range("time coarse", self.time[0], (1 << tf[0]) - 1)
+            check_range("time fine", self.time[1], (1 << tf[1]) - 1)
 
     def pack(self):
         c = self.config
@@ -141,15 +128,11 @@ class PusTm:
                 + data
             )
         except Exception:
-            e = _refused(self, c, total)
+            e = self._refused(c, total)
             if e is None:
                 raise
             raise e from None
-        if total > c.max_packet_size:
-            raise FieldRangeError("TM packet length", total, c.max_packet_size)
-        if c.pec:
-            return head + _PEC_PACK(_crc(head, 0xFFFF))
-        return head
+        return self._sealed(c, total, head)
 
     def _lax(self, c):
         # True if a value is negative or too wide for its octets: what struct.pack refuses on
@@ -198,10 +181,7 @@ class PusTm:
                 raise FieldRangeError("time", t, code.size) from e
         if c.tm_spare:
             head += bytes(c.tm_spare)
-        head += self.data
-        if c.pec:
-            return head + _PEC_PACK(_crc(head, 0xFFFF))
-        return head
+        return self._sealed(c, total, head + self.data)
 
     @classmethod
     def unpack(cls, buf, config=DEFAULT):
@@ -240,15 +220,8 @@ class PusTm:
         return cls._decode(buf, 0, config, True)[0]
 
     @classmethod
-    def unpack_from(cls, buf, offset=0, config=DEFAULT):
-        """Decode the TM at ``offset``; returns ``(tm, end_offset)``."""
-        return cls._decode(buf, offset, config, False)
-
-    @classmethod
     def _decode(cls, buf, offset, config, exact):
-        pid, psc, end, data_end = _frame(
-            "TM", buf, offset, config, exact, _TM_ID, config.tm_min_size
-        )
+        pid, psc, end, data_end = cls._frame(buf, offset, config, exact, config.tm_min_size)
         s = config.tm_struct
         if s is not None:
             b0, svc, sub, cnt, dest, coarse, fine = s.unpack_from(buf, offset)[3:]
@@ -256,9 +229,9 @@ class PusTm:
         else:
             b0, svc, sub = config.tc_common.unpack_from(buf, offset)[3:]
             pos = offset + 9
-            cnt = _int(buf, pos, config.message_counter_size)
+            cnt = read_int(buf, pos, config.message_counter_size)
             pos += config.message_counter_size
-            dest = _int(buf, pos, config.destination_id_size)
+            dest = read_int(buf, pos, config.destination_id_size)
             pos += config.destination_id_size
             t = None
             if config.time is not None:

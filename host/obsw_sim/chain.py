@@ -335,12 +335,15 @@ class Chain:
     def lines(self):
         return self.sim.lines()
 
+    @property
+    def station_alive(self):
+        """Whether the ground station's thread runs (None before it started)."""
+        return self._thread.is_alive() if self._thread is not None else None
+
     def pid_of(self, process):
         """The pid of OBC process ``process`` as the platform manager last reported it."""
         mark = "[platform] %s up (pid " % process
-        with self.sim._lock:
-            events = list(self.sim.events)
-        for _, text in reversed(events):
+        for _, text in reversed(self.sim.log_lines()):
             i = text.find(mark)
             if i >= 0:
                 return int(text[i + len(mark) :].split(")")[0])

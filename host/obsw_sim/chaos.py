@@ -223,12 +223,13 @@ class Campaign:
         simulation's last lines."""
         c = self.chain
         fop = c.station.ground.fop
+        events = c.sim.log_lines()
         return {
             "fop_state": fop.state,
             "fop_vs": fop.vs,
-            "station_alive": c._thread.is_alive() if c._thread else None,
-            "last": [text for _, text in c.sim.events[-6:]],
-            "loop_errors": sorted({t for _, t in c.sim.events if "loop error" in t})[:4],
+            "station_alive": c.station_alive,
+            "last": [text for _, text in events[-6:]],
+            "loop_errors": sorted({t for _, t in events if "loop error" in t})[:4],
         }
 
     def _lossy(self, seconds, loss, dup):

@@ -315,6 +315,11 @@ class ReconfigSim:
         if self.out is not None:
             self.out("  %6.2fs %s" % (t, text))
 
+    def log_lines(self):
+        """A copy of the log so far: (seconds since start, text) pairs."""
+        with self._lock:
+            return list(self.events)
+
     def seen(self, text):
         with self._lock:
             return any(text in e[1] for e in self.events)

@@ -21,15 +21,11 @@ from obsw_host import firmware
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 CORE_TESTS = sorted((ROOT / "tests" / "core").glob("test_*.py"))
-# Core tests that cannot run on a board with the Pyboard's heap and float, and why (counted as
+# Core tests that cannot run on a board with the Pyboard's heap, and why (counted as
 # skipped, with the reason, by the board-side runner). A file name skips the whole file.
 EEPROM = "host model of two 64 KiB M24512 EEPROMs: more than the Pyboard's whole heap"
 BIG = "a 64 KiB packet: more than the Pyboard's heap can hold in one block"
 HEAP = "a host-scale scenario (many transfers, stores or procedures at once) beyond a 103 KiB heap"
-FLOAT = (
-    "times as float epoch seconds or exact decimals: the board's floats are single precision "
-    "(32-bit, 128 s apart in 2025)"
-)
 FILES = "reads the host's files (tests/data, temporary folders)"
 TWO_ENDS = (
     "the spacecraft and the ground in one heap (the PUS application with its services, the "
@@ -75,43 +71,14 @@ CORTEX_M_SKIPS = {
     "test_reconfig_recovery.py::TestInTheApplication::"
     "test_silence_power_cycles_then_switches_over": EEPROM,
     "test_reconfig_recovery.py::TestInTheApplication::test_time_from_the_ds3231": EEPROM,
-    "test_cbor.py::TestDeterministic::test_shortest_float": FLOAT,
-    "test_cbor.py::TestVectors::test_decode_vectors": FLOAT,
-    "test_cbor.py::TestVectors::test_encode_vectors": FLOAT,
     "test_cfdp_class2.py::TestClass2::test_retransmissions_close_to_losses": FILE19K,
     "test_cfdp_filestore.py": FILES,
-    "test_pluto_engine.py::TestControl::test_abort": FLOAT,
-    "test_pluto_engine.py::TestControl::test_resume_cancels_pending_suspend": FLOAT,
-    "test_pluto_engine.py::TestControl::test_stop_at_end_of_step": FLOAT,
-    "test_pluto_engine.py::TestControl::test_stop_outside_steps_is_immediate": FLOAT,
-    "test_pluto_engine.py::TestControl::test_suspend_and_resume": FLOAT,
     "test_pluto_engine.py::TestLoading::test_load_file_and_bytes": FILES,
-    "test_pluto_engine.py::TestRunning::test_events_raised_and_questions": FLOAT,
-    "test_pluto_engine.py::TestRunning::test_failure_emits_failed": FLOAT,
-    "test_pluto_engine.py::TestRunning::test_procedure_reads_calls_and_waits": FLOAT,
-    "test_pluto_engine.py::TestRunning::test_two_procedures_at_once": FLOAT,
-    "test_pluto_engine.py::TestRunning::test_waits_for_component_event": FLOAT,
     "test_pluto_checker.py::TestRejections::test_long_operator_chain_is_a_syntax_error_with_line": TOKENS,  # noqa: E501
     "test_pluto_grammar.py::TestWrittenFromTheGrammar::test_every_production_loads_and_runs": FILES,  # noqa: E501
-    "test_pluto_il.py::TestActivities::test_abandoned_activity_is_aborted": FLOAT,
-    "test_pluto_il.py::TestActivities::test_arguments_by_name_or_position": FLOAT,
-    "test_pluto_il.py::TestActivities::test_component_error_is_not_confirmed": FLOAT,
-    "test_pluto_il.py::TestActivities::test_confirmed_with_converted_arguments": FLOAT,
-    "test_pluto_il.py::TestActivities::test_late_outcome_of_asynchronous_operation": FLOAT,
-    "test_pluto_il.py::TestActivities::test_no_outcome_within_timeout_is_aborted": FLOAT,
-    "test_pluto_il.py::TestActivities::test_provider_failure_is_aborted": FLOAT,
-    "test_pluto_il.py::TestEvents::test_outputs": FLOAT,
-    "test_pluto_il.py::TestEvents::test_wait_for_event_counts_publications": FLOAT,
-    "test_pluto_il.py::TestNames::test_describe_from_sdb_document": FLOAT,
-    "test_pluto_il.py::TestParameters::test_wait_until_parameter": FLOAT,
-    "test_pluto_interp.py": FLOAT,
     "test_cfdp_passes.py": PASSES,
+    "test_pluto_interp.py::TestParallelAndControl::test_thesis_cpdu_example": FILES,
     "test_pus_s03_housekeeping.py::TestUnsent::test_a_packet_too_long_is_heard_and_leaves_no_gap": BIG,  # noqa: E501
-    "test_pluto_annex_a_clauses.py": FLOAT,
-    "test_pluto_lexer.py::TestUnits::test_conversion_and_offset": FLOAT,
-    "test_pluto_lexer.py::TestUnits::test_iso_round_trip": FLOAT,
-    "test_pus_fields_numeric.py::TestReal::test_ieee": FLOAT,
-    "test_pus_fields_numeric.py::TestReal::test_ieee_errors": FLOAT,
     "test_pus_s15_storage.py::TestPersistence::test_log_is_compacted_atomically": HEAP,
     "test_pus_s15_storage.py::TestRetrieval::test_open_retrieval_follows_the_store": HEAP,
     "test_pus_s15_storage.py::TestStores::test_circular_and_bounded": HEAP,
@@ -126,11 +93,7 @@ CORTEX_M_SKIPS = {
     "test_reconfig_time.py::TestWatchdog::test_early_kick_is_a_reset_in_the_model": EEPROM,
     "test_reconfig_time.py::TestWatchdog::test_unhealthy_is_reset_by_timeout": EEPROM,
     "test_reconfig_time.py::TestWatchdog::test_window_respected_with_jittery_loop": EEPROM,
-    "test_spacecan_redundancy.py::TestHeartbeatMonitor::test_unbounded_switching": FLOAT,
     "test_spp.py::TestSpacePacket::test_largest_packet": BIG,
-    "test_timecode.py::TestCds::test_seconds": FLOAT,
-    "test_timecode.py::TestUtc::test_format_parse": FLOAT,
-    "test_timecode.py::TestUtc::test_leap_second": FLOAT,
 }
 # the board's test runner collects after every 8 KiB allocated (gc.threshold), as a small-heap
 # application does: collecting only when the heap is exhausted scatters the live objects of a

@@ -1,5 +1,5 @@
 # obsw on an emulated Cortex-M3 (QEMU mps2-an385): the MPS2_AN385 board of the qemu port with
-# the Pyboard's float (single precision), its application heap (MICROPY_HEAP_SIZE) and C stack
+# the Pyboard's float (double precision, in software), its application heap (MICROPY_HEAP_SIZE) and C stack
 # limit (OBSW_STACK_LIMIT; both set by tools/firmware.py from the Pyboard ELF) and a
 # /flash-like filesystem kept outside the heap.
 QEMU_ARCH = arm
@@ -23,6 +23,7 @@ SRC_BOARD_O = shared/runtime/gchelper_native.o shared/runtime/gchelper_thumb2.o
 MPY_CROSS_FLAGS += -march=armv7m
 
 MICROPY_VFS_LFS2 = 1
+MICROPY_FLOAT_IMPL = double
 USER_C_MODULES = $(BOARD_DIR)/cmodules
 FROZEN_MANIFEST ?= $(BOARD_DIR)/../../manifests/qemu.py
 

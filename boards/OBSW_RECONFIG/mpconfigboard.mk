@@ -15,6 +15,11 @@ endif
 
 # MicroPython settings
 MICROPY_VFS_LFS2 ?= 1
+# Double-precision floats (in software: the F405's FPU is single precision). The application
+# keeps time as float seconds since boot, as the host does: in single precision that float is
+# 1 s coarse after 97 days of uptime and its 1 s periods collapse
+# (tests/core/test_reconfig_uptime.py); in double it resolves a microsecond for 285 years.
+MICROPY_FLOAT_IMPL = double
 
 # The image freezes the reconfiguration application and the core modules it needs.
 FROZEN_MANIFEST ?= $(BOARD_DIR)/../../manifests/reconfig.py

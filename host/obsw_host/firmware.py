@@ -321,9 +321,14 @@ def _make(tree, out, artifact, inputs, args):
         return out / artifact, 0.0
     t0 = time.monotonic()
     # make recompiles a file when its source changes, not when the options do: a build with
-    # other options (cryptolib in or out, another heap) starts from a clean folder, and the
-    # frozen modules are always compiled again
-    options = "\n".join([str(tree)] + list(args) + [str(p) for p in inputs if "mbedtls" in str(p)])
+    # other options (cryptolib in or out, another heap, the board's settings such as its float)
+    # starts from a clean folder, and the frozen modules are always compiled again
+    options = "\n".join(
+        [str(tree)]
+        + list(args)
+        + [str(p) for p in inputs if "mbedtls" in str(p)]
+        + [pathlib.Path(p).read_text() for p in inputs if "mpconfigboard" in str(p)]
+    )
     was = out / ".obsw-options"
     if out.exists() and (not was.is_file() or was.read_text() != options):
         shutil.rmtree(out)

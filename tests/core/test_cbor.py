@@ -1,5 +1,6 @@
 """CBOR codec: RFC 8949 appendix A vectors, deterministic encoding and malformed input."""
 
+import struct
 import unittest
 
 from obsw.cbor import (
@@ -45,7 +46,9 @@ VECTORS = [
     (1.5, "f93e00"),
     (65504.0, "f97bff"),
     (100000.0, "fa47c35000"),
-    (3.4028234663852886e38, "fa7f7fffff"),
+    # the largest float32, built from its bits: a board's decimal parser (software pow) can
+    # read the literal 3.4028234663852886e38 one unit in the last place away
+    (struct.unpack(">f", b"\x7f\x7f\xff\xff")[0], "fa7f7fffff"),
     (1.0e300, "fb7e37e43c8800759c"),
     (5.960464477539063e-8, "f90001"),
     (0.00006103515625, "f90400"),

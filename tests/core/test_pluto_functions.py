@@ -43,7 +43,9 @@ class TestMathematical(unittest.TestCase):
         self.assertEqual(value("sqrt(16 m^2)"), "4.0 m")
         self.assertEqual(value("exp(0)"), "1.0")
         self.assertEqual(value("ln(1)"), "0.0")
-        self.assertEqual(value("log(1000)"), "3.0")
+        # the interpreter's libm decides the last bit: 2.9999999999999996 with a board's
+        # software log10, 3.0 with glibc
+        self.assertTrue(abs(float(value("log(1000)")) - 3.0) < 1e-12)
 
     def test_trigonometry_takes_angles_in_any_unit(self):
         self.assertEqual(value("round(sin(90 deg) * 1000)"), "1000")

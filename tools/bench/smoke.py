@@ -19,6 +19,7 @@ import json
 import math
 import os
 import pathlib
+import signal
 import subprocess
 import sys
 import time
@@ -61,20 +62,49 @@ def problems(result, name):
     return out
 
 
+# a benchmark runs with SIGTERM as SystemExit, so that at a timeout its `finally` blocks and
+# context managers stop what it started (QEMU, an OBC, Yamcs) and remove its temporary folders
+_RUN = (
+    "import os, runpy, signal, sys; "
+    "signal.signal(signal.SIGTERM, lambda *a: sys.exit(143)); "
+    "sys.argv = sys.argv[1:]; sys.path[0] = os.path.dirname(sys.argv[0]); "
+    "runpy.run_path(sys.argv[0], run_name='__main__')"
+)
+GRACE = 20.0  # seconds a timed-out benchmark has to stop before its process group is killed
+
+
+def _run(argv, env, timeout):
+    """``subprocess.run`` in a process group of its own: at the timeout the whole group gets
+    SIGTERM, then SIGKILL after GRACE, and TimeoutExpired is raised; nothing is left running."""
+    proc = subprocess.Popen(
+        argv,
+        cwd=report.ROOT,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGTERM)
+        try:
+            proc.communicate(timeout=GRACE)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate()
+        raise
+    return subprocess.CompletedProcess(argv, proc.returncode, out, err)
+
+
 def smoke(name, timeout):
     """('passed' | 'failed' | 'skipped', seconds, detail) of one benchmark's quick run."""
     script, extra, _ = report.RUNS[name]
-    argv = [sys.executable, str(HERE / script), "--json", "--quick"]
+    argv = [sys.executable, "-c", _RUN, str(HERE / script), "--json", "--quick"]
     t0 = time.monotonic()
     try:
-        res = subprocess.run(
-            argv,
-            cwd=report.ROOT,
-            env=dict(os.environ, **extra),
-            capture_output=True,
-            text=True,
-            timeout=timeout,
-        )
+        res = _run(argv, dict(os.environ, **extra), timeout)
     except subprocess.TimeoutExpired:
         return "failed", time.monotonic() - t0, "no result in %d s" % timeout
     seconds = time.monotonic() - t0

@@ -117,6 +117,7 @@ class Chain:
         self._uarts = []
         self._hk = set()  # structures defined on board
         self.platform = {}  # platform manager settings for the OBC's next boot
+        self.sections = {}  # more mission file sections for the OBC's next boot ("contact")
         self._stop = threading.Event()
         self._thread = None
 
@@ -171,6 +172,8 @@ class Chain:
         # the UART link to the module: context and time across power cycles and switch-overs
         platform.update(module_uarts=list(self.sim.obc_uart_paths), context_period=0.5)
         platform.update(self.platform)
+        for name, section in self.sections.items():
+            doc[name] = dict(section)
         if redundant:
             cycle = dict(defaults.PLATFORM["power_cycle"], **(platform.get("power_cycle") or {}))
             platform["power_cycle"] = dict(cycle, line=self.REDUNDANT_LINE)

@@ -134,6 +134,12 @@ UPDATE = {
 }
 # the reconfiguration module's autonomous recovery of the OBC (delivered to the boards in their
 # mission.json, obsw.reconfig.mission); the module's own fallback is the same table, in the core
+CONTACT = {
+    "stores": [],  # service 15 stores dumped at AOS, by priority; none: TM in real time
+    "hold": 10.0,  # seconds in contact after the last TC heard (outside the pass table)
+    "downlink_bps": None,  # the dump's rate; None: the frames section's, else 9600
+    "share": 0.8,  # the share of the downlink the dump may take
+}
 RECOVERY = dict(_recovery.DEFAULTS, lines=list(_recovery.DEFAULTS["lines"]))
 SECTIONS = {
     "pus": PUS,
@@ -143,6 +149,7 @@ SECTIONS = {
     "frames": FRAMES,
     "platform": PLATFORM,
     "recovery": RECOVERY,
+    "contact": CONTACT,
     "update": UPDATE,
 }
 

@@ -151,3 +151,25 @@ def test_cfdp_held_out_of_contact():
 def test_off_without_stores():
     p, *_ = make(stores=())
     assert not p.enabled and p.realtime(Header(10, 3, 25, 1))
+
+
+def test_a_restart_goes_on_after_the_last_packet_sent(tmp_path):
+    path = str(tmp_path / "passes.json")
+    p, storage, clock, sent, _ = make()
+    p.path = path
+    for i in range(4):
+        storage.stores[1].append(clock.t, b"H%05d" % i)
+    p.load(pack_table([(1000, 1100)]))
+    p.step()
+    clock.t = 1001.0
+    p.step()
+    assert len(sent) == 4
+    storage.stores[1].append(clock.t, b"H00004")
+    # the process restarts: the same stores (restored from their files), a new component
+    again = Passes(storage, lambda raw, vc: sent.append(raw), clock, lambda n, v: None,
+                   stores=(1, 2), bps=8000.0, share=1.0, clock=clock, path=path)  # fmt: skip
+    again.load(pack_table([(1000, 1100)]))
+    again.step()
+    clock.t = 1002.0
+    again.step()
+    assert sent[4:] == [b"H00004"]  # nothing twice

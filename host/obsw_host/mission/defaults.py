@@ -64,7 +64,8 @@ PUS = {
     "monitoring": [],  # ST[12] limit checks installed at the first start (obc.monitoring)
 }
 CFDP = {
-    "peers": {}
+    "peers": {},
+    "poll": 0.005,  # seconds between the CFDP entity's steps
 }  # ports and ids: obsw_host.mission.ports and obsw_host.mission.ids (the mission's)
 OBCP = {"timeout": 2.0, "activity_timeout": 30.0, "level": 2, "step_period": 0.01}
 SPACECAN = {

@@ -13,8 +13,10 @@ With ``contact.stores`` set in the mission file (the stores dumped, highest prio
 a TM that one of those stores keeps does not go out in real time: it waits in the store, and
 in contact ``StoreForward`` (``obsw.frames.downlink``) hands it to the store's virtual channel
 in storage order, by priority, at ``share`` of the downlink rate and only what the pass can
-still carry. Each cycle that sent packets of a store raises the event ``passes.dumped``
-(store, first and last storage sequence number, count); the ground acknowledges what it has
+still carry; where it stands in each store is kept in the state folder (``passes.json``), so
+a restarted process goes on after the last packet it sent. Each cycle that sent packets of
+a store raises the event ``passes.dumped`` (store, first and last storage sequence number,
+count); the ground acknowledges what it has
 with TC[8,1] ``Passes.acknowledge`` (store, seq: deletes through it, the room is free again)
 and asks again for what it lacks with ``Passes.resend`` (store, first, last). The forwarder's
 pointer never goes back, so nothing leaves twice unless the ground asks for it. The CFDP
@@ -91,7 +93,7 @@ class Passes:
     values)`` raises a database event; ``entity`` is the process's CFDP entity (or None)."""
 
     def __init__(self, storage, play, now, event, *, stores=(), hold=10.0, bps=9600.0,
-                 share=0.8, entity=None, clock=time.monotonic):  # fmt: skip
+                 share=0.8, entity=None, clock=time.monotonic, path=None):  # fmt: skip
         from obsw.cfdp.contact import PassHold
 
         self.storage = storage
@@ -105,6 +107,8 @@ class Passes:
         self.cycle_octets = bps * share / 8  # per second: the dump's share of the link
         self.hold = PassHold(entity) if entity is not None and self.enabled else None
         self.clock = clock
+        self.path = path  # where the forwarder's pointers are kept across restarts
+        self.saved = self._restore()
         self.il = None
         self.in_contact = False
         self.passes = 0
@@ -113,6 +117,31 @@ class Passes:
         self.dumped = 0
         self._last = None
         self._credit = 0.0
+
+    def _restore(self):
+        import json
+
+        if self.path is None:
+            return {}
+        try:
+            with open(self.path) as f:
+                return {int(k): int(v) for k, v in json.load(f).items()}
+        except (OSError, ValueError, TypeError, AttributeError):
+            return {}  # none yet, or unreadable: from each store's oldest packet
+
+    def _save(self):
+        import json
+        import os
+
+        if self.path is None:
+            return
+        part = self.path + ".part"
+        try:
+            with open(part, "w") as f:
+                json.dump({str(k): v for k, v in self.forward.next_seq.items()}, f)
+            os.replace(part, self.path)
+        except OSError:
+            pass  # a full disk: after a restart the unacknowledged packets go again
 
     def il_bind(self, provider):
         self.il = provider
@@ -184,8 +213,10 @@ class Passes:
         if [s.id for s in stores] != [s.id for s in fw.stores]:
             fw.stores = stores
             for st in stores:
-                if st.id not in fw.next_seq:  # from the oldest packet kept: none sent yet
-                    fw.next_seq[st.id] = st.packets[0][0] if st.packets else st.next_seq
+                if st.id not in fw.next_seq:  # where it stood, else the oldest packet kept
+                    oldest = st.packets[0][0] if st.packets else st.next_seq
+                    fw.next_seq[st.id] = max(oldest, min(self.saved.get(st.id, 0),
+                                                         st.next_seq))  # fmt: skip
         else:
             fw.stores = stores  # a store recreated under its id is a new object
 
@@ -226,6 +257,8 @@ class Passes:
                 sent[st.id] = [seq, seq, 1]
             else:
                 run[0], run[1], run[2] = min(run[0], seq), max(run[1], seq), run[2] + 1
+        if sent:
+            self._save()
         for sid, (first, last_seq, count) in sent.items():
             self.dumped += count
             self.event("passes.dumped", {"store": sid, "first": first, "last": last_seq,

@@ -217,6 +217,7 @@ class PusUnit:
             apid=ids.apid("cfdp"),
             packet_type=TYPE_TM,
         )
+        self.cfdp_poll = float(opts["poll"])
         self.copy = RemoteCopy(entity)
         self.node.provide(REMOTE_COPY, self.copy)
         self.cfdp.on_indication = self._indication
@@ -239,6 +240,7 @@ class PusUnit:
             bps=float(bps),
             share=float(opts["share"]),
             entity=self.cfdp.entity if self.cfdp is not None else None,
+            path=os.path.join(self.config.state, "passes.json"),
         )
         if passes.enabled:
             self.app.tm_filters.append(passes.realtime)
@@ -274,7 +276,7 @@ class PusUnit:
         while self._running:
             self.cfdp.step(0)
             self.copy.poll(time.monotonic())
-            await asyncio.sleep(0.005)
+            await asyncio.sleep(self.cfdp_poll)
 
     def _indication(self, ind):
         """CFDP indications: a state file set aside becomes an event, the rest go to the

@@ -162,8 +162,8 @@ def main(argv=None):
     ap.add_argument("--orbits", type=float, help="a bounded run of this many orbits")
     ap.add_argument("--hours", type=float, default=24.0, help="the full run's length")
     ap.add_argument("--speed", type=float, help="times faster (default 60, bounded run 100)")
-    ap.add_argument("--before", type=float, default=900.0,
-                    help="seconds of orbit before the first pass (default 900)")  # fmt: skip
+    ap.add_argument("--before", type=float, default=1800.0,
+                    help="seconds of orbit before the first pass (default 1800)")  # fmt: skip
     ap.add_argument("--write", action="store_true", help="write docs/ditl-last-run.md, ditl.png")
     ap.add_argument("--work", help="folder for the chain's files (default: a temporary one)")
     args = ap.parse_args(argv)

@@ -44,7 +44,7 @@ def chain_settings(chain, speed):
     that leave a loaded machine room (a deadline of 2 s is 20 ms here at 100 times)."""
     slack = max(1.0, speed / 2.0)
     chain.platform.update(heartbeat=1.0, deadline=3.0 * slack, start_timeout=60.0 * slack,
-                          context_period=5.0)  # fmt: skip
+                          context_period=5.0, module_timeout=1.0 * slack)  # fmt: skip
     chain.sections["spacecan"] = {"heartbeat_period": 1.0, "timeout": 1.0 * slack}
     chain.sections["frames"] = {"clcw_period": 1.0}
     chain.sections["obcp"] = {"step_period": 0.5}
@@ -78,6 +78,7 @@ class ChainDay:
         self.dumped = {HIGH: [], ROUTINE: []}  # (first, last, count) of passes.dumped
         self.acked = {HIGH: 0, ROUTINE: 0}
         self.resends = 0
+        self._asked = {}
         self.backlog = []  # (onboard s, octets) from store 2's reports
         self.executed = {}  # planned step index -> onboard time of its TM[1,7]
         self.plan = []
@@ -85,7 +86,7 @@ class ChainDay:
         self.series = {"t": [], "generated": [], "delivered": []}
         self.generated = {HK_HIGH: [], HK_ROUTINE: []}  # time tags seen, to count them
         self.contacts = 0
-        self._tx_steps = {}  # id(transaction) -> step index
+        self._tx_steps = {}  # request id -> plan step index
 
     def say(self, text):
         if self.out is not None:
@@ -108,8 +109,8 @@ class ChainDay:
                 v = decoded["values"].get("Passes.backlog")
                 if v is not None:
                     self.backlog.append((_seconds(tm), v))
-        elif tm.service == 1 and tm.subtype == 7 and tx is not None:
-            step = self._tx_steps.get(id(tx))
+        elif tm.service == 1 and tm.subtype == 7 and decoded:
+            step = self._tx_steps.get(decoded.get("request_id"))
             if step is not None:
                 key = ("tc", step)
                 if key in self.archive[HIGH]:
@@ -178,7 +179,7 @@ class ChainDay:
             words = step.request.split()
             args = dict(w.split("=", 1) for w in words[2:])
             req = g.function_request(words[1], **{k: float(v) for k, v in args.items()})
-            self._tx_steps[id(req)] = i
+            self._tx_steps[req.request_id] = i
             tx = g.schedule_at(step.time + TAI_MINUS_UNIX, req)
             if not tx.ok:
                 raise RuntimeError("plan step %d refused: %s" % (i, tx.verification()))
@@ -205,7 +206,7 @@ class ChainDay:
             self.start = time.time()
             self.end = self.start + self.seconds
             self.passes = [p for p in self.pred.passes(self.start, self.end, [self.station])
-                           if p.aos > self.start + 120.0]  # fmt: skip
+                           if p.aos > self.start + 60.0]  # fmt: skip
             self._uplink()
             self.say("chain up and set in %.0f s here; %d passes to fly" % (
                 time.monotonic() - began, len(self.passes)))  # fmt: skip
@@ -252,25 +253,30 @@ class ChainDay:
         self._carrier(False)
 
     def _acknowledge(self):
-        """Acknowledge, per store, through the last dump whose reports all came; ask again
-        for what did not (from the first unacknowledged dump on)."""
+        """Acknowledge, per store, through the last sequence number dumped when every packet
+        dumped so far came; else ask again for those after the last acknowledgement."""
         g = self.chain.ground
         for store in (HIGH, ROUTINE):
             dumps = self.dumped[store]
             if not dumps:
                 continue
-            have = len(self.archive[store])
-            sent = sum(c for _, _, c in dumps)
-            last = dumps[-1][1]
+            seqs = set()
+            for first, last, _count in dumps:
+                seqs.update(range(first, last + 1))
+            last = max(seqs)
             try:
-                if have >= sent and last > self.acked[store]:
-                    if g.perform("Passes.acknowledge", store=store, seq=last, timeout=10.0).ok:
-                        self.acked[store] = last
-                elif have < sent:
-                    first = self.acked[store] + 1
-                    g.perform("Passes.resend", store=store, first=first, last=last,
-                              timeout=10.0)  # fmt: skip
+                if len(self.archive[store]) >= len(seqs):
+                    if last > self.acked[store]:
+                        tx = g.perform("Passes.acknowledge", store=store, seq=last, timeout=10.0)
+                        if tx.ok:
+                            self.acked[store] = last
+                elif not self._asked.get(store):
+                    g.perform("Passes.resend", store=store, first=self.acked[store] + 1,
+                              last=last, timeout=10.0)  # fmt: skip
+                    self._asked[store] = True
                     self.resends += 1
+                else:
+                    self._asked[store] = False  # asked last round: ask again next round
             except Exception as e:  # a TC lost at the pass's edge: the next round asks again
                 self.say("acknowledgement of store %d: %s" % (store, e))
 

@@ -177,7 +177,7 @@ class PusUnit:
                 float(platform["context_period"]),
                 out,
             )
-            self.module.restore()
+            self.module.restore(float(platform["module_timeout"]))
         monitoring.install(self.app, sdb, opts["monitoring"])  # first start: the mission's
         self.app.unsent_listeners.append(self._unsent)
         self._reporting_unsent = False

@@ -146,3 +146,83 @@ def test_pass_table_store_and_forward(tmp_path):
         # an unknown store is refused
         nope = g.perform("Passes.acknowledge", store=77, seq=1)
         assert refused(nope, "UNKNOWN_STORE"), nope.verification()
+
+
+def test_a_file_up_across_two_passes(tmp_path):
+    """A class 2 upload larger than a pass: suspended at LOS on both ends (the OBC from its
+    pass table, the ground from the same windows), out of contact longer than the OBC's
+    inactivity limit (60 s: it would have cancelled the transaction), resumed at AOS where
+    it stopped, byte-identical, never restarted."""
+    import random
+
+    from obsw.cfdp.contact import PassHold
+    from obsw.cfdp.defs import ACKNOWLEDGED, NO_ERROR
+    from obsw.cfdp.filestore import MemoryFilestore
+    from obsw.spp import TYPE_TC
+    from obsw_host.cfdp.link import UdpEntity, make_entity
+    from obsw_host.pus.tai import tai_now
+
+    chain = Chain(str(tmp_path), processes=Chain.SAMPLE_PROCESSES)
+    chain.sections["contact"] = {"stores": [STORE], "hold": 1.0}
+    data = random.Random(7).randbytes(240_000)
+    with chain:
+        chain.wait_up(2 * WAIT)
+        g = chain.ground
+        sat, ground = chain.ids.cfdp_entities
+        files = MemoryFilestore({"up.bin": data})
+        entity = make_entity(ground, [sat], files, persist=False)
+        windows = []
+
+        def in_contact():
+            t = tai_now()
+            return any(a <= t < b for a, b in windows)
+
+        link = UdpEntity(entity, ("127.0.0.1", chain.cfdp_ground_port),
+                         {sat: ("127.0.0.1", chain.cfdp_port)}, apid=chain.ids.apid("cfdp"),
+                         packet_type=TYPE_TC, rate=12_000, pace=False,
+                         drop=lambda pdu: not in_contact())  # fmt: skip
+        hold = PassHold(entity)
+        try:
+            now = int(tai_now())
+            # a pass of 8 s now, then 70 s out of contact, then a pass of 60 s
+            windows[:] = [(now, now + 8), (now + 78, now + 138)]
+            assert g.perform("Passes.load", table=pack_table(windows)).ok
+            entity.put(sat, "up.bin", "up.bin", mode=ACKNOWLEDGED)
+            at_los = None
+            finished = []
+            progress = []  # the sender's progress, each step: it never goes back to zero
+            end = time.monotonic() + 5 * WAIT
+            while time.monotonic() < end and not finished:
+                hold.update(in_contact(), time.monotonic())
+                for ind in link.step(0.02):
+                    if ind.kind == "finished":
+                        finished.append(ind.info)
+                progress.extend(tx.progress_of() for tx in entity.tx.values())
+                t = tai_now()
+                if at_los is None and t >= windows[0][1]:
+                    at_los = [tx.progress_of() for tx in entity.tx.values()]
+            assert finished, [(tx.progress_of(), tx.suspended) for tx in entity.tx.values()]
+            assert finished[0].get("condition", NO_ERROR) == NO_ERROR, finished
+            assert at_los and 0 < at_los[0] < len(data), at_los  # it spanned the two passes
+            assert hold.suspends >= 1 and hold.resumes >= 1
+            assert progress == sorted(progress), "the transfer went back"
+            assert len(finished) == 1 and not entity.tx  # one transaction, done
+            path = os.path.join(chain.state, "files", "up.bin")
+            assert wait_file(path, data), "the OBC's copy differs"
+            print("up: %d octets, %d at LOS, finished in the second pass" % (
+                len(data), at_los[0]))  # fmt: skip
+        finally:
+            link.close()
+
+
+def wait_file(path, data, timeout=WAIT):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        try:
+            with open(path, "rb") as f:
+                if f.read() == data:
+                    return True
+        except OSError:
+            pass
+        time.sleep(0.1)
+    return False

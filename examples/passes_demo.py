@@ -1,10 +1,12 @@
 """Demo: operations across passes. The sample spacecraft's orbit (its TLE) over its ground
-station: the passes of the next day with what each can carry, the pass plan as service 11
-commands, then two orbits flown on one injected clock: housekeeping stored out of contact and
+station: the passes of the next day with what each can carry, the onboard pass table they make
+(the argument of TC[8,1] Passes.load, what `obsw ops uplink` sends), the pass plan as service
+11 commands, then two orbits flown on one injected clock: housekeeping stored out of contact and
 dumped by priority at AOS, a 2 MB file down and a 500 kB file up, each across two passes,
 suspended at LOS and resumed where it stopped."""
 
 from obsw_host.mission.check import load
+from obsw_host.ops.pass_table import table, windows
 from obsw_host.ops.passes import from_mission
 from obsw_host.ops.plan import plan
 from obsw_host.sample import MISSION_DIR
@@ -20,6 +22,9 @@ def run(out=print):
         d = p.to_dict()
         row = (d["station"], d["aos"], d["los"], d["max_elevation"], d["downlink_octets"])
         out("  %s  AOS %s  LOS %s  %5.1f deg  %7d octets down" % row)
+    ws = windows(passes)
+    out("  pass table for Passes.load: %d windows, %d octets (AOS, LOS: uint32 onboard seconds)"
+        % (len(ws), len(table(passes))))  # fmt: skip
     for s in plan(passes[:1]):
         out("  planned: %s" % s)
     start = passes[0].aos - 3600.0

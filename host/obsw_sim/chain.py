@@ -117,6 +117,8 @@ class Chain:
         self._uarts = []
         self._hk = set()  # structures defined on board
         self.platform = {}  # platform manager settings for the OBC's next boot
+        self.sections = {}  # more mission file sections for the OBC's next boot ("contact")
+        self.sim_options = {}  # more options of the reconfiguration module (ReconfigSim)
         self._stop = threading.Event()
         self._thread = None
 
@@ -171,6 +173,8 @@ class Chain:
         # the UART link to the module: context and time across power cycles and switch-overs
         platform.update(module_uarts=list(self.sim.obc_uart_paths), context_period=0.5)
         platform.update(self.platform)
+        for name, section in self.sections.items():  # over what the chain set
+            doc.setdefault(name, {}).update(section)
         if redundant:
             cycle = dict(defaults.PLATFORM["power_cycle"], **(platform.get("power_cycle") or {}))
             platform["power_cycle"] = dict(cycle, line=self.REDUNDANT_LINE)
@@ -224,6 +228,7 @@ class Chain:
             ids=self.ids,
             obc_lines=(self.obc_line, self.REDUNDANT_LINE),
             initial_lines=1 << self.obc_line,
+            **self.sim_options,
         )
         security, state = keys.load(self.sim.key_file, os.path.join(self.work, "station.state"))
         self.station = _station_class()(

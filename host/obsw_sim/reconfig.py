@@ -234,6 +234,7 @@ class ReconfigSim:
         reset_s=0.1,
         watchdog_open_ms=100,
         watchdog_timeout_ms=3000,
+        boot_limit=BOOT_LIMIT,
         heapsize="1M",
         out=None,
         key_file=None,
@@ -268,6 +269,7 @@ class ReconfigSim:
         self.stuck_s = stuck_s
         self.reset_s = reset_s
         self.wd = (watchdog_open_ms, watchdog_timeout_ms)
+        self.boot_limit = boot_limit  # seconds from power on to the first kick
         self.heapsize = heapsize
         self.out = out
         # TC frames to the controllers are signed (SDLS); keys made for the run unless given
@@ -524,8 +526,8 @@ class ReconfigSim:
                     if k != self._kicks[role]:
                         self._kicks[role] = k
                         self._wdog[role] = Tps3813Model(self.wd[0], self.wd[1], now * 1000)
-                    elif now - self._spawned_at[role] > BOOT_LIMIT:
-                        why = "never came (%g s since power on)" % BOOT_LIMIT
+                    elif now - self._spawned_at[role] > self.boot_limit:
+                        why = "never came (%g s since power on)" % self.boot_limit
                 else:
                     if k != self._kicks[role]:
                         self._kicks[role] = k

@@ -38,7 +38,8 @@ def test_two_orbits():
 
 
 def test_the_bounded_stage_passes():
-    r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "ditl.py"), "--orbits", "2"],
+    tool = os.path.join(ROOT, "tools", "ditl_core.py")
+    r = subprocess.run([sys.executable, tool, "--orbits", "2"],
                        capture_output=True, text=True, timeout=300)  # fmt: skip
     assert r.returncode == 0, r.stdout + r.stderr
     assert r.stdout.splitlines()[-1] == "6 passed, 0 failed"

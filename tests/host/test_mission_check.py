@@ -249,7 +249,14 @@ def folder(tmp_path):
 def test_the_sample_passes():
     m, problems = check(locate(sample.MISSION_DIR))
     assert problems == []
-    assert sorted(m.interfaces) == ["CpduN", "CpduR", "OnboardTime", "Software", "SolarPanel"]
+    assert sorted(m.interfaces) == [
+        "CpduN",
+        "CpduR",
+        "OnboardTime",
+        "Passes",
+        "Software",
+        "SolarPanel",
+    ]
     assert m.sdb.apid("pus") == 10
 
 

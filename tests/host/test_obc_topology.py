@@ -72,7 +72,7 @@ def test_the_sample_topology():
     assert topology.process_of("SolarPanel") is obc
     assert topology.process_of("frames") is None
     names = [i.name for i in topology.interfaces()]
-    assert names == ["SolarPanel", "CpduN", "CpduR", "OnboardTime", "Software"]  # built in
+    assert names == ["SolarPanel", "CpduN", "CpduR", "OnboardTime", "Software", "Passes"]
     described = topology.describe()
     assert described["components"]["SolarPanel"]["module"] == "obsw_host.solar_panel"
     assert described["processes"]["obc"]["units"] == ["pus", "spacecan"]
@@ -182,7 +182,7 @@ def test_components_run_by_no_process_and_unknown_names(tmp_path):
         "components": {"Magnetorquer": {"module": "missing.py"}},
     })).check()  # fmt: skip
     assert topology.describe()["components"]["Magnetorquer"]["process"] is None
-    assert [i.name for i in topology.interfaces()] == ["OnboardTime", "Software"]  # built in
+    assert [i.name for i in topology.interfaces()] == ["OnboardTime", "Software", "Passes"]
     with pytest.raises(obc_config.ConfigError) as e:
         mission(tmp_path, {"processes": {"core": ["pus", "Magnetorker"]}})
     assert e.value.key == "processes.core" and "Magnetorker" in str(e.value)

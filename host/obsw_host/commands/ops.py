@@ -1,14 +1,18 @@
-"""`obsw ops passes|plan`: operations across passes, from the mission's orbit and stations.
+"""`obsw ops passes|plan|uplink`: operations across passes, from the mission's orbit and stations.
 
 `passes --mission M --days N` lists every pass of the coming days over the mission's stations:
 AOS, culmination and LOS (UTC), maximum elevation, and what the pass can carry at the station's
 rates. `plan --mission M` turns passes into service 11 time-tagged commands (docs/passes.md).
+`uplink --mission M --days N` sends the predicted passes to the spacecraft as its onboard pass
+table (TC[8,1] ``Passes.load``; at most 64 windows, passes that overlap merged): the OBC's
+store-and-forward then starts its dumps at each AOS.
 """
 
 import datetime
 import json
 
 from obsw_host.errors import UserError
+from obsw_host.net import DEFAULT_HOST
 
 
 def add_parser(sub):
@@ -29,6 +33,15 @@ def add_parser(sub):
                     help="an onboard schedule report (JSON of `obsw ground` service 11 detail "
                     "report): check it against the plan instead of printing the plan")  # fmt: skip
     pl.set_defaults(func=plan_cmd)
+    up = s.add_parser("uplink", help="send the predicted passes as the onboard pass table")
+    _window(up)
+    up.add_argument("--host", default=DEFAULT_HOST, help="on-board host (default %(default)s)")
+    up.add_argument("--port", type=int, help="on-board UDP port (default: the mission's)")
+    up.add_argument("--apid", type=int, help="on-board APID (default: the database's 'pus')")
+    up.add_argument("--timeout", type=float, default=5.0, help="seconds to wait for the "
+                    "completion report (default 5)")  # fmt: skip
+    up.add_argument("-v", "--verbose", action="store_true", help="print every packet")
+    up.set_defaults(func=uplink_cmd)
 
 
 def _window(p):
@@ -113,3 +126,18 @@ def plan_cmd(args):
         print(s)
     print("%d commands for %d passes" % (len(steps), len(passes)))
     return 0
+
+
+def uplink_cmd(args):
+    """TC[8,1] Passes.load with the passes of the window: 0 when the OBC completed it."""
+    from obsw_host.commands import session
+    from obsw_host.ops.pass_table import LIMIT, table, windows
+
+    _, passes = predict(args)
+    ws = windows(passes)
+    if not args.json:
+        more = len(windows(passes, limit=10**6)) - len(ws)
+        print("%d passes, %d windows in the table%s" % (len(passes), len(ws), (
+            " (%d more beyond the table's %d: uplink again later)" % (more, LIMIT)
+            if more else "")))  # fmt: skip
+    return session.run(args, lambda g: g.perform("Passes.load", table=table(passes)))

@@ -107,6 +107,7 @@ class FdLink(_Outbox):
         self.fd = fd
         self.name = name
         self.enabled = True
+        self.carrier = True  # False: out of contact, nothing crosses either way
         os.set_blocking(fd, False)
         self._outbox(queue)
 
@@ -118,12 +119,13 @@ class FdLink(_Outbox):
 
     def read(self):
         try:
-            return os.read(self.fd, 65536)
+            data = os.read(self.fd, 65536)
         except (BlockingIOError, OSError):
             return b""
+        return data if self.carrier else b""  # read all the same: the other end never waits
 
     def write(self, data):
-        if not self.enabled:
+        if not self.enabled or not self.carrier:
             return
         if self.queue:
             self._queue(data)

@@ -27,6 +27,7 @@ from obsw_host.mission.errors import MissionError, Problem, did_you_mean, displa
 from obsw_host.mission.folder import MAX_PROCEDURE, locate, read_text
 from obsw_host.mission.schema import json_type, read_json, validate
 from obsw_host.obc.onboard_time import ONBOARD_TIME
+from obsw_host.obc.passes import PASSES
 from obsw_host.obc.plugins import Component, PluginError
 from obsw_host.obc.registry import KINDS, WITH_PUS
 from obsw_host.update.component import SOFTWARE
@@ -88,7 +89,8 @@ class _Checker:
         self.folder = os.path.dirname(os.path.abspath(mission_file))
         self.problems = []
         # component name -> Interface (the OBC's built-in ones, plug-ins and nodes)
-        self.interfaces = {ONBOARD_TIME.name: ONBOARD_TIME, SOFTWARE.name: SOFTWARE}
+        self.interfaces = {ONBOARD_TIME.name: ONBOARD_TIME, SOFTWARE.name: SOFTWARE,
+                           PASSES.name: PASSES}  # fmt: skip
         self.unresolved = set()  # components whose module is at fault (said once, there)
         self.where = {}  # kind or component -> the process that runs it
         self.nodes = {}  # SpaceCAN node name -> node id, of the definitions that load

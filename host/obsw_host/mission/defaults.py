@@ -64,7 +64,8 @@ PUS = {
     "monitoring": [],  # ST[12] limit checks installed at the first start (obc.monitoring)
 }
 CFDP = {
-    "peers": {}
+    "peers": {},
+    "poll": 0.005,  # seconds between the CFDP entity's steps
 }  # ports and ids: obsw_host.mission.ports and obsw_host.mission.ids (the mission's)
 OBCP = {"timeout": 2.0, "activity_timeout": 30.0, "level": 2, "step_period": 0.01}
 SPACECAN = {
@@ -123,6 +124,7 @@ PLATFORM = {
     # the OBC's context in its safeguard memory and the DS3231's time at start
     "module_uarts": None,  # the serial devices to its two controllers; None: no link
     "context_period": 1.0,  # seconds between context saves
+    "module_timeout": 1.0,  # seconds to wait for the module's time and context at start
 }
 # in-flight software updates (obsw_host.update): signed packages, two slots, a trial and rollback
 UPDATE = {
@@ -134,6 +136,12 @@ UPDATE = {
 }
 # the reconfiguration module's autonomous recovery of the OBC (delivered to the boards in their
 # mission.json, obsw.reconfig.mission); the module's own fallback is the same table, in the core
+CONTACT = {
+    "stores": [],  # service 15 stores dumped at AOS, by priority; none: TM in real time
+    "hold": 10.0,  # seconds in contact after the last TC heard (outside the pass table)
+    "downlink_bps": None,  # the dump's rate; None: the frames section's, else 9600
+    "share": 0.8,  # the share of the downlink the dump may take
+}
 RECOVERY = dict(_recovery.DEFAULTS, lines=list(_recovery.DEFAULTS["lines"]))
 SECTIONS = {
     "pus": PUS,
@@ -143,6 +151,7 @@ SECTIONS = {
     "frames": FRAMES,
     "platform": PLATFORM,
     "recovery": RECOVERY,
+    "contact": CONTACT,
     "update": UPDATE,
 }
 

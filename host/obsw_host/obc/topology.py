@@ -21,6 +21,7 @@ from obsw_host.mission.config import ConfigError
 from obsw_host.mission.ids import MissionIds
 from obsw_host.obc import plugins
 from obsw_host.obc.onboard_time import ONBOARD_TIME
+from obsw_host.obc.passes import PASSES
 from obsw_host.obc.registry import WITH_PUS
 from obsw_host.update.component import SOFTWARE
 
@@ -203,7 +204,7 @@ class Topology:
     def interfaces(self):
         """Every component interface of the OBC, wherever it runs (the OBCP engine's)."""
         frames = [FRAME_PROCESSOR] if self.runs("frames") else []
-        pus = [ONBOARD_TIME, SOFTWARE] if self.runs("pus") else []  # the PUS process's own
+        pus = [ONBOARD_TIME, SOFTWARE, PASSES] if self.runs("pus") else []  # the PUS process's own
         return self.component_interfaces() + self.equipment_interfaces() + frames + pus
 
     def describe(self):

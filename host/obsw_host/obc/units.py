@@ -28,6 +28,7 @@ from obsw_host.obc import monitoring
 from obsw_host.obc.health import HostHealth, ObcHealth
 from obsw_host.obc.module_link import ModuleLink
 from obsw_host.obc.onboard_time import ONBOARD_TIME, OnboardTime
+from obsw_host.obc.passes import PASSES, Passes
 from obsw_host.obc.ticks import Ticks
 from obsw_host.obc.topology import OBC_HEALTH, PLATFORM, PLATFORM_EVENTS
 from obsw_host.pus.onboard import Onboard, tai_now
@@ -162,6 +163,8 @@ class PusUnit:
         self.app = self.onboard.app
         self.obcp = self.app.services.get(18)
         self.node.provide(PLATFORM, PlatformEvents(self.app, sdb, self.health))
+        self.passes = self._passes(topology)
+        self.node.provide(PASSES, self.passes)
         self.software.refresh()  # update steps taken while this process was down: events
         self.module = None
         platform = topology.section("platform")
@@ -174,7 +177,7 @@ class PusUnit:
                 float(platform["context_period"]),
                 out,
             )
-            self.module.restore()
+            self.module.restore(float(platform["module_timeout"]))
         monitoring.install(self.app, sdb, opts["monitoring"])  # first start: the mission's
         self.app.unsent_listeners.append(self._unsent)
         self._reporting_unsent = False
@@ -214,10 +217,40 @@ class PusUnit:
             apid=ids.apid("cfdp"),
             packet_type=TYPE_TM,
         )
+        self.cfdp_poll = float(opts["poll"])
         self.copy = RemoteCopy(entity)
         self.node.provide(REMOTE_COPY, self.copy)
         self.cfdp.on_indication = self._indication
         entity.restore(time.monotonic())
+
+    def _passes(self, topology):
+        """Contact awareness (``obsw_host.obc.passes``): the pass table, the stores' dump,
+        CFDP held across passes."""
+        from obsw_host.frames.coding import LinkSettings
+
+        opts = topology.section("contact")
+        bps = opts["downlink_bps"] or LinkSettings.of(self.config).downlink_bps or 9600
+        passes = Passes(
+            self.app.services.get(15),
+            self.app.play,
+            self.onboard_time.now,
+            self.unit_event,
+            stores=[int(s) for s in opts["stores"]],
+            hold=float(opts["hold"]),
+            bps=float(bps),
+            share=float(opts["share"]),
+            entity=self.cfdp.entity if self.cfdp is not None else None,
+            path=os.path.join(self.config.state, "passes.json"),
+        )
+        if passes.enabled:
+            self.app.tm_filters.append(passes.realtime)
+        self.onboard.tc_listeners.append(passes.heard)
+        return passes
+
+    async def _passes_task(self):
+        while self._running:
+            self.passes.step()
+            await asyncio.sleep(self.onboard.period)
 
     def _obcp(self, opts):
         """The OBCP engine; returns what service 18 takes from the context."""
@@ -243,7 +276,7 @@ class PusUnit:
         while self._running:
             self.cfdp.step(0)
             self.copy.poll(time.monotonic())
-            await asyncio.sleep(0.005)
+            await asyncio.sleep(self.cfdp_poll)
 
     def _indication(self, ind):
         """CFDP indications: a state file set aside becomes an event, the rest go to the
@@ -323,6 +356,7 @@ class PusUnit:
         self.onboard.on_task_death = self._task_died
         self.onboard.tasks.append(self._transport_task)
         self.onboard.tasks.append(self._health_task)
+        self.onboard.tasks.append(self._passes_task)
         if self.cfdp is not None:
             self.onboard.tasks.append(self._cfdp_task)
         if self.engine is not None:

@@ -276,6 +276,7 @@ class Onboard:
         self.node = node if node is not None else Node("pus")
         self.address = None
         self.ground = None  # the sender of the last TC
+        self.tc_listeners = []  # called with no argument for every TC received
         self.fanout = TmFanout([tm_to])
         self._batch = None  # the TM of the TC being handled, sent once it is (_flush)
         self.tm_log = TmLog(sdb)
@@ -396,6 +397,8 @@ class Onboard:
     def _received(self, data, addr):
         if self.fanout.heard(data, addr):
             self.ground = addr
+            for heard in self.tc_listeners:
+                heard()
             self._batch = batch = []
             try:
                 self.app.receive(data)

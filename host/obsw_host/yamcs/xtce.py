@@ -602,6 +602,11 @@ class Generator:
             fields = [("fixed", "function", fid, 16), ("fixed", "n", len(f.arguments), 8)]
             for aid, aname, pair, labels in f.arguments:
                 fields.append(("fixed", "id_" + _label(aname), aid, 8))
+                if pair == (7, 0):  # variable octets: their length, then them
+                    length = _label(aname) + "_length"
+                    fields.append(("arg", length, argument_type("", U16)))
+                    fields.append(("arg", _label(aname), octets_argument_type("", pair, length)))
+                    continue
                 fields.append(("arg", _label(aname), argument_type("", pair, labels=labels)))
             self.command(
                 s, _label(f.path[-1]), M.TC_FUNCTION_PERFORM, fields, "TC[8,1] %s" % f.qualified

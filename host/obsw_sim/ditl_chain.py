@@ -1,0 +1,320 @@
+"""A day in the life of the whole chain: the OBC's processes, both reconfiguration
+controllers, TM frames and CLTUs between the OBC's UARTs and the station, the ground, flying
+the mission's orbit under time acceleration (``obsw_sim.faketime``: one clock, faster, in
+every process).
+
+``ChainDay(work, predictor, seconds)`` runs in a process started under libfaketime (the
+tool ``tools/ditl.py`` starts itself so). It brings the chain up with contact awareness on
+(``contact.stores``: store 1 for the high-priority housekeeping and the verification of the
+planned commands, store 2 for the routine housekeeping and the OBC's store backlog), then:
+
+- the pass table (``obsw_host.ops.pass_table``: the day's passes over the mission's first
+  station) goes up with TC[8,1] ``Passes.load``, and the plan (``obsw_host.ops.plan``: a
+  command ``lead`` s before AOS and one ``lag`` s after LOS, here ``SolarPanel.set_angle``
+  standing in for the transmitter) as TC[11,4];
+- the station's links carry nothing out of a pass (``FdLink.carrier``, set from the same
+  prediction): the OBC knows its passes from the table only; nothing is sent to it out of
+  contact;
+- in a pass the ground archives what comes down, by store and time tag, and every
+  ``ack_every`` s and just before LOS acknowledges what it has (``Passes.acknowledge``, after
+  the ``passes.dumped`` events: through the last sequence number whose reports all came) or
+  asks again for the rest (``Passes.resend``).
+
+``run()`` returns the figures (a dict) and keeps the series for the plots.
+"""
+
+import time
+
+from obsw_host.obc.passes import pack_table
+from obsw_host.ops.pass_table import windows
+from obsw_host.ops.plan import plan
+from obsw_host.pus.storage_ground import StorageGround
+from obsw_host.pus.tai import TAI_MINUS_UNIX
+
+from obsw_sim.chain import Chain
+
+HIGH, ROUTINE = 1, 2  # the stores, by priority
+HK_HIGH, HK_ROUTINE = 1, 30  # SolarPanel housekeeping; the backlog and the OBC's load
+PLAN_ON = "function SolarPanel.set_angle angle=30"
+PLAN_OFF = "function SolarPanel.set_angle angle=0"
+
+
+def chain_settings(chain, speed):
+    """The chain's timers for a run at ``speed``: heartbeats and deadlines in onboard seconds
+    that leave a loaded machine room (a deadline of 2 s is 20 ms here at 100 times)."""
+    slack = max(1.0, speed / 2.0)
+    chain.platform.update(heartbeat=1.0, deadline=3.0 * slack, start_timeout=60.0 * slack,
+                          context_period=5.0, module_timeout=1.0 * slack)  # fmt: skip
+    chain.sections["spacecan"] = {"heartbeat_period": 1.0, "timeout": 1.0 * slack}
+    chain.sections["frames"] = {"clcw_period": 1.0}
+    chain.sections["obcp"] = {"step_period": 0.5}
+    chain.sections["pus"] = {"period": 0.25}
+    chain.sections["cfdp"] = {"poll": 0.1}
+    chain.recovery.update(deadline=8.0 * slack, boot_grace=60.0 * slack)
+    chain.sim_options.update(watchdog_timeout_ms=int(3000 * slack), watchdog_open_ms=0,
+                             boot_limit=30.0 * slack)  # fmt: skip
+
+
+class ChainDay:
+    """One run of the whole chain (see the module text)."""
+
+    def __init__(self, work, predictor, seconds, speed, out=None, hk_period=10.0,
+                 ack_every=60.0, lead=60.0, lag=30.0):  # fmt: skip
+        self.work = work
+        self.pred = predictor
+        self.station = predictor.stations[0]
+        self.seconds = seconds
+        self.speed = speed
+        self.out = out
+        self.hk_period = hk_period
+        self.ack_every = ack_every
+        self.lead, self.lag = lead, lag
+        self.chain = Chain(work, out=out, processes=Chain.SAMPLE_PROCESSES,
+                           timeout=10.0 * max(1.0, speed / 2.0))  # fmt: skip
+        self.chain.sections["contact"] = {"stores": [HIGH, ROUTINE], "hold": 5.0}
+        chain_settings(self.chain, speed)
+        self.archive = {HIGH: {}, ROUTINE: {}}  # store -> {key: arrival (onboard s)}
+        self.duplicates = 0
+        self.dumped = {HIGH: [], ROUTINE: []}  # (first, last, count) of passes.dumped
+        self.acked = {HIGH: 0, ROUTINE: 0}
+        self.resends = 0
+        self._asked = {}
+        self.backlog = []  # (onboard s, octets) from store 2's reports
+        self.executed = {}  # planned step index -> onboard time of its TM[1,7]
+        self.plan = []
+        self.pass_use = []  # (aos, los, packets down, volume octets)
+        self.series = {"t": [], "generated": [], "delivered": []}
+        self.generated = {HK_HIGH: [], HK_ROUTINE: []}  # time tags seen, to count them
+        self.contacts = 0
+        self._tx_steps = {}  # request id -> plan step index
+
+    def say(self, text):
+        if self.out is not None:
+            self.out(text)
+
+    # ---------------------------------------------------------------- the ground's view
+
+    def _tm(self, tm, decoded, tx):
+        """Every TM the ground decodes: archive, dump events, plan verification."""
+        if tm.service == 3 and tm.subtype == 25 and len(tm.data) >= 2:
+            sid = tm.data[0] << 8 | tm.data[1]
+            store = HIGH if sid == HK_HIGH else ROUTINE if sid == HK_ROUTINE else None
+            if store is None:
+                return
+            key = ("hk", sid, tm.time)
+            if key in self.archive[store]:
+                self.duplicates += 1
+            self.archive[store][key] = self.onboard()
+            if sid == HK_ROUTINE and decoded and "values" in decoded:
+                v = decoded["values"].get("Passes.backlog")
+                if v is not None:
+                    self.backlog.append((_seconds(tm), v))
+        elif tm.service == 1 and tm.subtype == 7 and decoded:
+            step = self._tx_steps.get(decoded.get("request_id"))
+            if step is not None:
+                key = ("tc", step)
+                if key in self.archive[HIGH]:
+                    self.duplicates += 1
+                self.archive[HIGH][key] = self.onboard()
+                self.executed[step] = _seconds(tm)
+        elif tm.service == 5 and len(tm.data) >= 2:
+            eid = tm.data[0] << 8 | tm.data[1]
+            if eid == self._dumped.id:
+                d = self._dumped.unpack(tm.data[2:])
+                if d["store"] in self.dumped:
+                    self.dumped[d["store"]].append((d["first"], d["last"], d["count"]))
+
+    def onboard(self):
+        return time.time() + TAI_MINUS_UNIX
+
+    # ---------------------------------------------------------------- set-up
+
+    def _wait_up(self):
+        """Ping until one completes, each with a timeout that a loaded machine can meet."""
+        slack = max(1.0, self.speed / 2.0)
+        end = time.monotonic() + 600.0 * slack
+        while time.monotonic() < end:
+            try:
+                if self.chain.ground.ping(timeout=5.0 * slack).ok:
+                    return
+            except Exception:
+                pass
+        raise TimeoutError("no ping completed through the chain")
+
+    def _setup(self):
+        chain = self.chain
+        g = chain.ground
+        g.keep_unsolicited = 100
+        self._dumped = chain.sdb.event("passes.dumped")
+        g.proc.listeners.append(self._tm)
+        sg = StorageGround(g)
+        apid = g.apid
+        period = float(chain.config.section("pus").get("period", 0.1))
+        ticks = lambda s: max(1, int(round(s / period)))  # noqa: E731
+        ok = [
+            g.create_hk(HK_ROUTINE, ticks(self.hk_period * 6),
+                        ["Passes.backlog", "Obc.cpu_load", "Obc.restarts"]).ok,
+            g.set_hk_interval(HK_HIGH, ticks(self.hk_period)).ok,
+            g.enable_hk([HK_HIGH, HK_ROUTINE]).ok,
+        ]  # fmt: skip
+        for store, types, sids in ((HIGH, {3: [25], 1: [7, 8]}, [HK_HIGH]),
+                                   (ROUTINE, {3: [25]}, [HK_ROUTINE])):  # fmt: skip
+            ok.append(sg.create_store(store, 4_000_000, kind=1).ok)
+            ok.append(sg.store_types(store, {apid: types}).ok)
+            ok.append(sg.issue(sg.storage.add_hk(apid, store, {apid: sids})).ok)
+        ok.append(sg.enable_storage([HIGH, ROUTINE]).ok)
+        if not all(ok):
+            raise RuntimeError("the day's stores and housekeeping were not set up: %r" % ok)
+        self.sg = sg
+
+    def _uplink(self):
+        g = self.chain.ground
+        table = pack_table(windows(self.passes))
+        tx = g.perform("Passes.load", table=table)
+        if not tx.ok:
+            raise RuntimeError("pass table refused: %s" % tx.verification())
+        self.plan = plan(self.passes, lead=self.lead, lag=self.lag, tx_on=PLAN_ON,
+                         tx_off=PLAN_OFF)  # fmt: skip
+        for i, step in enumerate(self.plan):
+            words = step.request.split()
+            args = dict(w.split("=", 1) for w in words[2:])
+            req = g.function_request(words[1], **{k: float(v) for k, v in args.items()})
+            self._tx_steps[req.request_id] = i
+            tx = g.schedule_at(step.time + TAI_MINUS_UNIX, req)
+            if not tx.ok:
+                raise RuntimeError("plan step %d refused: %s" % (i, tx.verification()))
+
+    # ---------------------------------------------------------------- the day
+
+    def in_pass(self, t):
+        for p in self.passes:
+            if p.aos <= t < p.los:
+                return p
+        return None
+
+    def _carrier(self, on):
+        for link in self.chain.links:
+            link.carrier = on
+
+    def run(self, progress=None):
+        chain = self.chain
+        began = time.monotonic()
+        chain.start()
+        try:
+            self._wait_up()
+            self._setup()
+            self.start = time.time()
+            self.end = self.start + self.seconds
+            self.passes = [p for p in self.pred.passes(self.start, self.end, [self.station])
+                           if p.aos > self.start + 60.0]  # fmt: skip
+            self._uplink()
+            self.say("chain up and set in %.0f s here; %d passes to fly" % (
+                time.monotonic() - began, len(self.passes)))  # fmt: skip
+            self._fly(progress)
+        finally:
+            chain.stop()
+        return self.figures()
+
+    def _fly(self, progress):
+        g = self.chain.ground
+        current = None
+        last_ack = 0.0
+        next_sample = self.start
+        next_progress = self.start + 3600.0
+        while True:
+            now = time.time()
+            if now >= self.end:
+                break
+            p = self.in_pass(now)
+            if p is not None and current is None:  # AOS
+                self._carrier(True)
+                self.contacts += 1
+                current = [p.aos, p.los, sum(len(a) for a in self.archive.values()),
+                           self.station.downlink_bps * (p.los - p.aos) / 8]  # fmt: skip
+                last_ack = now
+            elif p is None and current is not None:  # LOS
+                self._carrier(False)
+                current[2] = sum(len(a) for a in self.archive.values()) - current[2]
+                self.pass_use.append(tuple(current))
+                current = None
+            # once more within 15 s of LOS, whatever the period
+            closing = current is not None and now > current[1] - 15.0 > last_ack
+            if current is not None and (now - last_ack >= self.ack_every or closing):
+                last_ack = now
+                self._acknowledge()
+            g.poll(0.05)
+            if now >= next_sample:
+                next_sample += 60.0
+                self.series["t"].append(now)
+                self.series["delivered"].append(sum(len(a) for a in self.archive.values()))
+            if progress is not None and now >= next_progress:
+                next_progress += 3600.0
+                progress(now - self.start, self)
+        self._carrier(False)
+
+    def _acknowledge(self):
+        """Acknowledge, per store, through the last sequence number dumped when every packet
+        dumped so far came; else ask again for those after the last acknowledgement."""
+        g = self.chain.ground
+        for store in (HIGH, ROUTINE):
+            dumps = self.dumped[store]
+            if not dumps:
+                continue
+            seqs = set()
+            for first, last, _count in dumps:
+                seqs.update(range(first, last + 1))
+            last = max(seqs)
+            try:
+                if len(self.archive[store]) >= len(seqs):
+                    if last > self.acked[store]:
+                        tx = g.perform("Passes.acknowledge", store=store, seq=last, timeout=10.0)
+                        if tx.ok:
+                            self.acked[store] = last
+                elif not self._asked.get(store):
+                    g.perform("Passes.resend", store=store, first=self.acked[store] + 1,
+                              last=last, timeout=10.0)  # fmt: skip
+                    self._asked[store] = True
+                    self.resends += 1
+                else:
+                    self._asked[store] = False  # asked last round: ask again next round
+            except Exception as e:  # a TC lost at the pass's edge: the next round asks again
+                self.say("acknowledgement of store %d: %s" % (store, e))
+
+    # ---------------------------------------------------------------- figures
+
+    def figures(self):
+        planned = [(i, s.time + TAI_MINUS_UNIX) for i, s in enumerate(self.plan)
+                   if s.time < self.end]  # fmt: skip
+        lateness = [self.executed[i] - t for i, t in planned if i in self.executed]
+        hk = sorted(k[2] for k in self.archive[HIGH] if k[0] == "hk")
+        hk_s = [c + f / 65536.0 for c, f in hk]
+        gaps = [b - a for a, b in zip(hk_s, hk_s[1:])]
+        # every report from the first to the last delivered came: no gap beyond the period
+        missing = sum(int(round(d / self.hk_period)) - 1 for d in gaps
+                      if d > 1.5 * self.hk_period)  # fmt: skip
+        orbit_s = 86400.0 / self.pred.tle.mean_motion
+        return {
+            "hours": self.seconds / 3600.0,
+            "orbits": self.seconds / orbit_s,
+            "passes": len(self.passes),
+            "contacts": self.contacts,
+            "delivered": {s: len(a) for s, a in self.archive.items()},
+            "hk_high": len(hk),
+            "missing": missing,
+            "duplicates": self.duplicates,
+            "resends": self.resends,
+            "acked": dict(self.acked),
+            "max_backlog": max((v for _, v in self.backlog), default=0),
+            "store_size": 4_000_000,
+            "planned": len(planned),
+            "executed": len(lateness),
+            "max_lateness": max((abs(x) for x in lateness), default=float("inf")),
+            "lateness": lateness,
+            "pass_use": self.pass_use,
+            "obc_boots": self.chain.sim.obc_boots if self.chain.sim else None,
+        }
+
+
+def _seconds(tm):
+    coarse, fine = tm.time
+    return coarse + fine / 65536.0

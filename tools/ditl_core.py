@@ -1,0 +1,188 @@
+#!/usr/bin/env python3
+"""A day in the life of the sample spacecraft at the core's level (obsw_sim.ditl: one
+process, one injected clock, the 5 MB and 1 MB files across passes): run it, check it, write
+its page. The whole chain's day is tools/ditl.py.
+
+python tools/ditl_core.py               24 hours from the orbit's epoch, checked; prints figures
+python tools/ditl_core.py --orbits 2    the bounded run (tools/test): two orbits from an hour
+                                        before the first pass, smaller files
+python tools/ditl_core.py --write       also write docs/ditl-last-run.md and docs/ditl.png
+
+The closing line is 'N passed, N failed' over the checks of the run (exit status 1 if any
+failed).
+"""
+
+import argparse
+import datetime
+import os
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
+
+from obsw_host.mission.check import load  # noqa: E402
+from obsw_host.ops.passes import from_mission  # noqa: E402
+from obsw_host.ops.tle import format_time  # noqa: E402
+from obsw_sim.ditl import HK, Day  # noqa: E402
+
+MISSION = os.path.join(ROOT, "examples", "sample")
+
+
+def _utc(t):
+    return format_time(datetime.datetime.fromtimestamp(t, datetime.timezone.utc))
+
+
+def checks(day, f, full):
+    """(name, ok, detail) of each check of the run."""
+    out = []
+    if full:
+        out.append(("24 hours, 15 orbits, 4 passes", f["hours"] >= 24 and f["orbits"] >= 15
+                    and f["passes"] >= 4, "%.1f h, %.1f orbits, %d passes" % (
+                        f["hours"], f["orbits"], f["passes"])))  # fmt: skip
+    else:
+        out.append(("two orbits, two passes", f["orbits"] >= 2 and f["passes"] >= 2,
+                    "%.1f orbits, %d passes" % (f["orbits"], f["passes"])))  # fmt: skip
+    due = sum(f["due"].values())
+    out.append(("housekeeping delivered exactly once", f["missing"] == 0 and
+                f["duplicates"] == 0 and due > 0, "%d due, %d missing, %d duplicates, %d asked "
+                "again" % (due, f["missing"], f["duplicates"], f["resend_requests"])))  # fmt: skip
+    out.append(("planned commands executed within 1 s", f["executed"] == f["planned"] > 0
+                and f["max_lateness"] <= 1.0, "%d of %d, latest %.3f s after its time" % (
+                    f["executed"], f["planned"], f["max_lateness"])))  # fmt: skip
+    for name, ok in (("down", f["down_file"]), ("up", f["up_file"])):
+        prog = [p for _t, p in f[name + "_resumes"]]
+        across = len([p for p in prog if p > 0]) >= 1
+        never_restarted = prog == sorted(prog)
+        size = len(day.down_data if name == "down" else day.up_data)
+        out.append(("%s file (%d octets) identical across passes" % (name, size),
+                    ok and across and never_restarted, "identical %s; received at each AOS %s" % (
+                        ok, prog)))  # fmt: skip
+    volume = sum(u[3] for u in f["pass_use"])
+    generated = sum(HK[s][1] * f["generated"][s] for s in HK)
+    out.append(("stores never overflow", f["overflow"] == 0 and volume > generated,
+                "peak fill %d %%, %d octets of passes against %d generated" % (
+                    f["max_store_fill"], volume, generated)))  # fmt: skip
+    return out
+
+
+def plot(day, f, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t0 = day.start
+    fig, ax = plt.subplots(4, 1, figsize=(9, 10))
+    ts = [t0 + i * 60.0 for i in range(int((day.end - t0) / 60) + 1)]
+    st = day.station
+    el = [day.pred.elevation(st, t) for t in ts]
+    h = [(t - t0) / 3600 for t in ts]
+    ax[0].plot(h, el, lw=0.7)
+    ax[0].axhline(st.min_elevation, color="grey", ls="--", lw=0.7)
+    for p in day.passes:
+        ax[0].axvspan((p.aos - t0) / 3600, (p.los - t0) / 3600, color="tab:green", alpha=0.3)
+    for t, _req in day.executed:
+        ax[0].axvline((t - t0) / 3600, color="tab:red", lw=0.5)
+    ax[0].set_ylim(0, 90)
+    ax[0].set_ylabel("elevation (deg)")
+    ax[0].set_title("passes over %s (green), planned commands executed (red)" % st.name)
+    sh = [(t - t0) / 3600 for t in day.series["t"]]
+    ax[1].plot(sh, day.series["fill"])
+    ax[1].set_ylabel("store fill (%)")
+    ax[1].set_title("the fuller packet store over the day")
+    n = range(len(f["pass_use"]))
+    ax[2].bar([i - 0.2 for i in n], [u[3] / 1e6 for u in f["pass_use"]], 0.4, label="volume")
+    ax[2].bar([i + 0.2 for i in n], [u[2] / 1e6 for u in f["pass_use"]], 0.4, label="sent")
+    ax[2].set_xticks(list(n))
+    ax[2].set_xticklabels(["pass %d" % (i + 1) for i in n])
+    ax[2].set_ylabel("MB")
+    ax[2].set_title("link use per pass")
+    ax[2].legend()
+    ax[3].plot(sh, day.series["generated"], label="generated on board")
+    ax[3].plot(sh, day.series["delivered"], label="delivered to the ground")
+    ax[3].set_xlabel("hours from %s" % _utc(t0))
+    ax[3].set_ylabel("housekeeping reports")
+    ax[3].legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def page(day, f, results, seconds, args):
+    rows = ["| pass | AOS (UTC) | LOS (UTC) | max el | volume (octets) | sent (octets) |",
+            "|---|---|---|---|---|---|"]  # fmt: skip
+    for i, (p, u) in enumerate(zip(day.passes, f["pass_use"])):
+        rows.append("| %d | %s | %s | %.1f | %d | %d |" % (
+            i + 1, _utc(p.aos), _utc(p.los), p.max_elevation, u[3], u[2]))  # fmt: skip
+    plan = ["| planned (UTC) | executed (onboard) | request |", "|---|---|---|"]
+    for s, (te, _req) in zip(sorted(day.plan, key=lambda s: s.time), sorted(day.executed)):
+        plan.append("| %s | %s | `%s` |" % (_utc(s.time), _utc(te), s.request))
+    checks_md = ["| check | result | figures |", "|---|---|---|"]
+    for name, ok, detail in results:
+        checks_md.append("| %s | %s | %s |" % (name, "pass" if ok else "FAIL", detail))
+    return "\n".join([
+        "# Day in the life: the last run",
+        "",
+        "Written by `python tools/ditl_core.py --write` (the rig and its design: "
+        "[Operations across passes](passes.md)). %.1f hours of orbit (%.1f orbits) of the "
+        "sample spacecraft from %s, computed in %.1f s on one injected clock, "
+        "loss %g each way." % (f["hours"], f["orbits"], _utc(day.start), seconds, args.loss),
+        "",
+        "![the day: passes, store fill, link use, data generated and delivered](ditl.png)",
+        "",
+        "## Checks",
+        "",
+        *checks_md,
+        "",
+        "## Passes",
+        "",
+        *rows,
+        "",
+        "## Commands planned and executed",
+        "",
+        *plan,
+        "",
+    ])  # fmt: skip
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawTextHelpFormatter
+    )
+    ap.add_argument("--orbits", type=float, help="a bounded run of this many orbits")
+    ap.add_argument("--hours", type=float, default=24.0, help="the full run's length")
+    ap.add_argument("--loss", type=float, default=1e-3, help="share of packets lost each way")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--write", action="store_true", help="write docs/ditl-last-run.md, ditl.png")
+    args = ap.parse_args(argv)
+    m = load(MISSION)
+    pred = from_mission(m.config.doc)
+    t0 = pred.tle.epoch.timestamp()
+    if args.orbits:
+        first = pred.passes(t0, t0 + 86400, pred.stations[:1])[0]
+        start = first.aos - 3600.0
+        seconds = args.orbits * 86400.0 / pred.tle.mean_motion
+        day = Day(pred, start, seconds, down_file=2_000_000, up_file=500_000, loss=args.loss,
+                  seed=args.seed)  # fmt: skip
+    else:
+        day = Day(pred, t0, args.hours * 3600, loss=args.loss, seed=args.seed)
+    began = time.monotonic()
+    f = day.run()
+    took = time.monotonic() - began
+    results = checks(day, f, full=not args.orbits)
+    for name, ok, detail in results:
+        print("%s %s: %s" % ("ok  " if ok else "FAIL", name, detail))
+    print("%.1f h of orbit in %.1f s" % (f["hours"], took))
+    if args.write:
+        plot(day, f, os.path.join(ROOT, "docs", "ditl.png"))
+        with open(os.path.join(ROOT, "docs", "ditl-last-run.md"), "w") as out:
+            out.write(page(day, f, results, took, args))
+        print("wrote docs/ditl-last-run.md and docs/ditl.png")
+    bad = sum(1 for r in results if not r[1])
+    print("%d passed, %d failed" % (len(results) - bad, bad))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

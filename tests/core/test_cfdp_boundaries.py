@@ -1,0 +1,132 @@
+"""CFDP edges: the retransmission list's merge, the large file flag at 4 GiB, NAKs clipped to
+what was sent, a prompted NAK that covers the tail gap, and Prompts a receiver must ignore."""
+
+import unittest
+
+from cfdp_sim import directive, make_pair, payload
+from obsw.cfdp.defs import ACKNOWLEDGED, PROMPT_KEEP_ALIVE, PROMPT_NAK, UNACKNOWLEDGED
+from obsw.cfdp.filestore import MemoryFilestore
+from obsw.cfdp.pdu.nak import NakPdu
+from obsw.cfdp.pdu.prompt import PromptPdu
+from obsw.cfdp.sender import SENDING, add_interval
+
+DATA = payload(2000)
+DIR_EOF = 0x04
+DIR_NAK = 0x08
+DIR_KEEP_ALIVE = 0x0C
+
+
+def file_offset(pdu):
+    """The offset of a raw file data PDU (small file, no segment metadata), or None."""
+    if not pdu[0] & 0x10:
+        return None
+    at = 4 + 2 * (((pdu[3] >> 4) & 7) + 1) + (pdu[3] & 7) + 1  # past the fixed header
+    return int.from_bytes(pdu[at : at + 4], "big")
+
+
+class SizedFilestore(MemoryFilestore):
+    """A filestore whose one file reports ``size`` octets (none of which is ever read here)."""
+
+    def __init__(self, size):
+        super().__init__({"big.bin": b""})
+        self._size = size
+
+    def size(self, name):
+        return self._size
+
+
+class TestAddInterval(unittest.TestCase):
+    def test_overlapping_from_above_keeps_the_lower_start(self):
+        lst = [[10, 20]]
+        add_interval(lst, 15, 30)
+        self.assertEqual(lst, [[10, 30]])
+
+    def test_touching_intervals_merge(self):
+        lst = [[10, 20], [30, 40]]
+        add_interval(lst, 20, 30)
+        self.assertEqual(lst, [[10, 40]])
+
+    def test_disjoint_intervals_stay_apart_in_order(self):
+        lst = [[10, 20], [50, 60]]
+        add_interval(lst, 30, 40)
+        self.assertEqual(lst, [[10, 20], [30, 40], [50, 60]])
+        add_interval(lst, 0, 5)
+        add_interval(lst, 70, 80)
+        self.assertEqual(lst, [[0, 5], [10, 20], [30, 40], [50, 60], [70, 80]])
+
+    def test_one_interval_covering_several(self):
+        lst = [[10, 20], [30, 40], [50, 60]]
+        add_interval(lst, 5, 55)
+        self.assertEqual(lst, [[5, 60]])
+
+
+class TestLargeFileFlag(unittest.TestCase):
+    def large(self, size):
+        a, _ = make_pair()
+        a.fs = SizedFilestore(size)
+        return a.find(a.put(2, "big.bin", "big.bin")).header.large
+
+    def test_below_4_gib_is_small(self):
+        self.assertFalse(self.large(0))
+        self.assertFalse(self.large(2000))
+        self.assertFalse(self.large((1 << 32) - 1))
+
+    def test_4_gib_and_above_is_large(self):
+        self.assertTrue(self.large(1 << 32))
+        self.assertTrue(self.large((1 << 33) + 1))
+
+
+class TestNakClippedToProgress(unittest.TestCase):
+    def test_a_nak_beyond_what_was_sent_asks_only_for_what_was_sent(self):
+        a, _ = make_pair(files_a={"src.bin": DATA}, mode=ACKNOWLEDGED)
+        tid = a.put(2, "src.bin", "dst.bin")
+        a.transmit(0, 3)  # metadata and the first two segments
+        tx = a.find(tid)
+        self.assertEqual((tx.state_, tx.progress), (SENDING, 128))
+        tx.on_pdu(NakPdu(tx.directive_header(), 0, len(DATA), [(0, len(DATA))]), 1)
+        self.assertEqual(tx.resend, [[0, 128]])
+
+
+def deliver(src, dst, now, keep=lambda pdu: True):
+    """Every PDU ``src`` has to send, those ``keep`` accepts handed to ``dst``; the raw PDUs."""
+    sent = []
+    while True:
+        out = [pdu for _dest, pdu in src.transmit(now, 32)]
+        if not out:
+            return sent
+        for pdu in out:
+            sent.append(pdu)
+            if keep(pdu):
+                dst.receive(pdu, now)
+
+
+class TestPrompts(unittest.TestCase):
+    def test_a_prompted_nak_names_the_gap_at_the_end_of_the_file(self):
+        a, b = make_pair(files_a={"src.bin": DATA}, mode=ACKNOWLEDGED)
+        tid = a.put(2, "src.bin", "dst.bin")
+        tail = 1280
+        sent = deliver(a, b, 0, lambda pdu: (file_offset(pdu) or 0) < tail)
+        self.assertIn(DIR_EOF, [directive(p) for p in sent])
+        deliver(b, a, 0, lambda pdu: False)  # the EOF ACK and the NAK at EOF, lost
+        self.assertTrue(a.prompt(tid, PROMPT_NAK, 1))
+        deliver(a, b, 1)
+        naks = [
+            a.receive(p, 1) for p in deliver(b, a, 1, lambda p: False) if directive(p) == DIR_NAK
+        ]
+        self.assertEqual(len(naks), 1)
+        self.assertEqual(naks[0].segments, [(tail, len(DATA))])
+
+    def test_an_unacknowledged_receiver_ignores_prompts(self):
+        a, b = make_pair(files_a={"src.bin": DATA}, mode=UNACKNOWLEDGED)
+        tid = a.put(2, "src.bin", "dst.bin")
+        first = [pdu for _dest, pdu in a.transmit(0, 2)]  # metadata, first segment
+        for pdu in first:
+            b.receive(pdu, 0)
+        header = a.find(tid).directive_header()
+        for kind in (PROMPT_KEEP_ALIVE, PROMPT_NAK):
+            b.receive(PromptPdu(header, kind).pack(), 1)
+        self.assertEqual([pdu for _dest, pdu in b.transmit(1, 32)], [])
+
+
+if __name__ == "__main__":
+    unittest.main()

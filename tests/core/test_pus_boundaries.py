@@ -1,0 +1,122 @@
+"""PUS packet fields at their edges: all-ones APID, sequence count and version, the length field
+one off either way, and the errors that name what was wrong."""
+
+import unittest
+
+from obsw.pus.packets import (
+    PusHeaderError,
+    PusLengthError,
+    PusTooShortError,
+    RequestId,
+    unpack_packet,
+)
+from obsw.pus.tc import PusTc
+from obsw.pus.tm import PusTm
+
+
+def _crc(data):
+    # CRC-16/CCITT-FALSE from its definition (polynomial 0x1021, preset all ones)
+    reg = 0xFFFF
+    for byte in data:
+        reg ^= byte << 8
+        for _ in range(8):
+            reg = ((reg << 1) ^ 0x1021) & 0xFFFF if reg & 0x8000 else (reg << 1) & 0xFFFF
+    return reg
+
+
+def _resealed(body):
+    """``body`` (a packet without its PEC) with a valid PEC appended."""
+    c = _crc(body)
+    return bytes(body) + bytes((c >> 8, c & 0xFF))
+
+
+class TestAllOnesFields(unittest.TestCase):
+    def test_tc_apid_and_sequence_count_all_ones(self):
+        raw = PusTc(0x7FF, 17, 1, b"ab", seq_count=0x3FFF, ack=15, source_id=0xFFFF).pack()
+        tc = PusTc.unpack(raw)
+        self.assertEqual(
+            (tc.apid, tc.seq_count, tc.ack, tc.source_id), (0x7FF, 0x3FFF, 15, 0xFFFF)
+        )
+        self.assertEqual(tc.data, b"ab")
+
+    def test_tc_apid_and_sequence_count_one_below_all_ones(self):
+        tc = PusTc.unpack(PusTc(0x7FE, 17, 1, b"", seq_count=0x3FFE).pack())
+        self.assertEqual((tc.apid, tc.seq_count), (0x7FE, 0x3FFE))
+
+    def test_request_id_fields_from_all_ones_words(self):
+        r = RequestId.from_words(0xFFFF, 0xFFFF)
+        self.assertEqual((r.version, r.packet_type, r.sec_header_flag), (7, 1, 1))
+        self.assertEqual((r.apid, r.seq_flags, r.seq_count), (0x7FF, 3, 0x3FFF))
+        self.assertEqual(RequestId.from_words(0x1FFF, 0).version, 0)
+        self.assertEqual(RequestId.from_words(0x2000, 0).version, 1)
+
+    def test_request_ids_that_differ_hash_apart(self):
+        # the hash is the 32-bit request ID itself: no two IDs share one
+        pairs = ((0x0001, 0x0000), (0x0000, 0x8000), (0x0000, 0xFFFF), (0x0001, 0x7FFF))
+        hashes = set(hash(RequestId.from_words(p, s)) for p, s in pairs)
+        self.assertEqual(len(hashes), len(pairs))
+        a, b = RequestId.from_words(0x1FFF, 0xC000), RequestId.from_words(0x1FFF, 0xC000)
+        self.assertEqual((a, hash(a)), (b, hash(b)))
+
+
+class TestLengthField(unittest.TestCase):
+    def test_length_field_one_above_the_packet(self):
+        raw = bytearray(PusTc(0x10, 17, 1, b"abcd").pack())
+        dlen = raw[4] << 8 | raw[5]
+        raw[4:6] = bytes(((dlen + 1) >> 8, (dlen + 1) & 0xFF))
+        with self.assertRaises(PusLengthError):
+            PusTc.unpack(_resealed(raw[:-2]))
+
+    def test_length_field_one_below_the_packet(self):
+        raw = bytearray(PusTc(0x10, 17, 1, b"abcd").pack())
+        dlen = raw[4] << 8 | raw[5]
+        raw[4:6] = bytes(((dlen - 1) >> 8, (dlen - 1) & 0xFF))
+        with self.assertRaises(PusLengthError):
+            PusTc.unpack(_resealed(raw[:-2]))
+
+    def test_length_field_exact(self):
+        self.assertEqual(PusTc.unpack(PusTc(0x10, 17, 1, b"abcd").pack()).data, b"abcd")
+
+
+class TestHeaderErrorsNameTheValue(unittest.TestCase):
+    def test_a_tm_given_as_tc_names_its_packet_type(self):
+        raw = PusTm(0x10, 1, 1, b"").pack()
+        with self.assertRaises(PusHeaderError) as cm:
+            PusTc.unpack(raw)
+        e = cm.exception
+        self.assertEqual((e.field, e.expected, e.actual), ("packet type", 1, 0))
+
+    def test_a_tc_given_as_tm_names_its_packet_type(self):
+        raw = PusTc(0x10, 17, 1, b"").pack()
+        with self.assertRaises(PusHeaderError) as cm:
+            PusTm.unpack(raw)
+        e = cm.exception
+        self.assertEqual((e.field, e.expected, e.actual), ("packet type", 0, 1))
+
+    def test_no_secondary_header_flag(self):
+        raw = bytearray(PusTc(0x10, 17, 1, b"").pack())
+        raw[0] &= ~0x08
+        with self.assertRaises(PusHeaderError) as cm:
+            PusTc.unpack(_resealed(raw[:-2]))
+        e = cm.exception
+        self.assertEqual((e.field, e.expected, e.actual), ("secondary header flag", 1, 0))
+
+
+class TestUnpackPacket(unittest.TestCase):
+    def test_one_octet_with_the_tc_bit_is_a_short_tc(self):
+        with self.assertRaises(PusTooShortError) as cm:
+            unpack_packet(b"\x18")
+        self.assertTrue(str(cm.exception).startswith("TC"), str(cm.exception))
+
+    def test_one_octet_without_it_is_a_short_tm(self):
+        with self.assertRaises(PusTooShortError) as cm:
+            unpack_packet(b"\x08")
+        self.assertTrue(str(cm.exception).startswith("TM"), str(cm.exception))
+
+    def test_nothing_is_a_short_tm(self):
+        with self.assertRaises(PusTooShortError):
+            unpack_packet(b"")
+
+
+if __name__ == "__main__":
+    unittest.main()

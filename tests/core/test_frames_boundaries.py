@@ -82,6 +82,121 @@ class TestFopEdges(unittest.TestCase):
         self.assertEqual(f.state, F.ACTIVE)
 
 
+class TestFopLowerProcedures(unittest.TestCase):
+    """FOP-1 with lower procedures that take frames when they say so (auto_accept off)."""
+
+    def test_alert_codes_are_distinct(self):
+        codes = (F.ALERT_LIMIT, F.ALERT_T1, F.ALERT_LOCKOUT, F.ALERT_SYNCH, F.ALERT_NNR)
+        self.assertEqual(len(set(codes)), len(codes))
+        self.assertEqual(F.ALERT_NAMES[F.ALERT_T1], "T1")
+        self.assertEqual(F.ALERT_NAMES[F.ALERT_LOCKOUT], "LOCKOUT")
+
+    def test_e22_a_second_bd_frame_before_the_first_is_taken(self):
+        f = F.Fop1(1, 0, auto_accept=False)
+        f.send_bd(b"a", now=0)
+        rid = f.send_bd(b"b", now=0)
+        self.assertEqual(f.last_event, 22)
+        self.assertEqual(f.take_notifications()[-1], (F.REJECT, rid, None))
+        self.assertEqual(([fr.data for fr in f.take_frames()], f.state), ([b"a"], F.INITIAL))
+
+    def test_e45_bd_frame_taken_makes_room_for_the_next(self):
+        f = F.Fop1(1, 0, auto_accept=False)
+        f.send_bd(b"a", now=0)
+        f.lower_response(2, True, now=0)
+        self.assertTrue(f.bd_out)
+        f.send_bd(b"b", now=0)
+        self.assertEqual([fr.data for fr in f.take_frames()], [b"a", b"b"])
+
+    def test_e46_bd_frame_refused_is_an_llif_alert(self):
+        f = F.Fop1(1, 0, auto_accept=False)
+        f.directive(F.INITIATE_AD_NO_CLCW, now=0)
+        f.send_bd(b"a", now=0)
+        f.take_notifications()
+        f.lower_response(2, False, now=0)
+        self.assertEqual(f.last_event, 46)
+        self.assertIn((F.ALERT, None, F.ALERT_LLIF), f.take_notifications())
+        self.assertEqual(f.state, F.INITIAL)
+
+    def test_e28_set_vr_while_a_bc_frame_is_out_is_rejected(self):
+        f = F.Fop1(1, 0, auto_accept=False)
+        f.directive(F.INITIATE_AD_WITH_UNLOCK, now=0)
+        f.directive(F.TERMINATE_AD, now=0)
+        f.take_frames()
+        f.take_notifications()
+        rid = f.directive(F.INITIATE_AD_WITH_SET_VR, 5, now=1)
+        self.assertEqual(f.last_event, 28)
+        self.assertEqual(f.take_notifications(), [(F.REJECT, rid, None)])
+        self.assertEqual((f.take_frames(), f.vs), ([], 0))
+
+    def test_a_retransmitted_bc_frame_waits_for_the_lower_procedures(self):
+        f = F.Fop1(1, 0, t1=1, transmission_limit=5, auto_accept=False)
+        f.directive(F.INITIATE_AD_WITH_UNLOCK, now=0)
+        f.lower_response(1, True, now=0)  # the BC frame taken
+        self.assertEqual(len(f.take_frames()), 1)
+        f.tick(1)  # retransmitted, handed down again: not taken yet
+        self.assertEqual(len(f.take_frames()), 1)
+        self.assertFalse(f.bc_out)
+        f.tick(2)  # the timer again, the frame still not taken: nothing more goes down
+        self.assertEqual(f.take_frames(), [])
+        f.lower_response(1, True, now=2.5)
+        self.assertEqual(len(f.take_frames()), 1)  # now the pending retransmission goes
+
+
+class TestFopDirectiveLimits(unittest.TestCase):
+    def verdict(self, kind, qualifier):
+        f = F.Fop1(1, 0)
+        rid = f.directive(kind, qualifier, now=0)
+        return [n[0] for n in f.take_notifications() if n[1] == rid]
+
+    def test_set_t1_needs_more_than_zero(self):
+        self.assertEqual(self.verdict(F.SET_T1, 0), [F.REJECT])
+        self.assertEqual(self.verdict(F.SET_T1, 1), [F.ACCEPT, F.POSITIVE_CONFIRM])
+
+    def test_set_window_1_to_255(self):
+        for k, ok in ((0, False), (1, True), (255, True), (256, False)):
+            want = [F.ACCEPT, F.POSITIVE_CONFIRM] if ok else [F.REJECT]
+            self.assertEqual(self.verdict(F.SET_WINDOW, k), want, k)
+
+    def test_set_transmission_limit_at_least_1(self):
+        self.assertEqual(self.verdict(F.SET_TRANSMISSION_LIMIT, 0), [F.REJECT])
+        self.assertEqual(self.verdict(F.SET_TRANSMISSION_LIMIT, 1), [F.ACCEPT, F.POSITIVE_CONFIRM])
+
+    def test_set_vs_0_to_255(self):
+        for k, ok in ((0, True), (255, True), (256, False), (-1, False)):
+            want = [F.ACCEPT, F.POSITIVE_CONFIRM] if ok else [F.REJECT]
+            self.assertEqual(self.verdict(F.SET_VS, k), want, k)
+
+
+class TestFopWindowAndTimeouts(unittest.TestCase):
+    def active(self, **kw):
+        f = F.Fop1(1, 0, **kw)
+        f.directive(F.INITIATE_AD_NO_CLCW, now=0)
+        f.take_notifications()
+        return f
+
+    def test_window_of_one_holds_the_second_frame(self):
+        f = self.active(window=1)
+        f.send_ad(b"a", now=0)
+        f.send_ad(b"b", now=0)
+        self.assertEqual([fr.data for fr in f.take_frames()], [b"a"])
+        f.on_clcw(Clcw(vcid=0, report=1), now=1)
+        self.assertEqual([fr.data for fr in f.take_frames()], [b"b"])
+
+    def test_window_of_two_sends_both(self):
+        f = self.active(window=2)
+        f.send_ad(b"a", now=0)
+        f.send_ad(b"b", now=0)
+        self.assertEqual([fr.data for fr in f.take_frames()], [b"a", b"b"])
+
+    def test_e104_timeout_type_1_below_the_limit_retransmits(self):
+        f = self.active(t1=1, transmission_limit=3, timeout_type=1)
+        f.send_ad(b"a", now=0)
+        f.tick(1)
+        self.assertEqual(f.last_event, 104)
+        self.assertEqual([fr.data for fr in f.take_frames()], [b"a", b"a"])
+        self.assertEqual((f.state, f.suspend_state), (F.ACTIVE, 0))
+
+
 class TestSdlsEdges(unittest.TestCase):
     def test_segment_header_alone_is_secured(self):
         sec = sdls.TcSecurity([sdls.SecurityAssociation(1, 0, KEY)])

@@ -211,6 +211,56 @@ class TestSdlsEdges(unittest.TestCase):
         self.assertIn("map=5", repr(sdls.SecurityAssociation(1, 0, KEY, map_id=5)))
 
 
+class TestSdlsLimits(unittest.TestCase):
+    def test_states_and_outcomes_are_distinct_and_named(self):
+        states = (sdls.SA_UNKEYED, sdls.SA_KEYED, sdls.SA_OPERATIONAL, sdls.SA_EXPIRED)
+        self.assertEqual([sdls.SA_STATE_NAMES[s] for s in states], list(sdls.SA_STATE_NAMES))
+        outcomes = (sdls.OK, sdls.BAD_SPI, sdls.NOT_OPERATIONAL, sdls.BAD_MAC, sdls.REPLAY)
+        self.assertEqual(len(set(outcomes + (sdls.TOO_SHORT,))), 6)
+        self.assertIn("unkeyed", repr(sdls.SecurityAssociation(1, 0)))
+
+    def test_replay_window_sizes(self):
+        self.assertEqual(sdls.ReplayWindow(1).size, 1)
+        self.assertEqual(sdls.ReplayWindow(sdls.MAX_WINDOW).size, sdls.MAX_WINDOW)
+        for size in (0, sdls.MAX_WINDOW + 1):
+            with self.assertRaises(sdls.SdlsError):
+                sdls.ReplayWindow(size)
+        self.assertEqual(sdls.ReplayWindow(8, ahead=1).ahead, 1)
+        with self.assertRaises(sdls.SdlsError):
+            sdls.ReplayWindow(8, ahead=0)
+
+    def test_numbers_are_not_reserved_in_blocks_unless_asked(self):
+        sa = sdls.SecurityAssociation(1, 0, KEY)
+        sec = sdls.TcSecurity([sa])
+        sec.apply(0x42, 0, b"\x01pkt")
+        sec.reserve(sa)
+        self.assertEqual((sa.reserve_block, sa.sn_reserved), (0, sa.sn_sent))
+
+    def test_a_keyed_sa_not_started_is_not_operational(self):
+        sa = sdls.SecurityAssociation(1, 0, KEY)
+        sec = sdls.TcSecurity([sa])
+        raw = TcFrame(0x42, 0, sec.apply(0x42, 0, b"\x01pkt"), 0, True).pack()
+        sa.state = sdls.SA_KEYED
+        self.assertEqual(sec.process(raw, len(raw))[0], sdls.NOT_OPERATIONAL)
+        self.assertEqual((sec.counters["sa_not_operational"], sec.counters["bad_spi"]), (1, 0))
+
+    def test_without_segment_headers(self):
+        sec = sdls.TcSecurity([sdls.SecurityAssociation(1, 0, KEY)], segment_header=False)
+        data = sec.apply(0x42, 0, b"pkt", bypass=True)
+        self.assertEqual(data[:2], b"\x00\x01")  # the SPI first
+        raw = TcFrame(0x42, 0, data, 0, True).pack()
+        outcome, sa, sn, clear = sec.process(raw, len(raw))
+        self.assertEqual((outcome, sa.spi, sn, clear), (sdls.OK, 1, 1, b"pkt"))
+
+    def test_shortest_frame_that_names_an_spi(self):
+        sec = sdls.TcSecurity([sdls.SecurityAssociation(1, 0, KEY)])
+        ten = TcFrame(0x42, 0, b"\x01\x00\x63", 0, True).pack()  # header, MAP, SPI, FECF
+        self.assertEqual(len(ten), 10)
+        self.assertEqual(sec.process(ten, 10)[0], sdls.BAD_SPI)
+        nine = TcFrame(0x42, 0, b"\x01\x00", 0, True).pack()
+        self.assertEqual(sec.process(nine, 9)[0], sdls.TOO_SHORT)
+
+
 class TestCltuBlockNamed(unittest.TestCase):
     def test_an_uncorrectable_later_codeblock_is_named(self):
         # codeblocks 0..9; the index is counted in 8-octet codeblocks, not 7-octet payloads

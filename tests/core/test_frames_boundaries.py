@@ -274,3 +274,18 @@ class TestCltuBlockNamed(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestCltuLengths(unittest.TestCase):
+    def test_a_1024_octet_frame_is_the_longest_the_decoder_takes(self):
+        longest = bytes(range(256)) * 4  # 147 codeblocks
+        dec = cltu.CltuDecoder()
+        self.assertEqual([d[:1024] for d in dec.feed(cltu.encode(longest))], [longest])
+        self.assertEqual(dec.feed(cltu.encode(longest + bytes(7))), [])  # 148 codeblocks
+        self.assertEqual((dec.cltus, dec.aborted), (1, 1))
+
+    def test_a_body_not_whole_codeblocks_names_its_length(self):
+        c = cltu.encode(bytes(7))
+        with self.assertRaises(CltuError) as cm:
+            cltu.decode(c[:-8] + b"\x00" + c[-8:])
+        self.assertIn("body of 17 bytes", str(cm.exception))

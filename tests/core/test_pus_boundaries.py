@@ -4,6 +4,7 @@ one off either way, and the errors that name what was wrong."""
 import unittest
 
 from obsw.pus.packets import (
+    PusCrcError,
     PusHeaderError,
     PusLengthError,
     PusTooShortError,
@@ -12,6 +13,7 @@ from obsw.pus.packets import (
 )
 from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm
+from obsw.spp import FieldRangeError
 
 
 def _crc(data):
@@ -38,6 +40,11 @@ class TestAllOnesFields(unittest.TestCase):
             (tc.apid, tc.seq_count, tc.ack, tc.source_id), (0x7FF, 0x3FFF, 15, 0xFFFF)
         )
         self.assertEqual(tc.data, b"ab")
+        self.assertEqual(tc.seq_flags, 3)
+        for flags in (0, 1, 2):
+            self.assertEqual(
+                PusTc.unpack(PusTc(1, 17, 1, seq_flags=flags).pack()).seq_flags, flags
+            )
 
     def test_tc_apid_and_sequence_count_one_below_all_ones(self):
         tc = PusTc.unpack(PusTc(0x7FE, 17, 1, b"", seq_count=0x3FFE).pack())
@@ -78,6 +85,19 @@ class TestLengthField(unittest.TestCase):
         self.assertEqual(PusTc.unpack(PusTc(0x10, 17, 1, b"abcd").pack()).data, b"abcd")
 
 
+class TestPec(unittest.TestCase):
+    def test_a_pec_computed_from_another_preset_is_refused(self):
+        # CRC-16/CCITT-FALSE starts from all ones; a PEC from 0xFFFE (one bit off) is wrong
+        body = PusTc(0x10, 17, 1, b"abcd").pack()[:-2]
+        reg = 0xFFFE
+        for byte in body:
+            reg ^= byte << 8
+            for _ in range(8):
+                reg = ((reg << 1) ^ 0x1021) & 0xFFFF if reg & 0x8000 else (reg << 1) & 0xFFFF
+        with self.assertRaises(PusCrcError):
+            PusTc.unpack(body + bytes((reg >> 8, reg & 0xFF)))
+
+
 class TestHeaderErrorsNameTheValue(unittest.TestCase):
     def test_a_tm_given_as_tc_names_its_packet_type(self):
         raw = PusTm(0x10, 1, 1, b"").pack()
@@ -100,6 +120,34 @@ class TestHeaderErrorsNameTheValue(unittest.TestCase):
             PusTc.unpack(_resealed(raw[:-2]))
         e = cm.exception
         self.assertEqual((e.field, e.expected, e.actual), ("secondary header flag", 1, 0))
+
+
+class TestRequestIdBuffer(unittest.TestCase):
+    def test_four_octets_from_the_offset(self):
+        r = RequestId.unpack(b"\x00\x00\x18\x05\xc0\x07", 2)
+        self.assertEqual((r.apid, r.seq_count), (5, 7))
+
+    def test_three_octets_from_the_offset(self):
+        with self.assertRaises(PusTooShortError) as cm:
+            RequestId.unpack(b"\x00\x00\x18\x05\xc0", 2)
+        self.assertEqual((cm.exception.needed, cm.exception.got), (4, 3))
+
+
+class TestPackRangeErrorsNameTheField(unittest.TestCase):
+    def field(self, **kw):
+        args = dict(apid=0, service=0, subtype=0, data=b"", seq_count=0, ack=0, seq_flags=0)
+        args.update(kw)
+        with self.assertRaises(FieldRangeError) as cm:
+            PusTc(**args).pack()
+        return cm.exception.field, cm.exception.value
+
+    def test_zero_fields_pass_and_the_wrong_one_is_named(self):
+        self.assertEqual(self.field(seq_count=0x4000), ("sequence count", 0x4000))
+        self.assertEqual(self.field(apid=0x800), ("APID", 0x800))
+
+    def test_sequence_flags_3_are_in_range(self):
+        self.assertEqual(self.field(seq_flags=3, ack=16), ("acknowledgement flags", 16))
+        self.assertEqual(self.field(seq_flags=4), ("sequence flags", 4))
 
 
 class TestUnpackPacket(unittest.TestCase):

@@ -7,7 +7,6 @@ import shutil
 import socket
 import subprocess
 import sys
-import time
 
 import pytest
 
@@ -104,11 +103,9 @@ def test_the_guide_runs_from_an_empty_folder(workdir):
                           "--timeout 0.5 ping >/dev/null 2>&1 && break; "
                           "sleep 0.5; done")  # fmt: skip
     script.append("kill %1 && wait")  # the reader's Ctrl-C
-    t0 = time.monotonic()
-    r = run("\n".join(script), str(workdir))
+    r = run("\n".join(script), str(workdir))  # within run's 120 s deadline
     assert r.returncode == 0, (r.stdout[-3000:], r.stderr[-3000:])
     assert "ok (my-sat;" in r.stdout
     assert (workdir / "missions" / "my-sat" / "components" / "magnetorquer.py").is_file()
     assert "alive" in r.stdout
     assert "last outcome confirmed" in r.stdout
-    assert time.monotonic() - t0 < 120

@@ -81,6 +81,20 @@ OPERATORS = {
 EQUIVALENT = {
     ("frames/rs.py", 61, "AddNot"): "the flag only picks bytes.translate or a loop over the same "
     "table: the same octets either way",
+    ("frames/rs.py", 35, "ReplaceBinaryOperator_Add_Sub"): "exp holds 2N entries: exp[i - N] "
+    "is exp[i + N] by negative indexing",
+    ("frames/rs.py", 144, "NumberReplacer"): "interleaving depth 1 then takes the slicing path, "
+    "whose one slice block[0::1] is the same octets",
+    ("frames/rs.py", 248, "NumberReplacer"): "Berlekamp-Massey keeps the locator's degree at or "
+    "below the step, so lam[step + 1] is 0 and the extra term adds nothing",
+    ("frames/rs.py", 269, "NumberReplacer"): "a degree-0 locator cannot occur: a zero remainder "
+    "returns before, and a nonzero one (degree < 2E) cannot vanish at all 2E roots",
+    ("frames/rs.py", 272, "NumberReplacer"): "lam[deg + 1] is 0 (deg is the highest nonzero "
+    "coefficient) and the search reads only the first deg + 1 logs",
+    ("cfdp/receiver.py", 48, "NumberReplacer"): "called only with more gaps than max_gaps (at "
+    "least 2), so the loop always runs and sets best",
+    ("pus/tc.py", 154, "ReplaceComparisonOperator_Lt_LtE"): "only decides whether _check runs: "
+    "with all four fields zero it passes them, so running it too changes nothing",
 }
 
 

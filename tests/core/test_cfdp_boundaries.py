@@ -3,11 +3,12 @@ what was sent, a prompted NAK that covers the tail gap, and Prompts a receiver m
 
 import unittest
 
-from cfdp_sim import directive, make_pair, payload
+from cfdp_sim import Link, directive, make_pair, payload
 from obsw.cfdp.defs import ACKNOWLEDGED, PROMPT_KEEP_ALIVE, PROMPT_NAK, UNACKNOWLEDGED
 from obsw.cfdp.filestore import MemoryFilestore
 from obsw.cfdp.pdu.nak import NakPdu
 from obsw.cfdp.pdu.prompt import PromptPdu
+from obsw.cfdp.receiver import Receiver, _merge_closest
 from obsw.cfdp.sender import SENDING, add_interval
 
 DATA = payload(2000)
@@ -126,6 +127,80 @@ class TestPrompts(unittest.TestCase):
         for kind in (PROMPT_KEEP_ALIVE, PROMPT_NAK):
             b.receive(PromptPdu(header, kind).pack(), 1)
         self.assertEqual([pdu for _dest, pdu in b.transmit(1, 32)], [])
+
+
+class Gaps:
+    """Just the gap list of a receiver, for its gap bookkeeping."""
+
+    def __init__(self, gaps):
+        self.gaps = gaps
+
+
+class TestGaps(unittest.TestCase):
+    def test_merge_the_two_gaps_with_the_fewest_octets_between(self):
+        gaps = [[0, 90, None], [100, 200, None], [205, 206, None]]  # 10 and 5 octets between
+        _merge_closest(gaps)
+        self.assertEqual(gaps, [[0, 90, None], [100, 206, None]])
+        gaps = [[0, 10, None], [12, 200, None], [205, 206, None]]  # 2 and 5 octets between
+        _merge_closest(gaps)
+        self.assertEqual(gaps, [[0, 200, None], [205, 206, None]])
+
+    def test_data_just_after_a_gap_fills_nothing(self):
+        r = Gaps([[0, 64, None]])
+        self.assertFalse(Receiver._fill(r, 64, 128))
+        self.assertEqual(r.gaps, [[0, 64, None]])
+
+    def test_data_just_before_a_gap_fills_nothing(self):
+        r = Gaps([[64, 128, None]])
+        self.assertFalse(Receiver._fill(r, 0, 64))
+        self.assertEqual(r.gaps, [[64, 128, None]])
+
+    def test_data_overlapping_a_gap_edge_by_one_octet(self):
+        r = Gaps([[64, 128, None]])
+        self.assertTrue(Receiver._fill(r, 0, 65))
+        self.assertEqual(r.gaps, [[65, 128, None]])
+        self.assertTrue(Receiver._fill(r, 127, 200))
+        self.assertEqual(r.gaps, [[65, 127, None]])
+
+
+class TestNakPdus(unittest.TestCase):
+    def test_naks_split_over_pdus_each_scoped_from_its_first_segment(self):
+        a, b = make_pair(files_a={"src.bin": DATA}, mode=ACKNOWLEDGED, max_pdu=40)
+        tid = a.put(2, "src.bin", "dst.bin")
+        deliver(a, b, 0, lambda pdu: directive(pdu) is not None and directive(pdu) != DIR_EOF)
+        rx = b.find(tid)
+        segments = [(100 * i, 100 * i + 10) for i in range(1, 8)]
+        before = b.stats["naks_sent"]
+        rx._send_naks(segments, 0, 1000)
+        naks = [a.receive(p, 0) for p in deliver(b, a, 0, lambda p: False)]
+        naks = [n for n in naks if n is not None and n.CODE == DIR_NAK]
+        self.assertTrue(len(naks) > 1)
+        self.assertEqual(b.stats["naks_sent"] - before, len(naks))
+        self.assertEqual([s for n in naks for s in n.segments], segments)
+        self.assertEqual(naks[0].start, 0)
+        for n in naks[1:]:
+            self.assertEqual(n.start, n.segments[0][0])
+        self.assertEqual(naks[-1].end, 1000)
+
+
+class TestUnacknowledgedLoss(unittest.TestCase):
+    def test_a_lost_segment_brings_no_nak_in_unacknowledged_mode(self):
+        a, b = make_pair(files_a={"src.bin": DATA}, mode=UNACKNOWLEDGED)
+        a.put(2, "src.bin", "dst.bin")
+        deliver(a, b, 0, lambda pdu: file_offset(pdu) != 640)
+        self.assertEqual(b.stats["naks_sent"], 0)
+        sent = [pdu for _dest, pdu in b.transmit(0, 32)]
+        self.assertEqual([directive(p) for p in sent if directive(p) == DIR_NAK], [])
+
+
+class TestDestinationDirectory(unittest.TestCase):
+    def test_a_file_sent_to_a_directory_lands_under_its_own_name(self):
+        a, b = make_pair(files_a={"sub/src.bin": DATA[:100]}, mode=ACKNOWLEDGED)
+        b.fs.mkdir("inbox")
+        a.put(2, "sub/src.bin", "inbox/")
+        link = Link(a, b)
+        link.run()
+        self.assertEqual(b.fs.read_bytes("inbox/src.bin"), DATA[:100])
 
 
 if __name__ == "__main__":

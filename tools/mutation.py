@@ -93,6 +93,8 @@ EQUIVALENT = {
     "coefficient) and the search reads only the first deg + 1 logs",
     ("cfdp/receiver.py", 48, "NumberReplacer"): "called only with more gaps than max_gaps (at "
     "least 2), so the loop always runs and sets best",
+    ("cfdp/sender.py", 268, "ReplaceTrueWithFalse"): "Transaction.save ignores force: every "
+    "save writes the state",
     ("pus/tc.py", 154, "ReplaceComparisonOperator_Lt_LtE"): "only decides whether _check runs: "
     "with all four fields zero it passes them, so running it too changes nothing",
 }

@@ -4,8 +4,16 @@ what was sent, a prompted NAK that covers the tail gap, and Prompts a receiver m
 import unittest
 
 from cfdp_sim import Link, directive, make_pair, payload
-from obsw.cfdp.defs import ACKNOWLEDGED, PROMPT_KEEP_ALIVE, PROMPT_NAK, UNACKNOWLEDGED
+from obsw.cfdp.defs import (
+    ACKNOWLEDGED,
+    CANCEL_REQUEST_RECEIVED,
+    KEEP_ALIVE_LIMIT_REACHED,
+    PROMPT_KEEP_ALIVE,
+    PROMPT_NAK,
+    UNACKNOWLEDGED,
+)
 from obsw.cfdp.filestore import MemoryFilestore
+from obsw.cfdp.pdu.keepalive import KeepAlivePdu
 from obsw.cfdp.pdu.nak import NakPdu
 from obsw.cfdp.pdu.prompt import PromptPdu
 from obsw.cfdp.receiver import Receiver, _merge_closest
@@ -201,6 +209,39 @@ class TestDestinationDirectory(unittest.TestCase):
         link = Link(a, b)
         link.run()
         self.assertEqual(b.fs.read_bytes("inbox/src.bin"), DATA[:100])
+
+
+class TestSenderLimits(unittest.TestCase):
+    def sender_at(self, progress, **kw):
+        a, _ = make_pair(files_a={"src.bin": DATA}, mode=ACKNOWLEDGED, **kw)
+        tid = a.put(2, "src.bin", "dst.bin")
+        a.transmit(0, 1 + progress // 64)  # metadata and the segments up to ``progress``
+        tx = a.find(tid)
+        self.assertEqual(tx.progress, progress)
+        return a, tx
+
+    def test_keep_alive_exactly_the_limit_behind(self):
+        a, tx = self.sender_at(192, keep_alive_limit=100)
+        tx.on_pdu(KeepAlivePdu(tx.directive_header(), 92), 1)
+        self.assertEqual([i for i in a.pop_indications() if i.kind == "fault"], [])
+        self.assertFalse(tx.done)
+
+    def test_keep_alive_one_more_behind(self):
+        a, tx = self.sender_at(192, keep_alive_limit=100)
+        tx.on_pdu(KeepAlivePdu(tx.directive_header(), 91), 1)
+        faults = [i.info["condition"] for i in a.pop_indications() if i.kind == "fault"]
+        self.assertEqual(faults, [KEEP_ALIVE_LIMIT_REACHED])
+
+    def test_an_unacknowledged_cancel_reports_the_data_incomplete(self):
+        a, b = make_pair(files_a={"src.bin": DATA}, mode=UNACKNOWLEDGED)
+        tid = a.put(2, "src.bin", "dst.bin")
+        a.transmit(0, 3)
+        a.cancel(tid, 1)
+        deliver(a, b, 1)
+        done = [i for i in a.pop_indications() if i.kind == "finished"]
+        self.assertEqual(len(done), 1)
+        self.assertEqual(done[0].info["condition"], CANCEL_REQUEST_RECEIVED)
+        self.assertEqual(done[0].info["delivery"], 1)  # data incomplete
 
 
 if __name__ == "__main__":

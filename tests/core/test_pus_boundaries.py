@@ -3,6 +3,7 @@ one off either way, and the errors that name what was wrong."""
 
 import unittest
 
+from obsw.pus.config import PusConfig
 from obsw.pus.packets import (
     PusCrcError,
     PusHeaderError,
@@ -148,6 +149,14 @@ class TestPackRangeErrorsNameTheField(unittest.TestCase):
     def test_sequence_flags_3_are_in_range(self):
         self.assertEqual(self.field(seq_flags=3, ack=16), ("acknowledgement flags", 16))
         self.assertEqual(self.field(seq_flags=4), ("sequence flags", 4))
+
+    def test_a_three_octet_source_id_at_its_limit(self):
+        c = PusConfig(source_id_size=3)
+        tc = PusTc.unpack(PusTc(1, 17, 1, b"x", source_id=0xFFFFFF, config=c).pack(), c)
+        self.assertEqual(tc.source_id, 0xFFFFFF)
+        with self.assertRaises(FieldRangeError) as cm:
+            PusTc(1, 17, 1, b"x", source_id=0x1000000, config=c).pack()
+        self.assertEqual(cm.exception.field, "source ID")
 
 
 class TestUnpackPacket(unittest.TestCase):

@@ -95,6 +95,9 @@ EQUIVALENT = {
     "least 2), so the loop always runs and sets best",
     ("cfdp/sender.py", 268, "ReplaceTrueWithFalse"): "Transaction.save ignores force: every "
     "save writes the state",
+    ("reconfig/recovery.py", 166, "ReplaceBinaryOperator_Add_Sub"): "while the OBC lines read 0 "
+    "every poll returns None whatever the deadline, and the first change of the lines sets it "
+    "afresh",
     ("pus/tc.py", 154, "ReplaceComparisonOperator_Lt_LtE"): "only decides whether _check runs: "
     "with all four fields zero it passes them, so running it too changes nothing",
 }

@@ -59,3 +59,36 @@ class TestLineChanges(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestDecisions(unittest.TestCase):
+    def test_kinds_are_distinct_and_named(self):
+        kinds = (R.POWER_CYCLE, R.SWITCH_OVER, R.STOOD_DOWN, R.FAILED)
+        self.assertEqual([R.KIND_NAMES[k] for k in kinds],
+                         ["power_cycle", "switch_over", "stood_down", "failed"])  # fmt: skip
+
+    def test_decisions_count_one_by_one_and_uptime_defaults_to_zero(self):
+        p = R.Recovery(EDGE)
+        p.start(0.0)
+        p.poll(2.0, 0x001)
+        d = p.done(2.0, True)
+        self.assertEqual((d.count, d.at_s), (1, 0))
+        p.poll(4.0, 0x001)
+        d = p.done(4.0, None, uptime_s=4.7)
+        self.assertEqual((d.kind, d.count, d.at_s), (R.STOOD_DOWN, 2, 4))
+
+    def test_after_a_power_cycle_the_line_off_time_and_boot_grace_pass(self):
+        p = R.Recovery({"off_ms": 1000, "boot_grace": 30.0, "deadline": 10.0})
+        p.start(0.0)
+        self.assertEqual(p.poll(30.0, 0x001)[0], R.POWER_CYCLE)
+        p.done(30.0, True)
+        self.assertIsNone(p.poll(60.9995, 0x001))  # 1 s off and 30 s of grace: 61 s
+        self.assertEqual(p.poll(61.0, 0x001)[0], R.POWER_CYCLE)
+
+    def test_a_failed_write_is_tried_again_after_the_deadline(self):
+        p = R.Recovery(EDGE)
+        p.start(0.0)
+        p.poll(2.0, 0x001)
+        self.assertEqual(p.done(2.0, False).kind, R.FAILED)
+        self.assertIsNone(p.poll(2.5, 0x001))
+        self.assertEqual(p.poll(3.0, 0x001)[0], R.POWER_CYCLE)

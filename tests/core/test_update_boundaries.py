@@ -7,11 +7,13 @@ import unittest
 
 from obsw.update.package import (
     BadManifest,
+    BadPath,
     Reader,
     Rollback,
     canonical,
     check_floor,
     check_manifest,
+    check_path,
     header,
     sha256_hex,
     version_key,
@@ -86,3 +88,37 @@ class TestChunks(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestPaths(unittest.TestCase):
+    def test_one_character_paths(self):
+        self.assertEqual(check_path("a"), "a")
+        for bad in ("/", ".", "\\\\"):
+            with self.assertRaises(BadPath):
+                check_path(bad)
+
+    def test_an_absolute_path_is_named_as_such(self):
+        for bad in ("/etc/passwd", "/a"):
+            with self.assertRaises(BadPath) as cm:
+                check_path(bad)
+            self.assertIn("not a relative POSIX path", str(cm.exception))
+        with self.assertRaises(BadPath) as cm:
+            check_path("lib/")
+        self.assertIn("empty, '.' or '..' part", str(cm.exception))
+
+
+class TestTreeDigests(unittest.TestCase):
+    def test_64_hex_digits_and_nothing_else(self):
+        for digest in ("ab" * 31 + "a", "ab" * 32 + "a", 5, None):
+            m = manifest()
+            m["tree"] = dict(m["tree"], extra=digest)
+            with self.assertRaises(BadManifest):
+                check_manifest(m)
+
+
+class TestSignedButNotJson(unittest.TestCase):
+    def test_a_signed_manifest_that_is_not_json(self):
+        for body in (b"{not json", b"\xff\xfe", b"[" * 20 + b"]" * 20):
+            data = header(body, sign(KEY, body))
+            with self.assertRaises(BadManifest):
+                Reader(io.BytesIO(data), verify, KEY, "sat-1", "obc")

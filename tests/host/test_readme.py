@@ -9,6 +9,13 @@ there (the copy of examples/ sits next to links to the rest of the tree). A line
 exit status is 0 unless its comment says ``exit N``. Lines that need hardware or root, or that
 are whole suites run elsewhere, are listed in SKIP with the reason. Ports move with
 OBSW_PORT_BASE (PUS) and a substitution (CFDP).
+
+A block may state what it prints: a ```text block right after it (nothing but blank lines
+between) holds the output of its lines in order, as a terminal shows it (standard output and
+error; a server's output, lines skipped here and ``export`` lines print nothing). The test
+compares it line by line, trailing spaces aside. What varies from run to run (times, process
+ids, ports, paths) is written ``...``: within a line it stands for any text, and a line that
+is only ``...`` for any number of lines, none included.
 """
 
 import os
@@ -59,9 +66,36 @@ def pages():
     return [pathlib.Path("README.md")] + docs
 
 
+BLOCK = re.compile(r"```(sh|python)\n(.*?)```(?:\n\s*```text\n(.*?)```)?", re.S)
+
+
 def blocks(page):
+    return [(kind, body) for kind, body, _ in stated(page)]
+
+
+def stated(page):
+    """(kind, body, the output the page states for it or None) of every runnable block."""
     text = (ROOT / page).read_text()
-    return [(m.group(1), m.group(2)) for m in re.finditer(r"```(sh|python)\n(.*?)```", text, re.S)]
+    return [(m.group(1), m.group(2), m.group(3)) for m in BLOCK.finditer(text)]
+
+
+def _line_pattern(line):
+    return re.compile(".*".join(re.escape(part) for part in line.split("...")) + r"\Z")
+
+
+def printed_as_stated(expected, actual):
+    """True if ``actual`` (what ran printed) is ``expected`` (a page's output block), where
+    ``...`` stands for any text within a line and a line of only ``...`` for any lines."""
+    want = expected.strip("\n").splitlines()
+    got = [x.rstrip() for x in actual.strip("\n").splitlines()]
+    pats = [None if w.strip() == "..." else _line_pattern(w.rstrip()) for w in want]
+    ok = {0}  # lines of ``got`` matched so far by some way through the first i patterns
+    for pat in pats:
+        if pat is None:
+            ok = set(range(min(ok), len(got) + 1)) if ok else set()
+        else:
+            ok = {j + 1 for j in ok if j < len(got) and pat.match(got[j])}
+    return len(got) in ok
 
 
 def shell_lines(body):
@@ -82,8 +116,12 @@ def lines(page):
 
 
 def free_base():
-    """A port base B with B+10 (PUS) and B+100, B+101 (CFDP) free."""
-    for base in range(21000, 60000, 337):
+    """A port base B with B+10 (PUS) and B+100, B+101 (CFDP) free. The search starts at a
+    place of this process's own, so that runs at the same time (pytest workers, another
+    checkout's tests) do not all take the first free base and then collide on it."""
+    bases = list(range(21000, 60000, 337))
+    start = os.getpid() % len(bases)
+    for base in bases[start:] + bases[:start]:
         try:
             for offset in (10, 100, 101):
                 s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -125,7 +163,10 @@ class Server:
         self.ready.set()
 
     def stop(self):
-        os.killpg(self.proc.pid, signal.SIGTERM)
+        try:
+            os.killpg(self.proc.pid, signal.SIGTERM)
+        except ProcessLookupError:  # it and its children ended by themselves
+            pass
         try:
             self.proc.wait(15)
         except subprocess.TimeoutExpired:
@@ -170,28 +211,31 @@ def test_every_example_runs(page, tmp_path):
     ports = {"5100": str(base + 100), "5101": str(base + 101)}
     servers, ran, skipped = [], 0, []
     try:
-        for kind, body in blocks(page):
+        for kind, body, expected in stated(page):
+            printed = []  # what the block's lines print, in order
             if kind == "python":
                 res = subprocess.run(
                     [sys.executable, "-c", body],
                     env=env,
                     cwd=work,
-                    capture_output=True,
+                    stdout=subprocess.PIPE,
+                    stderr=subprocess.STDOUT,
                     text=True,
                     timeout=BOUND,
                 )
                 assert res.returncode == 0, "%s: python block failed:\n%s\n%s" % (
                     page,
                     body,
-                    res.stderr,
+                    res.stdout,
                 )
                 ran += 1
+                _check_stated(page, body, expected, res.stdout)
                 continue
             for server in servers:
                 server.stop()
             servers = []
             cwd = tmp_path if body.startswith(TOP_FOLDER) else work
-            for command, expected, reason in shell_lines(body):
+            for command, status, reason in shell_lines(body):
                 if reason:
                     skipped.append((command, reason))
                     continue
@@ -216,18 +260,20 @@ def test_every_example_runs(page, tmp_path):
                     ["bash", "-c", command],
                     env=env,
                     cwd=cwd,
-                    capture_output=True,
+                    stdout=subprocess.PIPE,
+                    stderr=subprocess.STDOUT,
                     text=True,
                     timeout=BOUND,
                 )
-                assert res.returncode == expected, "%s: %r: exit %d\n%s\n%s" % (
+                assert res.returncode == status, "%s: %r: exit %d\n%s" % (
                     page,
                     command,
                     res.returncode,
-                    res.stdout[-2000:],
-                    res.stderr[-2000:],
+                    res.stdout[-4000:],
                 )
+                printed.append(res.stdout)
                 ran += 1
+            _check_stated(page, body, expected, "".join(printed))
     finally:
         for server in servers:
             server.stop()
@@ -235,6 +281,14 @@ def test_every_example_runs(page, tmp_path):
     if page == GUIDE:
         missing = served_services(work / "sample") - accepted_services(session_log)
         assert not missing, "the operator's guide reaches no TC of services %s" % sorted(missing)
+
+
+def _check_stated(page, body, expected, actual):
+    if expected is not None:
+        assert printed_as_stated(expected, actual), (
+            "%s: the block\n%s\nprinted\n%s\nnot what the page says:\n%s"
+            % (page, body, actual, expected)
+        )
 
 
 GUIDE = pathlib.Path("docs/operators-guide.md")
@@ -267,6 +321,20 @@ def accepted_services(path):
             if key in sent:
                 accepted.add(sent[key])
     return accepted
+
+
+def test_stated_output_matching():
+    assert printed_as_stated("alive\n", "alive\n")
+    assert not printed_as_stated("alive\n", "dead\n")
+    assert printed_as_stated("took ... s\n", "took 0.25 s\n")
+    assert not printed_as_stated("took ... s\n", "took 0.25 ms\n")
+    assert printed_as_stated("...\nalive\n", "a\nb\nalive\n")
+    assert printed_as_stated("...\nalive\n...\n", "alive\n")
+    assert printed_as_stated("a\n...\nz\n", "a\nz\n")
+    assert not printed_as_stated("a\n...\nz\n", "a\nb\n")
+    assert not printed_as_stated("a\n", "a\nb\n")  # no line left over unstated
+    assert printed_as_stated("x [1.5]  \n", "x [1.5]\n")  # trailing spaces aside; [ literal
+    assert printed_as_stated("", "")
 
 
 def test_examples_are_many_and_every_skip_has_a_reason():

@@ -18,16 +18,18 @@ ids, ports, paths) is written ``...``: within a line it stands for any text, and
 is only ``...`` for any number of lines, none included.
 """
 
+import json
 import os
 import pathlib
 import re
+import shlex
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import threading
 
+import mission_ports
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -116,26 +118,67 @@ def lines(page):
 
 
 def free_base():
-    """A port base B with B+10 (PUS) and B+100, B+101 (CFDP) free. The search starts at a
-    place of this process's own, so that runs at the same time (pytest workers, another
-    checkout's tests) do not all take the first free base and then collide on it."""
-    bases = list(range(21000, 60000, 337))
-    start = os.getpid() % len(bases)
-    for base in bases[start:] + bases[:start]:
-        try:
-            for offset in (10, 100, 101):
-                s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-                try:
-                    s.bind(("127.0.0.1", base + offset))
-                finally:
-                    s.close()
-        except OSError:
-            continue
-        return base
-    raise RuntimeError("no free port base")
+    """A port base B with B+10 (PUS) and B+100, B+101 (CFDP) free."""
+    return mission_ports.free_base(mission_ports.SAMPLE)
 
 
-READY = {"obsw obc serve": "PUS application process"}  # a server's ready line (else: its first)
+SHELL = set("|&;<>()$`\\*?[]{}~!")  # a line with any of these is the shell's to run
+
+
+def plain_obsw(command):
+    """The arguments of a line that is only ``obsw`` with words (no shell syntax), or None."""
+    if SHELL & set(command):
+        return None
+    try:
+        words = shlex.split(command)
+    except ValueError:
+        return None
+    return words[1:] if words and words[0] == "obsw" else None
+
+
+class Forks:
+    """tests/host/obsw_forks.py for one page: runs its plain ``obsw`` lines in a child forked
+    from a process that imported the command line once, instead of an interpreter each."""
+
+    def __init__(self, env, tmp):
+        self.env = env
+        self.tmp = tmp
+        self.proc = None
+        self.n = 0
+
+    def run(self, argv, env, cwd):
+        """(exit status, what it printed) of ``obsw ARGV`` in ``cwd`` with ``env``."""
+        if self.proc is None:
+            self.proc = subprocess.Popen(
+                [sys.executable, str(ROOT / "tests" / "host" / "obsw_forks.py")],
+                env=self.env, cwd=str(self.tmp), stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE, text=True, bufsize=1,
+            )  # fmt: skip
+            assert json.loads(self._reply())["ready"]
+        self.n += 1
+        out = self.tmp / ("forks-%d.out" % self.n)
+        req = {"argv": argv, "cwd": str(cwd), "env": dict(env), "out": str(out),
+               "timeout": BOUND}  # fmt: skip
+        self.proc.stdin.write(json.dumps(req) + "\n")
+        self.proc.stdin.flush()
+        status = json.loads(self._reply())["status"]
+        return status, out.read_text(errors="replace")
+
+    def _reply(self):
+        line = self.proc.stdout.readline()
+        assert line, "the obsw fork server ended"
+        return line
+
+    def stop(self):
+        if self.proc is not None:
+            self.proc.stdin.close()
+            self.proc.wait(BOUND)
+            self.proc.stdout.close()
+
+
+READY = {}  # a server's ready line (else: its first); `obsw obc serve`: see Server.is_ready
+OBC = "obsw obc serve"
+OBC_PROCESSES = re.compile(r", processes (.*?), state in ")  # its first line names them
 
 
 class Server:
@@ -153,14 +196,29 @@ class Server:
         )
         self.ready = threading.Event()
         self.output = []
+        self.waiting = None  # an OBC's processes not up yet (once its first line named them)
         threading.Thread(target=self._read, daemon=True).start()
 
     def _read(self):
         for text in self.proc.stdout:
             self.output.append(text)
-            if self.ready_text in text:
+            if self.is_ready(text):
                 self.ready.set()
         self.ready.set()
+
+    def is_ready(self, text):
+        """True once the server is ready. An OBC is when each of its processes is up (the
+        platform manager heard its first heartbeat): its PUS process then answers at once;
+        the line of the PUS process binding its port comes earlier than that."""
+        if not self.line.startswith(OBC):
+            return self.ready_text in text
+        m = OBC_PROCESSES.search(text)
+        if m:
+            self.waiting = set(m.group(1).split(", "))
+        for name in list(self.waiting or ()):
+            if "[platform] %s up (pid" % name in text:
+                self.waiting.discard(name)
+        return self.waiting == set()
 
     def stop(self):
         try:
@@ -210,6 +268,7 @@ def test_every_example_runs(page, tmp_path):
     os.makedirs(env["HOME"])
     ports = {"5100": str(base + 100), "5101": str(base + 101)}
     servers, ran, skipped = [], 0, []
+    forks = Forks(env, tmp_path)
     try:
         for kind, body, expected in stated(page):
             printed = []  # what the block's lines print, in order
@@ -256,27 +315,33 @@ def test_every_example_runs(page, tmp_path):
                     assert server.proc.poll() is None, "%r ended: %s" % (command, server.output)
                     ran += 1
                     continue
-                res = subprocess.run(
-                    ["bash", "-c", command],
-                    env=env,
-                    cwd=cwd,
-                    stdout=subprocess.PIPE,
-                    stderr=subprocess.STDOUT,
-                    text=True,
-                    timeout=BOUND,
-                )
-                assert res.returncode == status, "%s: %r: exit %d\n%s" % (
+                argv = plain_obsw(command)
+                if argv is not None:
+                    code, output = forks.run(argv, env, cwd)
+                else:
+                    res = subprocess.run(
+                        ["bash", "-c", command],
+                        env=env,
+                        cwd=cwd,
+                        stdout=subprocess.PIPE,
+                        stderr=subprocess.STDOUT,
+                        text=True,
+                        timeout=BOUND,
+                    )
+                    code, output = res.returncode, res.stdout
+                assert code == status, "%s: %r: exit %d\n%s" % (
                     page,
                     command,
-                    res.returncode,
-                    res.stdout[-4000:],
+                    code,
+                    output[-4000:],
                 )
-                printed.append(res.stdout)
+                printed.append(output)
                 ran += 1
             _check_stated(page, body, expected, "".join(printed))
     finally:
         for server in servers:
             server.stop()
+        forks.stop()
     print("%s: %d examples ran, %d skipped: %s" % (page, ran, len(skipped), skipped))
     if page == GUIDE:
         missing = served_services(work / "sample") - accepted_services(session_log)

@@ -3,21 +3,25 @@
 put into a module one at a time, the module's tests run against each; a mutant the tests do not
 notice (it survives) marks a behaviour nothing pins.
 
-    python tools/mutation.py [MODULE...] [--sample N] [--seed S] [--jobs J] [--write]
+    python tools/mutation.py [MODULE...] [--sample N] [--seed S] [--jobs J] [--write] [--json]
+    python tools/mutation.py --results FILE [--sample N] [--write]
 
 MODULE is a name of TARGETS (default: all). The mutants are those a programmer makes: a
 comparison turned into its neighbour (< and <=, == and !=, in and not in), a constant off by
 one, + and - swapped, a condition negated, True and False swapped, and and or swapped, a loop
 that never runs, a break that continues, an except clause that catches something else. Each
 module is mutated in a copy of the tree of its own (cosmic-ray writes the mutant into the file),
-its tests run on CPython with pytest; a mutant that makes them fail or hang is killed.
+its tests run on CPython with pytest under OBSW_PURE=1 (the Python paths the board runs, not
+the C codec that takes over some of them on CPython); a mutant that makes them fail or hang is
+killed.
 
 `--sample N` takes N mutants of each module, chosen by `--seed` (the `mutation` stage of
 tools/test runs a sample); the whole run (every mutant of every module: hours on two cores) is a
 job run by hand, `--write` then writes docs/mutation.md. Survivors that cannot be killed (the
 mutant does what the original does) are listed in EQUIVALENT with the reason. The last line is
-`N passed, N failed`: a module passes with at least GOAL of its mutants killed and every
-survivor explained.
+`N passed, N failed`: a module passes with at least GOAL of its other mutants killed and every
+survivor explained. `--json` prints the results; `--results FILE` reads them back from such a
+run's output instead of running (to write the page again once survivors are explained).
 """
 
 import argparse
@@ -39,12 +43,22 @@ TIMEOUT = 60.0  # seconds a mutant's tests may take (a hang kills it)
 
 # module -> the test files (patterns in tests/core) that pin it; they also run on the unix port
 TARGETS = {
-    "pus/packets.py": ["test_pus_packets.py", "test_pus_app.py", "test_errors.py"],
-    "pus/tc.py": ["test_pus_packets.py", "test_pus_app.py", "test_pus_random_requests.py"],
-    "frames/farm.py": ["test_frames_farm*.py", "test_frames_cop*.py"],
-    "frames/fop.py": ["test_frames_fop*.py", "test_frames_cop*.py"],
-    "frames/sdls.py": ["test_frames_sdls*.py"],
-    "frames/cltu.py": ["test_frames_cltu*.py"],
+    "pus/packets.py": [
+        "test_pus_packets.py",
+        "test_pus_app.py",
+        "test_errors.py",
+        "test_pus_boundaries.py",
+    ],
+    "pus/tc.py": [
+        "test_pus_packets.py",
+        "test_pus_app.py",
+        "test_pus_random_requests.py",
+        "test_pus_boundaries.py",
+    ],
+    "frames/farm.py": ["test_frames_farm*.py", "test_frames_boundaries.py", "test_frames_cop*.py"],
+    "frames/fop.py": ["test_frames_fop*.py", "test_frames_boundaries.py", "test_frames_cop*.py"],
+    "frames/sdls.py": ["test_frames_sdls*.py", "test_frames_boundaries.py"],
+    "frames/cltu.py": ["test_frames_cltu*.py", "test_frames_boundaries.py"],
     "frames/rs.py": ["test_frames_rs*.py", "test_frames_coding*.py"],
     "cfdp/receiver.py": ["test_cfdp_*.py"],
     "cfdp/sender.py": ["test_cfdp_*.py"],
@@ -66,7 +80,33 @@ OPERATORS = {
 }  # fmt: skip
 
 # (module, line, operator) -> why the mutant cannot be told from the original
-EQUIVALENT = {}
+EQUIVALENT = {
+    ("frames/rs.py", 61, "AddNot"): "the flag only picks bytes.translate or a loop over the same "
+    "table: the same octets either way",
+    ("frames/rs.py", 35, "ReplaceBinaryOperator_Add_Sub"): "exp holds 2N entries: exp[i - N] "
+    "is exp[i + N] by negative indexing",
+    ("frames/rs.py", 144, "NumberReplacer"): "interleaving depth 1 then takes the slicing path, "
+    "whose one slice block[0::1] is the same octets",
+    ("frames/rs.py", 248, "NumberReplacer"): "Berlekamp-Massey keeps the locator's degree at or "
+    "below the step, so lam[step + 1] is 0 and the extra term adds nothing",
+    ("frames/rs.py", 269, "NumberReplacer"): "a degree-0 locator cannot occur: a zero remainder "
+    "returns before, and a nonzero one (degree < 2E) cannot vanish at all 2E roots",
+    ("frames/rs.py", 272, "NumberReplacer"): "lam[deg + 1] is 0 (deg is the highest nonzero "
+    "coefficient) and the search reads only the first deg + 1 logs",
+    ("cfdp/receiver.py", 48, "NumberReplacer"): "called only with more gaps than max_gaps (at "
+    "least 2), so the loop always runs and sets best",
+    ("cfdp/sender.py", 268, "ReplaceTrueWithFalse"): "Transaction.save ignores force: every "
+    "save writes the state",
+    ("reconfig/recovery.py", 166, "ReplaceBinaryOperator_Add_Sub"): "while the OBC lines read 0 "
+    "every poll returns None whatever the deadline, and the first change of the lines sets it "
+    "afresh",
+    ("frames/fop.py", 401, "NumberReplacer"): "Look for Directive runs only in state S5 "
+    "(Initializing with BC frame), where the sent queue holds the one BC frame: first is last",
+    ("pus/tc.py", 87, "ReplaceComparisonOperator_IsNot_Is"): "the C codec's path (not taken under "
+    "OBSW_PURE); where it runs, the Python code after it packs the same octets",
+    ("pus/tc.py", 154, "ReplaceComparisonOperator_Lt_LtE"): "only decides whether _check runs: "
+    "with all four fields zero it passes them, so running it too changes nothing",
+}
 
 
 def copy_tree(dest):
@@ -84,7 +124,8 @@ def copy_tree(dest):
 
 def cosmic(args, cwd):
     tool = os.path.join(os.path.dirname(sys.executable), "cosmic-ray")
-    return subprocess.run([tool] + args, cwd=cwd, capture_output=True, text=True)
+    env = dict(os.environ, OBSW_PURE="1")  # the mutated Python code runs, never the C codec
+    return subprocess.run([tool] + args, cwd=cwd, capture_output=True, text=True, env=env)
 
 
 def run_module(module, sample, seed):
@@ -166,8 +207,11 @@ def results(session, module, total, seconds):
 
 
 def verdict(r):
+    """(killed share of the mutants that differ from the original, goal met): a mutant listed
+    in EQUIVALENT does what the original does, so no test can kill it and it is not counted."""
     unexplained = [s for s in r["survived"] if not s["equivalent"]]
-    rate = r["killed"] / r["ran"] if r["ran"] else 1.0
+    real = r["ran"] - (len(r["survived"]) - len(unexplained))
+    rate = r["killed"] / real if real else 1.0
     return rate, rate >= GOAL and not unexplained
 
 
@@ -182,7 +226,8 @@ def page(results_, sample):
         "a `break` that continues, an `except` that catches something else) and its tests run",
         "against each mutant. Goal: at least %d %% of each module's mutants killed, every"
         % round(GOAL * 100),
-        "survivor killed or explained as equivalent.",
+        "survivor killed or explained as equivalent (it does what the original does: no test",
+        "can tell them apart; the reason is given below, and `killed %` is of the others).",
         "",
         "Run: %s%s."
         % (
@@ -190,13 +235,14 @@ def page(results_, sample):
             ", a sample of %d mutants per module" % sample if sample else ", every mutant",
         ),  # fmt: skip
         "",
-        "| module | mutants | killed | survived | killed % | goal |",
-        "|---|---|---|---|---|---|",
+        "| module | mutants | killed | equivalent | survived | killed % | goal |",
+        "|---|---|---|---|---|---|---|",
     ]
     for r in results_:
         rate, ok = verdict(r)
-        out.append("| `%s` | %d | %d | %d | %.1f | %s |" % (
-            r["module"], r["ran"], r["killed"], len(r["survived"]), 100 * rate,
+        same = sum(1 for s in r["survived"] if s["equivalent"])
+        out.append("| `%s` | %d | %d | %d | %d | %.1f | %s |" % (
+            r["module"], r["ran"], r["killed"], same, len(r["survived"]) - same, 100 * rate,
             "met" if ok else "MISSED"))  # fmt: skip
     for r in results_:
         if not r["survived"]:
@@ -209,6 +255,35 @@ def page(results_, sample):
     return "\n".join(out) + "\n"
 
 
+def tell(r):
+    """Print a module's line (and its unexplained survivors); True if it met the goal."""
+    rate, ok = verdict(r)
+    print("%-4s %-22s %4d mutants, %4d killed, %3d survived (%5.1f %%) %6.0f s" % (
+        "ok" if ok else "MISS", r["module"], r["ran"], r["killed"], len(r["survived"]),
+        100 * rate, r["seconds"]))  # fmt: skip
+    for s in r["survived"]:
+        if not s["equivalent"]:
+            change = " / ".join(c.strip() for c in s["change"])
+            print("       line %d %s: %s" % (s["line"], s["operator"], change))
+    return ok
+
+
+def saved(path):
+    """The results list a ``--json`` run printed (the one line of the file that is one)."""
+    with open(path) as f:
+        for line in f:
+            if line.startswith("["):
+                return json.loads(line)
+    raise SystemExit("%s: no results (the output of a --json run)" % path)
+
+
+def explained(r):
+    """``r`` with each survivor's explanation as EQUIVALENT gives it now."""
+    for s in r["survived"]:
+        s["equivalent"] = EQUIVALENT.get((r["module"], s["line"], s["operator"]))
+    return r
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("modules", nargs="*", metavar="MODULE", help="of: " + ", ".join(TARGETS))
@@ -217,6 +292,9 @@ def main(argv=None):
     ap.add_argument("--jobs", type=int, default=2, help="modules mutated at once")
     ap.add_argument("--write", action="store_true", help="write docs/mutation.md")
     ap.add_argument("--json", action="store_true", help="print the results as JSON")
+    ap.add_argument("--results", metavar="FILE",
+                    help="no run: the results a --json run printed to FILE, explained by "
+                    "EQUIVALENT as it is now (give --sample as that run had it)")  # fmt: skip
     args = ap.parse_args(argv)
     unknown = [m for m in args.modules if m not in TARGETS]
     if unknown:
@@ -227,26 +305,26 @@ def main(argv=None):
         return 1
     modules = args.modules or list(TARGETS)
     done, passed, failed = [], 0, 0
-    with concurrent.futures.ThreadPoolExecutor(max(1, args.jobs)) as pool:
-        futures = {pool.submit(run_module, m, args.sample, args.seed): m for m in modules}
-        for fut in concurrent.futures.as_completed(futures):
-            m = futures[fut]
-            try:
-                r = fut.result()
-            except Exception as e:  # a module that cannot be mutated is a failure, said once
-                failed += 1
-                print("FAIL %-22s %s" % (m, e))
-                continue
-            done.append(r)
-            rate, ok = verdict(r)
+    if args.results:
+        done = [explained(r) for r in saved(args.results) if r["module"] in modules]
+        for r in done:
+            ok = tell(r)
             passed, failed = passed + ok, failed + (not ok)
-            print("%-4s %-22s %4d mutants, %4d killed, %3d survived (%5.1f %%) %6.0f s" % (
-                "ok" if ok else "MISS", m, r["ran"], r["killed"], len(r["survived"]),
-                100 * rate, r["seconds"]))  # fmt: skip
-            for s in r["survived"]:
-                if not s["equivalent"]:
-                    change = " / ".join(c.strip() for c in s["change"])
-                    print("       line %d %s: %s" % (s["line"], s["operator"], change))
+        modules = [m for m in modules if any(r["module"] == m for r in done)]
+    else:
+        with concurrent.futures.ThreadPoolExecutor(max(1, args.jobs)) as pool:
+            futures = {pool.submit(run_module, m, args.sample, args.seed): m for m in modules}
+            for fut in concurrent.futures.as_completed(futures):
+                m = futures[fut]
+                try:
+                    r = fut.result()
+                except Exception as e:  # a module that cannot be mutated: a failure, said once
+                    failed += 1
+                    print("FAIL %-22s %s" % (m, e))
+                    continue
+                done.append(r)
+                ok = tell(r)
+                passed, failed = passed + ok, failed + (not ok)
     done.sort(key=lambda r: modules.index(r["module"]))
     if args.write:
         with open(os.path.join(ROOT, "docs", "mutation.md"), "w") as f:

@@ -26,6 +26,8 @@ class SimulatedWatchdog:
         self.resets = []  # times of resets
         self.armed = False
         self.disarms = 0
+        self.closes = 0  # writers' closes seen
+        self.rounds = 0  # times the reader thread looked at the FIFO (tests wait on it)
         self._last = None
         self._magic = False
         self._fd = None
@@ -49,6 +51,7 @@ class SimulatedWatchdog:
             if ready:
                 self._read()
             self.check()
+            self.rounds += 1
 
     def _read(self):
         try:
@@ -57,6 +60,7 @@ class SimulatedWatchdog:
             return
         now = self.clock()
         if not data:  # the writer closed the device
+            self.closes += 1
             if self.armed and self._magic:
                 self.armed = False
                 self.disarms += 1

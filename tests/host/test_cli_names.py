@@ -98,11 +98,18 @@ def test_replay_prints_the_logged_times_not_the_replay_time(obc, tmp_path):  # n
     log = tmp_path / "s.log"
     assert ground(port, "--log", log, "ping").returncode == 0
     logged = [json.loads(x)["utc"] for x in log.read_text().splitlines()]
-    time.sleep(2.0)  # a gap between the session and its replay, so the two times differ
+    # a gap between the session and its replay, so the two times differ: the clock 2 s on
+    end = time.monotonic() + 10.0
+    while _seconds(_utc_now()) - _seconds(logged[-1]) < 2.0 and time.monotonic() < end:
+        time.sleep(0.05)
     shown = [UTC.match(x).group(0) for x in obsw("ground", "replay", log).stdout.splitlines()]
     assert len(shown) == len(logged)
     for was, now in zip(logged, shown):
         assert abs(_seconds(was) - _seconds(now)) < 1.0, (was, now)
+
+
+def _utc_now():
+    return time.strftime("%Y-%m-%dT%H:%M:%S.000Z", time.gmtime())
 
 
 def _seconds(utc):

@@ -8,7 +8,6 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 
 import pytest
 from obsw_host import sample
@@ -272,12 +271,10 @@ def test_a_mistake_stops_obc_serve_in_one_line(
     monkeypatch.chdir(tmp_path)
     said = [str(p) for p in check(os.path.join(folder, "mission.json"))[1]]
     state = tmp_path / "state"
-    t0 = time.monotonic()
     r = subprocess.run(
         OBSW + ["obc", "serve", folder, "--state", str(state)],
         env=ENV, capture_output=True, text=True, timeout=BOUND, cwd=str(tmp_path),
     )  # fmt: skip
-    took = time.monotonic() - t0
     lines = [x for x in (r.stdout + r.stderr).splitlines() if x.strip()]
     assert r.returncode == 2, lines
     assert len(lines) == 1, lines
@@ -288,7 +285,6 @@ def test_a_mistake_stops_obc_serve_in_one_line(
     assert "Traceback" not in line
     assert lines == said  # `obsw mission check` says the same
     assert not state.exists()  # no process started: none made its state folder
-    assert took < BOUND
 
 
 def test_every_problem_is_listed(folder):

@@ -79,7 +79,7 @@ def test_a_close_without_the_magic_character_leaves_it_armed_and_it_resets(devic
     dog.kick()
     assert wait_for(lambda: device.armed)
     dog.close(disarm=False)  # as when the platform manager dies
-    time.sleep(0.05)
+    assert wait_for(lambda: device.closes == 1)
     assert device.armed
     device.fake_clock.t += 5.5
     assert wait_for(lambda: device.resets == [device.fake_clock.t])
@@ -218,7 +218,8 @@ def test_the_watchdog_is_armed_when_all_are_up_and_kicked_only_while_all_are_hea
     s.step(clock())
     assert s.state == wd.STARVED and s.unhealthy(clock()) == ["core"]
     assert s.watchdog.kicks == 2
-    time.sleep(0.05)
+    seen = device.rounds
+    assert wait_for(lambda: device.rounds >= seen + 2)  # it read whatever was written by now
     assert len(device.kicks) == 2 and device.resets == []
     clock.t += 3.5  # starved past the device's timeout: the board resets
     assert wait_for(lambda: len(device.resets) == 1)

@@ -9,18 +9,27 @@ there (the copy of examples/ sits next to links to the rest of the tree). A line
 exit status is 0 unless its comment says ``exit N``. Lines that need hardware or root, or that
 are whole suites run elsewhere, are listed in SKIP with the reason. Ports move with
 OBSW_PORT_BASE (PUS) and a substitution (CFDP).
+
+A block may state what it prints: a ```text block right after it (nothing but blank lines
+between) holds the output of its lines in order, as a terminal shows it (standard output and
+error; a server's output, lines skipped here and ``export`` lines print nothing). The test
+compares it line by line, trailing spaces aside. What varies from run to run (times, process
+ids, ports, paths) is written ``...``: within a line it stands for any text, and a line that
+is only ``...`` for any number of lines, none included.
 """
 
+import json
 import os
 import pathlib
 import re
+import shlex
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import threading
 
+import mission_ports
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -59,9 +68,36 @@ def pages():
     return [pathlib.Path("README.md")] + docs
 
 
+BLOCK = re.compile(r"```(sh|python)\n(.*?)```(?:\n\s*```text\n(.*?)```)?", re.S)
+
+
 def blocks(page):
+    return [(kind, body) for kind, body, _ in stated(page)]
+
+
+def stated(page):
+    """(kind, body, the output the page states for it or None) of every runnable block."""
     text = (ROOT / page).read_text()
-    return [(m.group(1), m.group(2)) for m in re.finditer(r"```(sh|python)\n(.*?)```", text, re.S)]
+    return [(m.group(1), m.group(2), m.group(3)) for m in BLOCK.finditer(text)]
+
+
+def _line_pattern(line):
+    return re.compile(".*".join(re.escape(part) for part in line.split("...")) + r"\Z")
+
+
+def printed_as_stated(expected, actual):
+    """True if ``actual`` (what ran printed) is ``expected`` (a page's output block), where
+    ``...`` stands for any text within a line and a line of only ``...`` for any lines."""
+    want = expected.strip("\n").splitlines()
+    got = [x.rstrip() for x in actual.strip("\n").splitlines()]
+    pats = [None if w.strip() == "..." else _line_pattern(w.rstrip()) for w in want]
+    ok = {0}  # lines of ``got`` matched so far by some way through the first i patterns
+    for pat in pats:
+        if pat is None:
+            ok = set(range(min(ok), len(got) + 1)) if ok else set()
+        else:
+            ok = {j + 1 for j in ok if j < len(got) and pat.match(got[j])}
+    return len(got) in ok
 
 
 def shell_lines(body):
@@ -83,21 +119,66 @@ def lines(page):
 
 def free_base():
     """A port base B with B+10 (PUS) and B+100, B+101 (CFDP) free."""
-    for base in range(21000, 60000, 337):
-        try:
-            for offset in (10, 100, 101):
-                s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-                try:
-                    s.bind(("127.0.0.1", base + offset))
-                finally:
-                    s.close()
-        except OSError:
-            continue
-        return base
-    raise RuntimeError("no free port base")
+    return mission_ports.free_base(mission_ports.SAMPLE)
 
 
-READY = {"obsw obc serve": "PUS application process"}  # a server's ready line (else: its first)
+SHELL = set("|&;<>()$`\\*?[]{}~!")  # a line with any of these is the shell's to run
+
+
+def plain_obsw(command):
+    """The arguments of a line that is only ``obsw`` with words (no shell syntax), or None."""
+    if SHELL & set(command):
+        return None
+    try:
+        words = shlex.split(command)
+    except ValueError:
+        return None
+    return words[1:] if words and words[0] == "obsw" else None
+
+
+class Forks:
+    """tests/host/obsw_forks.py for one page: runs its plain ``obsw`` lines in a child forked
+    from a process that imported the command line once, instead of an interpreter each."""
+
+    def __init__(self, env, tmp):
+        self.env = env
+        self.tmp = tmp
+        self.proc = None
+        self.n = 0
+
+    def run(self, argv, env, cwd):
+        """(exit status, what it printed) of ``obsw ARGV`` in ``cwd`` with ``env``."""
+        if self.proc is None:
+            self.proc = subprocess.Popen(
+                [sys.executable, str(ROOT / "tests" / "host" / "obsw_forks.py")],
+                env=self.env, cwd=str(self.tmp), stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE, text=True, bufsize=1,
+            )  # fmt: skip
+            assert json.loads(self._reply())["ready"]
+        self.n += 1
+        out = self.tmp / ("forks-%d.out" % self.n)
+        req = {"argv": argv, "cwd": str(cwd), "env": dict(env), "out": str(out),
+               "timeout": BOUND}  # fmt: skip
+        self.proc.stdin.write(json.dumps(req) + "\n")
+        self.proc.stdin.flush()
+        status = json.loads(self._reply())["status"]
+        return status, out.read_text(errors="replace")
+
+    def _reply(self):
+        line = self.proc.stdout.readline()
+        assert line, "the obsw fork server ended"
+        return line
+
+    def stop(self):
+        if self.proc is not None:
+            self.proc.stdin.close()
+            self.proc.wait(BOUND)
+            self.proc.stdout.close()
+
+
+READY = {}  # a server's ready line (else: its first); `obsw obc serve`: see Server.is_ready
+OBC = "obsw obc serve"
+OBC_PROCESSES = re.compile(r", processes (.*?), state in ")  # its first line names them
 
 
 class Server:
@@ -115,17 +196,35 @@ class Server:
         )
         self.ready = threading.Event()
         self.output = []
+        self.waiting = None  # an OBC's processes not up yet (once its first line named them)
         threading.Thread(target=self._read, daemon=True).start()
 
     def _read(self):
         for text in self.proc.stdout:
             self.output.append(text)
-            if self.ready_text in text:
+            if self.is_ready(text):
                 self.ready.set()
         self.ready.set()
 
+    def is_ready(self, text):
+        """True once the server is ready. An OBC is when each of its processes is up (the
+        platform manager heard its first heartbeat): its PUS process then answers at once;
+        the line of the PUS process binding its port comes earlier than that."""
+        if not self.line.startswith(OBC):
+            return self.ready_text in text
+        m = OBC_PROCESSES.search(text)
+        if m:
+            self.waiting = set(m.group(1).split(", "))
+        for name in list(self.waiting or ()):
+            if "[platform] %s up (pid" % name in text:
+                self.waiting.discard(name)
+        return self.waiting == set()
+
     def stop(self):
-        os.killpg(self.proc.pid, signal.SIGTERM)
+        try:
+            os.killpg(self.proc.pid, signal.SIGTERM)
+        except ProcessLookupError:  # it and its children ended by themselves
+            pass
         try:
             self.proc.wait(15)
         except subprocess.TimeoutExpired:
@@ -169,29 +268,33 @@ def test_every_example_runs(page, tmp_path):
     os.makedirs(env["HOME"])
     ports = {"5100": str(base + 100), "5101": str(base + 101)}
     servers, ran, skipped = [], 0, []
+    forks = Forks(env, tmp_path)
     try:
-        for kind, body in blocks(page):
+        for kind, body, expected in stated(page):
+            printed = []  # what the block's lines print, in order
             if kind == "python":
                 res = subprocess.run(
                     [sys.executable, "-c", body],
                     env=env,
                     cwd=work,
-                    capture_output=True,
+                    stdout=subprocess.PIPE,
+                    stderr=subprocess.STDOUT,
                     text=True,
                     timeout=BOUND,
                 )
                 assert res.returncode == 0, "%s: python block failed:\n%s\n%s" % (
                     page,
                     body,
-                    res.stderr,
+                    res.stdout,
                 )
                 ran += 1
+                _check_stated(page, body, expected, res.stdout)
                 continue
             for server in servers:
                 server.stop()
             servers = []
             cwd = tmp_path if body.startswith(TOP_FOLDER) else work
-            for command, expected, reason in shell_lines(body):
+            for command, status, reason in shell_lines(body):
                 if reason:
                     skipped.append((command, reason))
                     continue
@@ -212,29 +315,45 @@ def test_every_example_runs(page, tmp_path):
                     assert server.proc.poll() is None, "%r ended: %s" % (command, server.output)
                     ran += 1
                     continue
-                res = subprocess.run(
-                    ["bash", "-c", command],
-                    env=env,
-                    cwd=cwd,
-                    capture_output=True,
-                    text=True,
-                    timeout=BOUND,
-                )
-                assert res.returncode == expected, "%s: %r: exit %d\n%s\n%s" % (
+                argv = plain_obsw(command)
+                if argv is not None:
+                    code, output = forks.run(argv, env, cwd)
+                else:
+                    res = subprocess.run(
+                        ["bash", "-c", command],
+                        env=env,
+                        cwd=cwd,
+                        stdout=subprocess.PIPE,
+                        stderr=subprocess.STDOUT,
+                        text=True,
+                        timeout=BOUND,
+                    )
+                    code, output = res.returncode, res.stdout
+                assert code == status, "%s: %r: exit %d\n%s" % (
                     page,
                     command,
-                    res.returncode,
-                    res.stdout[-2000:],
-                    res.stderr[-2000:],
+                    code,
+                    output[-4000:],
                 )
+                printed.append(output)
                 ran += 1
+            _check_stated(page, body, expected, "".join(printed))
     finally:
         for server in servers:
             server.stop()
+        forks.stop()
     print("%s: %d examples ran, %d skipped: %s" % (page, ran, len(skipped), skipped))
     if page == GUIDE:
         missing = served_services(work / "sample") - accepted_services(session_log)
         assert not missing, "the operator's guide reaches no TC of services %s" % sorted(missing)
+
+
+def _check_stated(page, body, expected, actual):
+    if expected is not None:
+        assert printed_as_stated(expected, actual), (
+            "%s: the block\n%s\nprinted\n%s\nnot what the page says:\n%s"
+            % (page, body, actual, expected)
+        )
 
 
 GUIDE = pathlib.Path("docs/operators-guide.md")
@@ -267,6 +386,20 @@ def accepted_services(path):
             if key in sent:
                 accepted.add(sent[key])
     return accepted
+
+
+def test_stated_output_matching():
+    assert printed_as_stated("alive\n", "alive\n")
+    assert not printed_as_stated("alive\n", "dead\n")
+    assert printed_as_stated("took ... s\n", "took 0.25 s\n")
+    assert not printed_as_stated("took ... s\n", "took 0.25 ms\n")
+    assert printed_as_stated("...\nalive\n", "a\nb\nalive\n")
+    assert printed_as_stated("...\nalive\n...\n", "alive\n")
+    assert printed_as_stated("a\n...\nz\n", "a\nz\n")
+    assert not printed_as_stated("a\n...\nz\n", "a\nb\n")
+    assert not printed_as_stated("a\n", "a\nb\n")  # no line left over unstated
+    assert printed_as_stated("x [1.5]  \n", "x [1.5]\n")  # trailing spaces aside; [ literal
+    assert printed_as_stated("", "")
 
 
 def test_examples_are_many_and_every_skip_has_a_reason():

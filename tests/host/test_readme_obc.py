@@ -1,7 +1,7 @@
 """Every shell example of the documentation's PUS, OBCP and OBC pages, run as written against one
-`obsw obc serve` with the sample spacecraft (default ports on 127.0.0.1). An example ending
-in a comment `# exit N` must exit with N, one saying `exit 1 if none came` (a listener) with
-0 or 1, every other one with 0. Bounded: each command has
+`obsw obc serve` with the sample spacecraft (on 127.0.0.1, on ports of this run's own). An
+example ending in a comment `# exit N` must exit with N, one saying `exit 1 if none came` (a
+listener) with 0 or 1, every other one with 0. Bounded: each command has
 a timeout, the whole run prints its time."""
 
 import os
@@ -13,6 +13,7 @@ import subprocess
 import sys
 import time
 
+import mission_ports
 import pytest
 from obsw_host.sample import MISSION_DIR
 
@@ -50,22 +51,8 @@ def obsw():
     return [exe] if exe else [sys.executable, "-m", "obsw_host.cli"]
 
 
-def ports_free(ports=(5010, 5100)):
-    """True when the sample spacecraft's UDP ports can be bound (another run may hold them)."""
-    import socket
-
-    for port in ports:
-        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        try:
-            s.bind(("127.0.0.1", port))
-        except OSError:
-            return False
-        finally:
-            s.close()
-    return True
-
-
-# the reader's session names its mission once, as the docs say (`export OBSW_MISSION=...`)
+# the reader's session names its mission once, as the docs say (`export OBSW_MISSION=...`);
+# its ports are this run's own (an OBC may already serve the sample on the default ports)
 ENV = dict(os.environ, OBSW_MISSION=MISSION_DIR)
 
 
@@ -88,9 +75,7 @@ def test_every_obc_example_of_the_docs(tmp_path, capsys):
     os.symlink(MISSION_DIR, tmp_path / "sample")  # the pages run from examples/: `sample` there
     state = tmp_path / "state"
     t0 = time.monotonic()
-    end = t0 + 300.0
-    while not ports_free() and time.monotonic() < end:  # another checkout's run: wait our turn
-        time.sleep(0.5)
+    ENV["OBSW_PORT_BASE"] = str(mission_ports.free_base())
     server = subprocess.Popen(
         obsw() + ["obc", "serve", "--state", str(state)],
         stdout=subprocess.PIPE,

@@ -41,14 +41,11 @@ def test_hung_and_killed_obc_recovered_then_switched_over(tmp_path):
         assert sim.wait_for(lambda: sim.seen("[OBC] context saved"), 30)
         time.sleep(1.5)  # a few saves with the DS3231 set by the OBC's UTC
 
-        t = time.monotonic()
         sim.hang_obc()
         assert sim.wait_for(lambda: sim.seen("recovery: power_cycle line 0"), 20)
         assert sim.wait_for(lambda: sim.obc_boots == 2 and restored(sim, 2), 20)
-        took = time.monotonic() - t
         assert sim.seen("[OBC] onboard time from the DS3231")
         assert "seq={256:" in restored(sim, 2) and "boots=1" in restored(sim, 2)
-        assert took < FAST["boot_grace"] + 5.0 + 5.0
 
         time.sleep(1.5)
         sim.kill_obc()

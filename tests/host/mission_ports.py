@@ -1,0 +1,35 @@
+"""A port base of a test's own for a mission's processes: with ``OBSW_PORT_BASE`` set to it,
+every port of the mission moves (base + APID and the rest), so a test never meets an OBC
+already serving on the default ports nor another test run at the same time.
+
+``free_base(offsets)`` returns a base B with B + each offset free on 127.0.0.1 (UDP and TCP).
+The search starts at a place of this process's own, so that runs at the same time (pytest
+workers, another checkout's tests) do not all take the first free base and collide on it.
+"""
+
+import os
+import socket
+
+SAMPLE = (10, 100, 101)  # the sample spacecraft: PUS (APID 10), CFDP onboard and ground
+
+
+def _free(port):
+    for kind in (socket.SOCK_DGRAM, socket.SOCK_STREAM):
+        s = socket.socket(socket.AF_INET, kind)
+        try:
+            s.bind(("127.0.0.1", port))
+        except OSError:
+            return False
+        finally:
+            s.close()
+    return True
+
+
+def free_base(offsets=SAMPLE, low=21000, high=60000, step=337):
+    """A port base B with B + every offset free."""
+    bases = list(range(low, high - max(offsets), step))
+    start = os.getpid() % len(bases)
+    for base in bases[start:] + bases[:start]:
+        if all(_free(base + offset) for offset in offsets):
+            return base
+    raise RuntimeError("no free port base for offsets %s" % (offsets,))

@@ -2,8 +2,6 @@
 
 firmware_stages.py firmware     the Pyboard image builds; flash and frozen-bytecode table
 firmware_stages.py upy-frozen   core tests on the unix port with the core frozen
-firmware_stages.py upy-float32  core tests on the unix port with single-precision floats (the
-                                board's), from source; the board's float skips only
 firmware_stages.py cortex-m     core tests on the QEMU Cortex-M board through mpremote
 firmware_stages.py heap         reconfiguration session and a PLUTO procedure on the QEMU board
                                 with the Pyboard's heap: heap figures
@@ -149,56 +147,6 @@ def stage_upy_frozen():
             totals[i] += got[i]
     c = totals
     return _close("upy-frozen", t0, c[0] + entry_ok, c[1] + (not entry_ok), c[2])
-
-
-# what upy-float32 skips: the board's float skips, the tests the board skips for reading the
-# host's files (one of them waits on float epoch seconds: in single precision it never ends),
-# and the OBCP service's, which the board skips for its heap and which keep float epoch times
-FLOAT_SKIPS = {k: v for k, v in CORTEX_M_SKIPS.items() if v in (FLOAT, FILES)}
-FLOAT_SKIPS["test_pus_s18_obcp.py"] = FLOAT
-
-
-FILE_TIMEOUT = 300  # s a core test file may take on the unix port
-
-
-def stage_upy_float32():
-    """Every core test on the unix port built with single-precision floats, the board's float
-    format, from source: the board's float and host-file skips (with their reasons) and nothing
-    else are skipped, so what the board skips for its heap runs in its float format too."""
-    t0 = time.monotonic()
-    try:
-        exe = firmware.build_unix_float32()
-    except firmware.FirmwareError as e:
-        print(e)
-        return _close("upy-float32", t0, 0, 1)
-    env = dict(
-        os.environ, MICROPYPATH="%s:%s:.frozen" % (ROOT / "tools" / "upy", ROOT / "micropython")
-    )
-    probe = "print('single precision' if 1.0 + 2.0 ** -30 == 1.0 else 'double precision')"
-    r = subprocess.run([str(exe), "-c", probe], env=env, capture_output=True, text=True)
-    print(r.stdout.strip() or r.stderr.strip())
-    single = r.stdout.strip() == "single precision"
-    totals = [0, 0, 0]
-    for path in CORE_TESTS:  # one interpreter per test file, as a board boots afresh for each
-        name = path.name
-        skips = {k: v for k, v in FLOAT_SKIPS.items() if k.split("::")[0] == name}
-        code = "import sys\nfrom obsw_run_tests import main\nsys.exit(main(%r, %r))\n" % (
-            [str(path.relative_to(ROOT))], skips)  # fmt: skip
-        try:
-            r = subprocess.run([str(exe), "-X", "heapsize=64M", "-c", code], env=env, cwd=ROOT,
-                               capture_output=True, text=True, timeout=FILE_TIMEOUT)  # fmt: skip
-        except subprocess.TimeoutExpired:
-            print("FAIL %s: still running after %d s" % (name, FILE_TIMEOUT))
-            totals[1] += 1
-            continue
-        out = r.stdout + r.stderr
-        got = _counts(out) or (0, 1, 0)
-        if got[1] or r.returncode:
-            print("\n".join(out.splitlines()[-30:]))
-        for i in range(3):
-            totals[i] += got[i]
-    c = totals
-    return _close("upy-float32", t0, c[0] + single, c[1] + (not single), c[2])
 
 
 def _stage_dir(name):
@@ -545,7 +493,6 @@ def main(argv):
         "board": stage_board,
         "firmware": firmware.stage_sizes,
         "upy-frozen": stage_upy_frozen,
-        "upy-float32": stage_upy_float32,
         "cortex-m": stage_cortex_m,
         "heap": stage_heap,
     }

@@ -390,19 +390,6 @@ def build_unix(src=None):
     return _make(tree, out, "micropython", manifest_inputs(manifest), args)[0]
 
 
-def build_unix_float32(src=None):
-    """The unix port as build_unix makes it but with single-precision floats (32-bit, as the
-    Pyboard and the Cortex-M board compute them): the executable."""
-    tree = source(src)
-    build_mpy_cross(src)
-    out = BUILD / "unix-float32"
-    manifest = ROOT / "manifests" / "unix.py"
-    args = ["-C", str(tree / "ports" / "unix"), "BUILD=" + str(out), "PROG=micropython-float32"]
-    args += list(UNIX_OPTIONS) + ["FROZEN_MANIFEST=" + str(manifest)]
-    args += ["CFLAGS_EXTRA=-DMICROPY_FLOAT_IMPL=1"]  # MICROPY_FLOAT_IMPL_FLOAT
-    return _make(tree, out, "micropython-float32", manifest_inputs(manifest), args)[0]
-
-
 def _pyboard_symbols(src=None):
     elf = build_pyboard(src) / "firmware.elf"
     out = subprocess.run(["arm-none-eabi-nm", str(elf)], capture_output=True, text=True).stdout

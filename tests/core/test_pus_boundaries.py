@@ -3,6 +3,7 @@ one off either way, and the errors that name what was wrong."""
 
 import unittest
 
+from obsw.pus.any_packet import unpack_packet
 from obsw.pus.config import PusConfig
 from obsw.pus.packets import (
     PusCrcError,
@@ -10,7 +11,6 @@ from obsw.pus.packets import (
     PusLengthError,
     PusTooShortError,
     RequestId,
-    unpack_packet,
 )
 from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm

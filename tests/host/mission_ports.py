@@ -3,8 +3,10 @@ every port of the mission moves (base + APID and the rest), so a test never meet
 already serving on the default ports nor another test run at the same time.
 
 ``free_base(offsets)`` returns a base B with B + each offset free on 127.0.0.1 (UDP and TCP).
-The search starts at a place of this process's own, so that runs at the same time (pytest
-workers, another checkout's tests) do not all take the first free base and collide on it.
+A base is free when it is checked, not yet when the mission's processes bind it: so each pytest
+worker searches bases of its own (every Nth of N workers), and the search starts at a place of
+this process's own, so that runs at the same time (another checkout's tests) do not all take
+the first free base and collide on it.
 """
 
 import os
@@ -28,6 +30,9 @@ def _free(port):
 def free_base(offsets=SAMPLE, low=21000, high=60000, step=337):
     """A port base B with B + every offset free."""
     bases = list(range(low, high - max(offsets), step))
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")[2:]
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    bases = bases[int(worker or 0) % workers :: workers]
     start = os.getpid() % len(bases)
     for base in bases[start:] + bases[:start]:
         if all(_free(base + offset) for offset in offsets):

@@ -242,7 +242,10 @@ def test_switch_over_to_the_redundant_obc(tmp_path, capsys):
             t = time.monotonic()
             inject()
             seen = "recovery: %s line %d" % (decision, nominal)
-            assert chain.sim.wait_for(lambda s=seen: chain.sim.seen(s), WAIT), seen
+            assert chain.sim.wait_for(lambda s=seen: chain.sim.seen(s), WAIT), "%s\n%s" % (
+                seen,
+                "\n".join("%6.2f %s" % e for e in chain.sim.log_lines()[-60:]),
+            )
             assert chain.sim.wait_for(lambda b=boots: chain.sim.obc_boots == b + 1, WAIT)
             tries = led.ping_until_ok()
             figures.append(("OBC %s: %s, serving again (%d pings)" % (fault, decision, tries),

@@ -60,7 +60,7 @@ from obsw.pus.services.s01_verification import (
 )
 from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm
-from obsw.spp import SequenceCounter
+from obsw.spp import SEQ_UNSEGMENTED, SequenceCounter
 
 # The event this process raises when periodic work overruns its cycle; the host gives the id
 # the spacecraft database names ``pus.cycle_overrun`` (``overrun_event``; None: no event).
@@ -78,14 +78,19 @@ class Request:
     it returns: the request is accepted, started and completed in that order.
     """
 
-    __slots__ = ("app", "tc", "stage", "request_id", "since")
+    __slots__ = ("app", "tc", "stage", "rid", "since")
 
-    def __init__(self, app, tc):
+    def __init__(self, app, tc, rid=None):
         self.app = app
         self.tc = tc
         self.stage = 0  # the last stage passed
-        self.request_id = tc.request_id()
+        # the request ID, packed (the TC's first four octets): each service 1 report has it
+        self.rid = bytes(rid) if rid is not None else tc.request_id().pack()
         self.since = 0.0
+
+    @property
+    def request_id(self):
+        return RequestId.unpack(self.rid)
 
     @property
     def data(self):
@@ -109,19 +114,19 @@ class Request:
             self.stage = ACCEPTANCE
             self.app.count("accepted")
             if self.tc.ack & ACK_ACCEPTANCE:
-                self.app.verification.success(self.request_id, ACCEPTANCE, self.tc.source_id)
+                self.app.verification.succeeded(self.rid, ACCEPTANCE, self.tc.source_id)
 
     def start(self):
         if self.stage < START:
             self.accept()
             self.stage = START
             if self.tc.ack & ACK_START:
-                self.app.verification.success(self.request_id, START, self.tc.source_id)
+                self.app.verification.succeeded(self.rid, START, self.tc.source_id)
 
     def progress(self, step):
         self.start()
         if self.tc.ack & ACK_PROGRESS:
-            self.app.verification.success(self.request_id, PROGRESS, self.tc.source_id, step)
+            self.app.verification.succeeded(self.rid, PROGRESS, self.tc.source_id, step)
 
     def report(self, message_type, data=b""):
         """Send a response TM (to the requester), after the start of execution."""
@@ -134,7 +139,7 @@ class Request:
             self.stage = COMPLETION
             self.app.count("completed")
             if self.tc.ack & ACK_COMPLETION:
-                self.app.verification.success(self.request_id, COMPLETION, self.tc.source_id)
+                self.app.verification.succeeded(self.rid, COMPLETION, self.tc.source_id)
 
     def fail(self, failure):
         """Report ``failure`` (a PusFailure) at the stage the request has reached."""
@@ -152,8 +157,8 @@ class Request:
         self.stage = COMPLETION
         self.app.count("failed")
         self.app.count_failure(failure.code)
-        self.app.verification.failure(
-            self.request_id, stage, failure.code, failure.data, self.tc.source_id, failure.step
+        self.app.verification.failed(
+            self.rid, stage, failure.code, failure.data, self.tc.source_id, failure.step
         )
 
 
@@ -207,6 +212,8 @@ class ApplicationProcess:
         self.tasks = []  # [request, task] of handlers running as asyncio tasks
         self.events_lost = 0
         self.last_cycle = None
+        self._stamping = False  # a TC is being handled (``receive``)
+        self._stamp = None  # the time code of its reports, once the first is made
         self.verification = Verification()
         self.register(self.verification)
 
@@ -237,7 +244,7 @@ class ApplicationProcess:
         except Exception:  # a decoder defect must not stop the process either
             self.count("dropped")
             return None
-        req = Request(self, tc)
+        req = Request(self, tc, data[:4])  # a decoded TC's first 4 octets: its request ID
         if tc.apid not in self.apids:
             req.fail(PusFailure(FAILURE_ILLEGAL_APID))
             return req
@@ -254,7 +261,12 @@ class ApplicationProcess:
         if len(self.tasks) >= self.max_tasks:
             req.fail(PusFailure(FAILURE_BUSY))
             return req
-        self._run(req, handler)
+        self._stamping = True  # the reports made while it is handled carry one time
+        try:
+            self._run(req, handler)
+        finally:
+            self._stamping = False
+            self._stamp = None
         return req
 
     def _reject_packet(self, error):
@@ -323,9 +335,13 @@ class ApplicationProcess:
         key = (service << 8) | subtype
         counters = self.message_counters
         n = counters.get(key, 0)
-        code = self.config.time
+        config = self.config
         try:
-            t = code.from_seconds(self.time()) if code is not None else None
+            t = self._stamp
+            if t is None and config.time is not None:
+                t = config.time.from_seconds(self.time())
+                if self._stamping:  # the TC being handled: its other reports reuse it
+                    self._stamp = t
             raw = PusTm(
                 apid,
                 service,
@@ -336,20 +352,22 @@ class ApplicationProcess:
                 destination,
                 t,
                 self.time_ref,
-                config=self.config,
+                SEQ_UNSEGMENTED,
+                config,
             ).pack()
         except ValueError as e:  # counts advance only for packets sent: no gap on the ground
             self.count("tm_unpackable")
             self.unsent(service, subtype, str(e))
             return None
         self.sequence.next(apid)
-        counters[key] = (n + 1) & self.config.message_counter_max
+        counters[key] = (n + 1) & config.message_counter_max
         if self.tm_stores or self.tm_filters:
             if not self._pipeline(raw):
                 self.count("tm_withheld")
                 return raw
         if self._emit(raw):
-            self.count("tm_sent")
+            counters = self.counters
+            counters["tm_sent"] = counters.get("tm_sent", 0) + 1
             return raw
         return None
 

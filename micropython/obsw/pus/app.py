@@ -214,6 +214,7 @@ class ApplicationProcess:
         self.last_cycle = None
         self._stamping = False  # a TC is being handled (``receive``)
         self._stamp = None  # the time code of its reports, once the first is made
+        self._tm = PusTm(apid, 0, 0, seq_flags=SEQ_UNSEGMENTED)
         self.verification = Verification()
         self.register(self.verification)
 
@@ -336,40 +337,47 @@ class ApplicationProcess:
         counters = self.message_counters
         n = counters.get(key, 0)
         config = self.config
+        seq = self.sequence
+        count = seq.next(apid)
         try:
             t = self._stamp
             if t is None and config.time is not None:
                 t = config.time.from_seconds(self.time())
                 if self._stamping:  # the TC being handled: its other reports reuse it
                     self._stamp = t
-            raw = PusTm(
-                apid,
-                service,
-                subtype,
-                data,
-                self.sequence.peek(apid),
-                n,
-                destination,
-                t,
-                self.time_ref,
-                SEQ_UNSEGMENTED,
-                config,
-            ).pack()
+            tm = self._tm  # one packet object, its fields set for each TM (no allocation)
+            tm.apid = apid
+            tm.service = service
+            tm.subtype = subtype
+            tm.data = data
+            tm.seq_count = count
+            tm.message_counter = n
+            tm.destination_id = destination
+            tm.time = t
+            tm.time_ref = self.time_ref
+            tm.config = config
+            raw = tm.pack()
         except ValueError as e:  # counts advance only for packets sent: no gap on the ground
+            seq.set(apid, count)
             self.count("tm_unpackable")
             self.unsent(service, subtype, str(e))
             return None
-        self.sequence.next(apid)
+        except Exception:
+            seq.set(apid, count)
+            raise
         counters[key] = (n + 1) & config.message_counter_max
         if self.tm_stores or self.tm_filters:
             if not self._pipeline(raw):
                 self.count("tm_withheld")
                 return raw
-        if self._emit(raw):
-            counters = self.counters
-            counters["tm_sent"] = counters.get("tm_sent", 0) + 1
-            return raw
-        return None
+        try:
+            self.out(raw)
+        except Exception as e:
+            self._lost(raw, e)
+            return None
+        counters = self.counters
+        counters["tm_sent"] = counters.get("tm_sent", 0) + 1
+        return raw
 
     def _pipeline(self, raw):
         """Offer ``raw`` to every store, ask every filter; True if it goes out in real time."""
@@ -390,12 +398,16 @@ class ApplicationProcess:
     def _emit(self, raw):
         try:
             self.out(raw)
-        except Exception as e:  # the output's failure is counted and said; the loop goes on
-            self.count("tm_lost")
-            if len(raw) > 8:  # TM[service, subtype] from the secondary header
-                self.unsent(raw[7], raw[8], "output failed: %s" % (e,))
+        except Exception as e:
+            self._lost(raw, e)
             return False
         return True
+
+    def _lost(self, raw, error):
+        """The output's failure is counted and said; the loop goes on."""
+        self.count("tm_lost")
+        if len(raw) > 8:  # TM[service, subtype] from the secondary header
+            self.unsent(raw[7], raw[8], "output failed: %s" % (error,))
 
     def play(self, raw, vc):
         """Send a TM retrieved from a packet store on virtual channel ``vc``."""

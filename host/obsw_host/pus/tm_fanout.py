@@ -43,7 +43,10 @@ class TmFanout:
         subs = self.subscribers
         now = self.clock()
         tc = data != SUBSCRIBE
-        if address not in subs and len(subs) >= self.limit:
+        if address in subs:  # a known client (every TC of an operator): kept fresh
+            subs[address] = now
+            return tc
+        if len(subs) >= self.limit:
             self._prune(now)
             if len(subs) >= self.limit:
                 self.refused += 1
@@ -51,10 +54,9 @@ class TmFanout:
                     return False
                 oldest = min(subs, key=subs.get)
                 del subs[oldest]
-        if address not in subs:
-            self._targets = None
-            if self._due is None or now + self.linger < self._due:
-                self._due = now + self.linger
+        self._targets = None
+        if self._due is None or now + self.linger < self._due:
+            self._due = now + self.linger
         subs[address] = now
         return tc
 

@@ -4,10 +4,11 @@
 provider (``obsw.pus.services``). Nothing a TC carries can make it raise: a bad packet
 becomes a service 1 failure report with the failure code and a counter, or, when not even
 its header is readable, a counted drop. The TC's acknowledgement flags decide which success
-reports go out. The TM a TC causes while it is handled carry one time, that of the first. A handler that is a coroutine runs as an asyncio task, so slow requests
-(calls through the interaction layer) proceed side by side; a bounded number may run at
-once. ``tick()`` is one cycle of the activity loop that drives the services' periodic work;
-a service still busy with its previous cycle is stopped and an overrun event raised.
+reports go out. The TM a TC causes while it is handled carry one time, that of the first.
+A handler that is a coroutine runs as an asyncio task, so slow requests (calls through the
+interaction layer) proceed side by side; a bounded number may run at once. ``tick()`` is
+one cycle of the activity loop that drives the services' periodic work; a service still
+busy with its previous cycle is stopped and an overrun event raised.
 
 Wiring is declared here and services add themselves to it; none replaces another's
 attributes, so the order of ``register`` calls carries no meaning:

@@ -1,7 +1,7 @@
 """What the OBC's sockets receive is read into one buffer each and copied at its size: a small
 message never costs a buffer of the largest size. A fresh 64-70 kB buffer per message, shrunk
 to what came, fragmented the heap of the PUS process: its resident memory grew for hours under
-traffic (issue 41). Measured with tracemalloc's peak, not with time."""
+traffic. Measured with tracemalloc's peak, not with time."""
 
 import os
 import socket

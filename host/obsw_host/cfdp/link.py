@@ -89,7 +89,7 @@ class UdpEntity:
         self.sock.bind(bind)
         self.address = self.sock.getsockname()
         # datagrams are received into this buffer and copied at their size: a fresh 70,000
-        # octet buffer per datagram, shrunk to what came, fragmented the heap (issue 41)
+        # octet buffer per datagram, shrunk to what came, fragmented the heap
         self._buf = bytearray(_RECV)
         self._view = memoryview(self._buf)
         self.seq = 0

@@ -34,7 +34,7 @@ _SUN_PATH_MAX = 100
 _SLICE = 0.01  # a lone connection is waited on by a blocking recv of at most this long
 # received into one buffer per connection, then copied at their size: a fresh buffer of the
 # largest size per receive, shrunk to what came, left the process's heap fragmented (its
-# resident memory grew for hours under traffic, issue 41)
+# resident memory grew for hours under traffic)
 _RECV = 65536
 _POLLIN = select.POLLIN | select.POLLPRI | select.POLLHUP | select.POLLERR
 

@@ -39,12 +39,12 @@ import subprocess
 import sys
 import tempfile
 
+from obsw_host import firmware
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
-sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]  # this tree's
 
 import firmware_stages  # noqa: E402 (the heap stage's session)
-from obsw_host import firmware  # noqa: E402
 
 OPS_SCRIPT = os.path.join(ROOT, "tools", "bench", "board_ops.py")
 SHIFT = 7  # -icount shift: 2**SHIFT ns of virtual time per guest instruction

@@ -23,7 +23,7 @@ import statistics
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path[:0] = [str(ROOT / "micropython"), str(ROOT / "host")]  # this tree, not an installed one
+sys.path[:0] = [str(ROOT / "micropython")]
 
 from cryptography.hazmat.primitives.asymmetric.ed25519 import (  # noqa: E402
     Ed25519PrivateKey,

@@ -152,6 +152,36 @@ class TestRouting(unittest.TestCase):
         self.assertEqual(loop.app.tc_counts[(17 << 8) | 1], 3)
         self.assertEqual(loop.app.counters["completed"], 3)
 
+    def test_the_reports_of_a_tc_carry_one_time(self):
+        calls = []
+
+        def now():  # on-board time that moves on at each look
+            calls.append(1)
+            return 1000.0 + len(calls)
+
+        loop = Loop(time=now)
+        loop.app.register(ServiceTest())
+        user = loop.ground.register(ServiceTestUser())
+        loop.run(user.ping(APID))
+        loop.run(user.ping(APID))
+        times = [t.time for t in loop.tm]
+        self.assertEqual(len(set(times[:4])), 1)  # the first TC's four reports
+        self.assertEqual(len(set(times[4:])), 1)  # the second's
+        self.assertNotEqual(times[0], times[4])
+        self.assertEqual(len(calls), 2)
+
+    def test_a_tm_too_long_leaves_no_gap_in_the_counts(self):
+        loop, user = make()
+        heard = []
+        loop.app.unsent_listeners.append(lambda *a: heard.append(a))
+        loop.run(user.ping(APID))
+        self.assertIsNone(loop.app.send_tm(17, 2, bytes(70000), 7))  # over the packet size
+        self.assertEqual(loop.app.counters["tm_unpackable"], 1)
+        self.assertEqual([(s, t) for s, t, _ in heard], [(17, 2)])
+        loop.run(user.ping(APID))
+        self.assertEqual([t.seq_count for t in loop.tm], list(range(8)))
+        self.assertEqual([t.message_counter for t in loop.tm if t.subtype == 2], [0, 1])
+
     def test_progress_reports(self):
         loop = Loop()
         loop.app.register(Custom())

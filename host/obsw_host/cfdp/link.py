@@ -40,6 +40,7 @@ PACE_MIN = 64e3
 PACE_MAX = 1e9
 PACE_STEP = 0.25  # seconds between increases; and between two halvings
 PACE_RUN = 8  # segments in a row asked again: the receiver overflowed, not the link
+_RECV = 70000  # octets: more than the largest space packet a UDP datagram brings
 
 
 class PeerError(ValueError):
@@ -87,6 +88,10 @@ class UdpEntity:
         self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
         self.sock.bind(bind)
         self.address = self.sock.getsockname()
+        # datagrams are received into this buffer and copied at their size: a fresh 70,000
+        # octet buffer per datagram, shrunk to what came, fragmented the heap
+        self._buf = bytearray(_RECV)
+        self._view = memoryview(self._buf)
         self.seq = 0
         self.sent = 0
         self.received = 0
@@ -126,11 +131,12 @@ class UdpEntity:
         n = 0
         while True:
             try:
-                data = self.sock.recv(70000)
+                size = self.sock.recv_into(self._buf)
             except (BlockingIOError, InterruptedError):
                 return n
             except OSError:
                 return n
+            data = bytes(self._view[:size])
             try:
                 pkt = SpacePacket.unpack(data)
             except SppError:

@@ -209,6 +209,26 @@ class _Udp:
                 return
         self.waiting.append((bytes(data), address))
 
+    def send_all(self, batch, targets):
+        """Send every datagram of ``batch`` to every address of ``targets``, in order."""
+        if self.waiting:
+            for raw in batch:
+                for address in targets:
+                    self.sendto(raw, address)
+            return
+        sendto = self.sock.sendto
+        for i, raw in enumerate(batch):
+            for j, address in enumerate(targets):
+                try:
+                    sendto(raw, address)
+                except OSError:  # the socket full or refusing: the careful way from here on
+                    for k in range(j, len(targets)):
+                        self.sendto(raw, targets[k])
+                    for rest in batch[i + 1 :]:
+                        for a in targets:
+                            self.sendto(rest, a)
+                    return
+
     def _refused(self, data, error):
         """A datagram the socket refused (too long, no route): counted and said."""
         self.count("udp_errors")
@@ -355,13 +375,14 @@ class Onboard:
     # -------------------------------------------------------------------------- I/O
 
     def _send(self, raw):
+        batch = self._batch
+        if batch is not None:  # a TC being handled: its reports go out together, then logged
+            batch.append(raw)
+            return
         t = self._transport
         if t is None:
             raise OSError("not bound")
         self.tm_log.tm(raw)
-        if self._batch is not None:  # a TC being handled: its reports go out together
-            self._batch.append(raw)
-            return
         if not self.fanout.send(t.sendto, raw):
             self.app.count("tm_no_ground")
 
@@ -371,15 +392,13 @@ class Onboard:
         do) took the CPU from this process on a loaded machine (issue 41)."""
         t = self._transport
         if t is None:
+            self.app.count("tm_lost", len(batch))
             return
         targets = self.fanout.targets()
         if not targets:
             self.app.count("tm_no_ground", len(batch))
             return
-        sendto = t.sendto
-        for raw in batch:
-            for address in targets:
-                sendto(raw, address)
+        t.send_all(batch, targets)
 
     def _playback(self, raw, vc):
         """The app's playback: a retrieved packet to the frame processor's ``vc`` input."""
@@ -406,6 +425,9 @@ class Onboard:
                 self._batch = None
                 if batch:
                     self._flush(batch)
+                    log = self.tm_log.tm  # after the ground has its reports
+                    for raw in batch:
+                        log(raw)
 
     async def main(self):
         """Bind, then serve TCs and run the activity loop until ``stop()``."""

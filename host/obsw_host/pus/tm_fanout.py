@@ -31,16 +31,22 @@ class TmFanout:
         self.limit = limit
         self.subscribers = {}  # address -> last time heard
         self.refused = 0  # new subscribers refused while the set was full
+        self._targets = None  # what ``targets`` returns until the set changes
+        self._due = None  # no subscriber falls silent before then (None: none to prune)
 
     def heard(self, data, address):
         """Note a datagram from ``address``; True if it is a TC for the process to handle."""
         if data == UNSUBSCRIBE:
-            self.subscribers.pop(address, None)
+            if self.subscribers.pop(address, None) is not None:
+                self._targets = None
             return False
         subs = self.subscribers
         now = self.clock()
         tc = data != SUBSCRIBE
-        if address not in subs and len(subs) >= self.limit:
+        if address in subs:  # a known client (every TC of an operator): kept fresh
+            subs[address] = now
+            return tc
+        if len(subs) >= self.limit:
             self._prune(now)
             if len(subs) >= self.limit:
                 self.refused += 1
@@ -48,19 +54,33 @@ class TmFanout:
                     return False
                 oldest = min(subs, key=subs.get)
                 del subs[oldest]
+        self._targets = None
+        if self._due is None or now + self.linger < self._due:
+            self._due = now + self.linger
         subs[address] = now
         return tc
 
     def _prune(self, now):
+        due = None
         for address, last in list(self.subscribers.items()):
             if now - last > self.linger:
                 del self.subscribers[address]
+                self._targets = None
+            elif due is None or last + self.linger < due:
+                due = last + self.linger
+        self._due = due
 
     def targets(self):
-        """The addresses TM goes to now (silent subscribers dropped)."""
-        self._prune(self.clock())
-        out = list(self.static)
-        out.extend(a for a in self.subscribers if a not in out)
+        """The addresses TM goes to now (silent subscribers dropped); the same list until
+        the set changes (not to be changed by the caller)."""
+        due = self._due
+        if due is not None and self.clock() > due:
+            self._prune(self.clock())
+        out = self._targets
+        if out is None:
+            out = list(self.static)
+            out.extend(a for a in self.subscribers if a not in out)
+            self._targets = out
         return out
 
     def send(self, sendto, raw):

@@ -4,10 +4,11 @@
 provider (``obsw.pus.services``). Nothing a TC carries can make it raise: a bad packet
 becomes a service 1 failure report with the failure code and a counter, or, when not even
 its header is readable, a counted drop. The TC's acknowledgement flags decide which success
-reports go out. A handler that is a coroutine runs as an asyncio task, so slow requests
-(calls through the interaction layer) proceed side by side; a bounded number may run at
-once. ``tick()`` is one cycle of the activity loop that drives the services' periodic work;
-a service still busy with its previous cycle is stopped and an overrun event raised.
+reports go out. The TM a TC causes while it is handled carry one time, that of the first.
+A handler that is a coroutine runs as an asyncio task, so slow requests (calls through the
+interaction layer) proceed side by side; a bounded number may run at once. ``tick()`` is
+one cycle of the activity loop that drives the services' periodic work; a service still
+busy with its previous cycle is stopped and an overrun event raised.
 
 Wiring is declared here and services add themselves to it; none replaces another's
 attributes, so the order of ``register`` calls carries no meaning:
@@ -60,7 +61,7 @@ from obsw.pus.services.s01_verification import (
 )
 from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm
-from obsw.spp import SequenceCounter
+from obsw.spp import SEQ_UNSEGMENTED, SequenceCounter
 
 # The event this process raises when periodic work overruns its cycle; the host gives the id
 # the spacecraft database names ``pus.cycle_overrun`` (``overrun_event``; None: no event).
@@ -78,14 +79,19 @@ class Request:
     it returns: the request is accepted, started and completed in that order.
     """
 
-    __slots__ = ("app", "tc", "stage", "request_id", "since")
+    __slots__ = ("app", "tc", "stage", "rid", "since")
 
-    def __init__(self, app, tc):
+    def __init__(self, app, tc, rid=None):
         self.app = app
         self.tc = tc
         self.stage = 0  # the last stage passed
-        self.request_id = tc.request_id()
+        # the request ID, packed (the TC's first four octets): each service 1 report has it
+        self.rid = bytes(rid) if rid is not None else tc.request_id().pack()
         self.since = 0.0
+
+    @property
+    def request_id(self):
+        return RequestId.unpack(self.rid)
 
     @property
     def data(self):
@@ -109,19 +115,19 @@ class Request:
             self.stage = ACCEPTANCE
             self.app.count("accepted")
             if self.tc.ack & ACK_ACCEPTANCE:
-                self.app.verification.success(self.request_id, ACCEPTANCE, self.tc.source_id)
+                self.app.verification.succeeded(self.rid, ACCEPTANCE, self.tc.source_id)
 
     def start(self):
         if self.stage < START:
             self.accept()
             self.stage = START
             if self.tc.ack & ACK_START:
-                self.app.verification.success(self.request_id, START, self.tc.source_id)
+                self.app.verification.succeeded(self.rid, START, self.tc.source_id)
 
     def progress(self, step):
         self.start()
         if self.tc.ack & ACK_PROGRESS:
-            self.app.verification.success(self.request_id, PROGRESS, self.tc.source_id, step)
+            self.app.verification.succeeded(self.rid, PROGRESS, self.tc.source_id, step)
 
     def report(self, message_type, data=b""):
         """Send a response TM (to the requester), after the start of execution."""
@@ -134,7 +140,7 @@ class Request:
             self.stage = COMPLETION
             self.app.count("completed")
             if self.tc.ack & ACK_COMPLETION:
-                self.app.verification.success(self.request_id, COMPLETION, self.tc.source_id)
+                self.app.verification.succeeded(self.rid, COMPLETION, self.tc.source_id)
 
     def fail(self, failure):
         """Report ``failure`` (a PusFailure) at the stage the request has reached."""
@@ -152,8 +158,8 @@ class Request:
         self.stage = COMPLETION
         self.app.count("failed")
         self.app.count_failure(failure.code)
-        self.app.verification.failure(
-            self.request_id, stage, failure.code, failure.data, self.tc.source_id, failure.step
+        self.app.verification.failed(
+            self.rid, stage, failure.code, failure.data, self.tc.source_id, failure.step
         )
 
 
@@ -207,6 +213,9 @@ class ApplicationProcess:
         self.tasks = []  # [request, task] of handlers running as asyncio tasks
         self.events_lost = 0
         self.last_cycle = None
+        self._stamping = False  # a TC is being handled (``receive``)
+        self._stamp = None  # the time code of its reports, once the first is made
+        self._tm = PusTm(apid, 0, 0, seq_flags=SEQ_UNSEGMENTED)
         self.verification = Verification()
         self.register(self.verification)
 
@@ -237,7 +246,7 @@ class ApplicationProcess:
         except Exception:  # a decoder defect must not stop the process either
             self.count("dropped")
             return None
-        req = Request(self, tc)
+        req = Request(self, tc, data[:4])  # a decoded TC's first 4 octets: its request ID
         if tc.apid not in self.apids:
             req.fail(PusFailure(FAILURE_ILLEGAL_APID))
             return req
@@ -254,7 +263,12 @@ class ApplicationProcess:
         if len(self.tasks) >= self.max_tasks:
             req.fail(PusFailure(FAILURE_BUSY))
             return req
-        self._run(req, handler)
+        self._stamping = True  # the reports made while it is handled carry one time
+        try:
+            self._run(req, handler)
+        finally:
+            self._stamping = False
+            self._stamp = None
         return req
 
     def _reject_packet(self, error):
@@ -323,35 +337,48 @@ class ApplicationProcess:
         key = (service << 8) | subtype
         counters = self.message_counters
         n = counters.get(key, 0)
-        code = self.config.time
+        config = self.config
+        seq = self.sequence
+        count = seq.next(apid)
         try:
-            t = code.from_seconds(self.time()) if code is not None else None
-            raw = PusTm(
-                apid,
-                service,
-                subtype,
-                data,
-                self.sequence.peek(apid),
-                n,
-                destination,
-                t,
-                self.time_ref,
-                config=self.config,
-            ).pack()
+            t = self._stamp
+            if t is None and config.time is not None:
+                t = config.time.from_seconds(self.time())
+                if self._stamping:  # the TC being handled: its other reports reuse it
+                    self._stamp = t
+            tm = self._tm  # one packet object, its fields set for each TM (no allocation)
+            tm.apid = apid
+            tm.service = service
+            tm.subtype = subtype
+            tm.data = data
+            tm.seq_count = count
+            tm.message_counter = n
+            tm.destination_id = destination
+            tm.time = t
+            tm.time_ref = self.time_ref
+            tm.config = config
+            raw = tm.pack()
         except ValueError as e:  # counts advance only for packets sent: no gap on the ground
+            seq.set(apid, count)
             self.count("tm_unpackable")
             self.unsent(service, subtype, str(e))
             return None
-        self.sequence.next(apid)
-        counters[key] = (n + 1) & self.config.message_counter_max
+        except Exception:
+            seq.set(apid, count)
+            raise
+        counters[key] = (n + 1) & config.message_counter_max
         if self.tm_stores or self.tm_filters:
             if not self._pipeline(raw):
                 self.count("tm_withheld")
                 return raw
-        if self._emit(raw):
-            self.count("tm_sent")
-            return raw
-        return None
+        try:
+            self.out(raw)
+        except Exception as e:
+            self._lost(raw, e)
+            return None
+        counters = self.counters
+        counters["tm_sent"] = counters.get("tm_sent", 0) + 1
+        return raw
 
     def _pipeline(self, raw):
         """Offer ``raw`` to every store, ask every filter; True if it goes out in real time."""
@@ -372,12 +399,16 @@ class ApplicationProcess:
     def _emit(self, raw):
         try:
             self.out(raw)
-        except Exception as e:  # the output's failure is counted and said; the loop goes on
-            self.count("tm_lost")
-            if len(raw) > 8:  # TM[service, subtype] from the secondary header
-                self.unsent(raw[7], raw[8], "output failed: %s" % (e,))
+        except Exception as e:
+            self._lost(raw, e)
             return False
         return True
+
+    def _lost(self, raw, error):
+        """The output's failure is counted and said; the loop goes on."""
+        self.count("tm_lost")
+        if len(raw) > 8:  # TM[service, subtype] from the secondary header
+            self.unsent(raw[7], raw[8], "output failed: %s" % (error,))
 
     def play(self, raw, vc):
         """Send a TM retrieved from a packet store on virtual channel ``vc``."""

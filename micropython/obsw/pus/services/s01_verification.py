@@ -129,13 +129,21 @@ class Verification(Service):
     )
 
     def success(self, request_id, stage, destination=0, step=None):
-        data = request_id.pack()
+        return self.succeeded(request_id.pack(), stage, destination, step)
+
+    def succeeded(self, rid, stage, destination=0, step=None):
+        """``success`` of the request whose ID ``rid`` is packed already (4 octets: a
+        request's reports of every stage carry the same, packed once)."""
         if step is not None:
-            data += STEP_ID.pack(step)
-        return self.app.send_tm(1, _SUCCESS[stage], data, destination)
+            rid += STEP_ID.pack(step)
+        return self.app.send_tm(1, _SUCCESS[stage], rid, destination)
 
     def failure(self, request_id, stage, code, data=b"", destination=0, step=None):
-        out = request_id.pack()
+        return self.failed(request_id.pack(), stage, code, data, destination, step)
+
+    def failed(self, rid, stage, code, data=b"", destination=0, step=None):
+        """``failure`` of the request whose ID ``rid`` is packed already."""
+        out = rid
         if stage == PROGRESS:
             out += STEP_ID.pack(step or 0)
         out += FAILURE_CODE.pack(code) + bytes(data)

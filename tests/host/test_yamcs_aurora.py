@@ -167,6 +167,10 @@ class Aurora:
         try:
             cmd = commands.issue("/%s/%s" % (self.instance, name), args=args)
             cmd.await_complete(timeout=TIMEOUT)
+            # Yamcs may conclude a command on its completion report before it has marked the
+            # acceptance report that came first (their times can be equal): wait for that mark
+            # too while the connection still follows the command
+            cmd.await_acknowledgment("Verifier_Accepted", timeout=TIMEOUT)
         finally:
             commands.cancel()  # its websocket closed
         return cmd

@@ -203,6 +203,9 @@ def wait_value(ground, mode, name, predicate, since=0):
 def issue(ground, mode, command, args=None):
     cmd = ground.connection(mode).issue(command, args=args)
     cmd.await_complete(timeout=TIMEOUT)
+    # Yamcs may conclude a command on its completion report before it has marked the
+    # acceptance report that came first (their times can be equal): wait for that mark too
+    cmd.await_acknowledgment("Verifier_Accepted", timeout=TIMEOUT)
     return cmd
 
 

@@ -62,6 +62,8 @@ CORTEX_M_SKIPS = {
     "test_pus_s15_copy.py::TestCopyByTimeWindow::test_from_to_after_before": HEAP,
     "test_pus_s15_copy.py::TestCopyByTimeWindow::test_refusals": HEAP,
     "test_pus_s15_storage.py::TestRetrieval::test_by_time_range_on_the_playback_channel": HEAP,
+    "test_pus_s15_storage.py::TestRetrieval::test_by_sequence_and_abort": HEAP,
+    "test_pus_app.py::TestRouting::test_a_tm_too_long_leaves_no_gap_in_the_counts": BIG,
     "test_pus_s21_by_reference.py": MEMORY,
     "test_pus_s06_objects.py::TestWriteProtection::test_every_load_honours_it": MEMORY,
     "test_pus_s15_storage.py::TestStores::test_housekeeping_and_event_control": HEAP,

@@ -3,10 +3,11 @@ every port of the mission moves (base + APID and the rest), so a test never meet
 already serving on the default ports nor another test run at the same time.
 
 ``free_base(offsets)`` returns a base B with B + each offset free on 127.0.0.1 (UDP and TCP).
-A base is free when it is checked, not yet when the mission's processes bind it: so each pytest
-worker searches bases of its own (every Nth of N workers), and the search starts at a place of
-this process's own, so that runs at the same time (another checkout's tests) do not all take
-the first free base and collide on it.
+A base is free when it is checked, not yet when the mission's processes bind it: so the bases
+lie below the kernel's ephemeral ports (32768 and up, where the tests that take a port the
+kernel picks get theirs), each pytest worker searches bases of its own (every Nth of N
+workers), and the search starts at a place of this process's own, so that runs at the same
+time (another checkout's tests) do not all take the first free base and collide on it.
 """
 
 import os
@@ -27,7 +28,7 @@ def _free(port):
     return True
 
 
-def free_base(offsets=SAMPLE, low=21000, high=60000, step=337):
+def free_base(offsets=SAMPLE, low=10000, high=32000, step=337):
     """A port base B with B + every offset free."""
     bases = list(range(low, high - max(offsets), step))
     worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")[2:]

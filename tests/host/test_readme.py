@@ -258,6 +258,7 @@ def test_every_example_runs(page, tmp_path):
         OBSW_IL_DIR=str(tmp_path / "il"),
         TMPDIR=str(tmp_path),
         HOME=str(tmp_path / "home"),  # what the examples write under ~ stays here
+        OBSW_STATE=str(tmp_path / "state"),  # the page's OBCs keep their state to themselves
         PYTHONPATH=os.pathsep.join([str(work), str(ROOT / "micropython"), str(ROOT / "host")]),
     )
     env.pop("OBSW_MISSION", None)  # a page names its mission as a reader would type it

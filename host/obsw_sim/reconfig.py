@@ -303,6 +303,7 @@ class ReconfigSim:
         self._t0 = time.monotonic()
         self._wdog = [None, None]
         self._kicks = [0, 0]
+        self._kick_at = [0, 0]  # the last kick's time on its controller's clock (W_KICK_MS)
         self._req_since = [None, None]
         self._restart_at = [None, None]
         self._spawned_at = [0.0, 0.0]
@@ -494,6 +495,10 @@ class ReconfigSim:
         os.pwrite(self._wire_fd, b"\x00", base + W.W_FAULT)
         self._restart_at[role] = (time.monotonic() + self.reset_s, cause)
 
+    @staticmethod
+    def _kick_ms(w, base):
+        return w[base + W.W_KICK_MS] | w[base + W.W_KICK_MS + 1] << 8
+
     def _supervise(self):
         next_com = 0.0
         while not self._stop.is_set():
@@ -525,13 +530,21 @@ class ReconfigSim:
                 if dog is None:
                     if k != self._kicks[role]:
                         self._kicks[role] = k
+                        self._kick_at[role] = self._kick_ms(w, base)
                         self._wdog[role] = Tps3813Model(self.wd[0], self.wd[1], now * 1000)
                     elif now - self._spawned_at[role] > self.boot_limit:
                         why = "never came (%g s since power on)" % self.boot_limit
                 else:
                     if k != self._kicks[role]:
+                        # judged by the pulses' own spacing (their mean when this look
+                        # found several): this loop sees them late when the machine is
+                        # loaded, and a late look is not an early kick
+                        n = (k - self._kicks[role]) & 0xFF
                         self._kicks[role] = k
-                        why = dog.kick(now * 1000)
+                        t = self._kick_ms(w, base)
+                        gap = ((t - self._kick_at[role]) & 0xFFFF) // n
+                        self._kick_at[role] = t
+                        why = dog.kick(now * 1000, gap)
                     why = why or dog.poll(now * 1000)
                 if why is not None:
                     self._reset(role, RESET_WATCHDOG, "watchdog: kick %s" % why)

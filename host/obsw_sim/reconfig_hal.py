@@ -26,6 +26,7 @@ W_ALIVE = 5
 W_KICKS = 6  # TPS3813 WDI pulses, counted modulo 256
 W_FAULT = 7  # set by the supervisor: 1 = firmware hangs with CPDU_REQ high
 W_STEPS = 8  # main loop passes modulo 256 (progress, for the supervisor)
+W_KICK_MS = 9  # the last WDI pulse's time on the controller's clock, ms modulo 65536 (2 bytes)
 Q_OFFSET = 32  # latched outputs, 2 bytes little-endian
 LATCHES = 34
 COLLISIONS = 35
@@ -180,6 +181,9 @@ class SimHal(Hal):
 
     def wdi(self, level):
         if level:
+            # the pulse's time first: the supervisor reads it when it sees the count change
+            t = time.ticks_ms() & 0xFFFF
+            self.wire.put(self.base + W_KICK_MS, bytes((t & 0xFF, t >> 8)))
             self._kicks = (self._kicks + 1) & 0xFF
             self.wire.put(self.base + W_KICKS, bytes((self._kicks,)))
 

@@ -198,3 +198,13 @@ class TestWatchdog(unittest.TestCase):
         self.assertEqual(tps.kick(50), "early")
         with self.assertRaises(WatchdogConfigError):
             Watchdog(ModelHal(), open_ms=500, timeout_ms=510)
+
+    def test_a_kick_seen_late_is_judged_by_its_own_spacing(self):
+        # an observer that saw the last kick 250 ms late sees the next 60 ms after it: the
+        # pulses were 300 ms apart, which the chip (beside the controller) sees
+        tps = Tps3813Model(100, 1000)
+        self.assertIsNone(tps.kick(550, gap_ms=None))
+        self.assertIsNone(tps.kick(610, gap_ms=300))
+        self.assertEqual(tps.kick(700, gap_ms=99), "early")
+        self.assertEqual(tps.kick(800, gap_ms=100), None)
+        self.assertEqual(tps.resets, 1)

@@ -7,4 +7,4 @@ import sys
 
 from obsw_run_tests import main
 
-sys.exit(main(sys.argv[1:]))
+sys.exit(main(sys.argv[1:], collect=False))  # a large heap: see obsw_run_tests

@@ -292,8 +292,11 @@ class DS3231Model:
 
 class Tps3813Model:
     """Window watchdog: a kick earlier than ``open_ms`` after the last, or none within
-    ``timeout_ms``, asserts reset. ``kick(now_ms)`` and ``poll(now_ms)`` return
-    "early", "late" or None."""
+    ``timeout_ms``, asserts reset. ``kick(now_ms, gap_ms)`` and ``poll(now_ms)`` return
+    "early", "late" or None. ``gap_ms``, when given, is the kick's distance from the one before
+    as the pulses themselves were timed (the chip sits beside the controller): an observer that
+    sees kicks some time after they happen passes it, so that its own delays never make a kick
+    look early."""
 
     def __init__(self, open_ms, timeout_ms, now_ms=0):
         self.open_ms = open_ms
@@ -301,8 +304,8 @@ class Tps3813Model:
         self.last = now_ms
         self.resets = 0
 
-    def kick(self, now_ms):
-        early = now_ms - self.last < self.open_ms
+    def kick(self, now_ms, gap_ms=None):
+        early = (now_ms - self.last if gap_ms is None else gap_ms) < self.open_ms
         self.last = now_ms
         if early:
             self.resets += 1

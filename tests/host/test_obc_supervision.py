@@ -349,7 +349,11 @@ def test_the_obc_component_publishes_what_changed(tmp_path):
     class Provider:
         node = Node()
 
-    health = ObcHealth(HostHealth(str(tmp_path), str(tmp_path)))
+    class PinnedDisk(HostHealth):  # the disk is this machine's: other processes change it
+        def disk_used(self):
+            return 12.5
+
+    health = ObcHealth(PinnedDisk(str(tmp_path), str(tmp_path)))
     health.il_bind(Provider)
     health.sample()
     names = [m for _, m, _ in Provider.node.published]

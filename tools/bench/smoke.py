@@ -31,7 +31,7 @@ report = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(report)
 
 SKIP = 77  # a benchmark's exit status when it cannot run here (its reason on stderr)
-TIMEOUT = 300  # seconds for one benchmark's quick run (they take under a minute)
+TIMEOUT = 600  # seconds for one quick run: under a minute when quiet, over 5 on a loaded machine
 
 
 def problems(result, name):

@@ -423,6 +423,22 @@ def test_examples_are_many_and_every_skip_has_a_reason():
     assert len(skipped) <= SKIPPED_AT_MOST, skipped
 
 
+# pages with an example that runs here without stating its output, and why
+UNSTATED = {"docs/benchmarks.md": "its report block's other lines run benchmarks (skipped here)"}
+
+
+def runs(kind, body):
+    """True if the block runs here: Python, or a shell block with a line not skipped."""
+    return kind == "python" or any(not why for _, _, why in shell_lines(body))
+
+
+def test_every_example_that_runs_states_what_it_prints():
+    unstated = [(str(page), body.splitlines()[0]) for page in pages()
+                for kind, body, printed in stated(page)
+                if printed is None and runs(kind, body) and str(page) not in UNSTATED]  # fmt: skip
+    assert unstated == []
+
+
 @pytest.mark.parametrize("name", ["node.json", "proc.pluto", "system.json", "turn.plt"])
 def test_sample_files_are_shipped(name):
     assert (ROOT / "examples" / name).is_file()

@@ -101,6 +101,8 @@ EQUIVALENT = {
     "coefficient) and the search reads only the first deg + 1 logs",
     ("cfdp/receiver.py", 48, "NumberReplacer"): "called only with more gaps than max_gaps (at "
     "least 2), so the loop always runs and sets best",
+    ("cfdp/receiver.py", 151, "ReplaceComparisonOperator_GtE_Gt"): "upto is only ever the "
+    "progress, and every gap ends at or below it: no gap starts at it",
     ("cfdp/sender.py", 268, "ReplaceTrueWithFalse"): "Transaction.save ignores force: every "
     "save writes the state",
     ("reconfig/recovery.py", 166, "ReplaceBinaryOperator_Add_Sub"): "while the OBC lines read 0 "

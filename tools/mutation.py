@@ -91,6 +91,10 @@ EQUIVALENT = {
     "table: the same octets either way",
     ("frames/rs.py", 35, "ReplaceBinaryOperator_Add_Sub"): "exp holds 2N entries: exp[i - N] "
     "is exp[i + N] by negative indexing",
+    ("frames/rs.py", 146, "AddNot"): "the flag only picks slicing or a loop over the same "
+    "indexes to split a block into its interleaved words: the same octets either way",
+    ("frames/rs.py", 155, "AddNot"): "the flag only picks slice assignment or a loop over the "
+    "same indexes to join the words again: the same octets either way",
     ("frames/rs.py", 144, "NumberReplacer"): "interleaving depth 1 then takes the slicing path, "
     "whose one slice block[0::1] is the same octets",
     ("frames/rs.py", 248, "NumberReplacer"): "Berlekamp-Massey keeps the locator's degree at or "

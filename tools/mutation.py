@@ -118,6 +118,15 @@ EQUIVALENT = {
     "OBSW_PURE); where it runs, the Python code after it packs the same octets",
     ("pus/tc.py", 153, "ReplaceComparisonOperator_IsNot_Is"): "the C codec's path (not taken "
     "under OBSW_PURE); where it runs, the Python code after it decodes the same packet",
+    ("pus/tc.py", 134, "NumberReplacer"): "< 1 sends all-zero fields to _check, which passes "
+    "them; < -1 lets -1 through _lax: CPython's struct.pack refuses it and pack names the field "
+    "as _check does; on the unix port (struct.pack truncates) test_pus_boundaries.py kills it",
+    ("pus/tc.py", 135, "NumberReplacer"): ">> 7 sends 128..255 to _check, which passes them; "
+    ">> 9 lets 256 through _lax: CPython's struct.pack refuses it and pack names the field as "
+    "_check does; on the unix port (struct.pack truncates) test_pus_boundaries.py kills it",
+    ("pus/tc.py", 135, "ReplaceOrWithAnd"): "lets a service or subtype of 256 through _lax: "
+    "CPython's struct.pack refuses it and pack names the field as _check does; on the unix port "
+    "(struct.pack truncates) test_pus_boundaries.py kills it",
     ("pus/tc.py", 134, "ReplaceComparisonOperator_Lt_LtE"): "only decides whether _check runs: "
     "with all four fields zero it passes them, so running it too changes nothing",
 }

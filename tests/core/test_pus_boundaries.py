@@ -131,6 +131,17 @@ class TestPackRangeErrorsNameTheField(unittest.TestCase):
         self.assertEqual(self.field(seq_count=0x4000), ("sequence count", 0x4000))
         self.assertEqual(self.field(apid=0x800), ("APID", 0x800))
 
+    def test_a_negative_field_or_an_octet_of_256_is_named(self):
+        for kw, named in (
+            ({"apid": -1}, ("APID", -1)),
+            ({"seq_count": -1}, ("sequence count", -1)),
+            ({"seq_flags": -1}, ("sequence flags", -1)),
+            ({"ack": -1}, ("acknowledgement flags", -1)),
+            ({"service": 256}, ("service type", 256)),
+            ({"subtype": 256}, ("message subtype", 256)),
+        ):
+            self.assertEqual(self.field(**kw), named)
+
     def test_sequence_flags_3_are_in_range(self):
         self.assertEqual(self.field(seq_flags=3, ack=16), ("acknowledgement flags", 16))
         self.assertEqual(self.field(seq_flags=4), ("sequence flags", 4))

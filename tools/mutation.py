@@ -5,6 +5,7 @@ notice (it survives) marks a behaviour nothing pins.
 
     python tools/mutation.py [MODULE...] [--sample N] [--seed S] [--jobs J] [--write] [--json]
     python tools/mutation.py --results FILE [--sample N] [--write]
+    python tools/mutation.py [MODULE...] --draw N [--seed S]
 
 MODULE is a name of TARGETS (default: all). The mutants are those a programmer makes: a
 comparison turned into its neighbour (< and <=, == and !=, in and not in), a constant off by
@@ -15,11 +16,15 @@ its tests run on CPython with pytest under OBSW_PURE=1 (the Python paths the boa
 the C codec that takes over some of them on CPython); a mutant that makes them fail or hang is
 killed.
 
-`--sample N` takes N mutants of each module, chosen by `--seed` (the `mutation` stage of
-tools/test runs a sample); the whole run (every mutant of every module: hours on two cores) is a
-job run by hand, `--write` then writes docs/mutation.md. Survivors that cannot be killed (the
-mutant does what the original does) are listed in EQUIVALENT with the reason. The last line is
-`N passed, N failed`: a module passes with at least GOAL of its other mutants killed and every
+`--sample N` takes N mutants of each module, chosen by `--seed`. `--draw N` (the `mutation`
+stage of tools/test) draws N mutants across the modules, a module at a time in an order the seed
+gives (printed; a fresh one unless `--seed` is given), and runs each against its module's
+tests: its line says killed, equivalent (listed in EQUIVALENT: not run) or survived, and
+`N passed, N failed` counts a survivor as a failure. The whole run (every mutant of every
+module: hours on two cores) is a job run by hand, `--write` then writes docs/mutation.md.
+Survivors that cannot be killed (the mutant does what the original does) are listed in
+EQUIVALENT with the reason. Without `--draw` the last line is `N passed, N failed` of the
+modules: a module passes with at least GOAL of its other mutants killed and every
 survivor explained. `--json` prints the results; `--results FILE` reads them back from such a
 run's output instead of running (to write the page again once survivors are explained).
 """
@@ -79,12 +84,17 @@ OPERATORS = {
     "ReplaceOrWithAnd", "ZeroIterationForLoop", "ReplaceBreakWithContinue", "ExceptionReplacer",
 }  # fmt: skip
 
-# (module, line, operator) -> why the mutant cannot be told from the original
+# (module, line, operator) -> why the mutant cannot be told from the original (lines move with
+# the code: tests/host/test_mutation_tool.py checks that each entry names a mutant there is)
 EQUIVALENT = {
     ("frames/rs.py", 61, "AddNot"): "the flag only picks bytes.translate or a loop over the same "
     "table: the same octets either way",
     ("frames/rs.py", 35, "ReplaceBinaryOperator_Add_Sub"): "exp holds 2N entries: exp[i - N] "
     "is exp[i + N] by negative indexing",
+    ("frames/rs.py", 146, "AddNot"): "the flag only picks slicing or a loop over the same "
+    "indexes to split a block into its interleaved words: the same octets either way",
+    ("frames/rs.py", 155, "AddNot"): "the flag only picks slice assignment or a loop over the "
+    "same indexes to join the words again: the same octets either way",
     ("frames/rs.py", 144, "NumberReplacer"): "interleaving depth 1 then takes the slicing path, "
     "whose one slice block[0::1] is the same octets",
     ("frames/rs.py", 248, "NumberReplacer"): "Berlekamp-Massey keeps the locator's degree at or "
@@ -95,6 +105,8 @@ EQUIVALENT = {
     "coefficient) and the search reads only the first deg + 1 logs",
     ("cfdp/receiver.py", 48, "NumberReplacer"): "called only with more gaps than max_gaps (at "
     "least 2), so the loop always runs and sets best",
+    ("cfdp/receiver.py", 151, "ReplaceComparisonOperator_GtE_Gt"): "upto is only ever the "
+    "progress, and every gap ends at or below it: no gap starts at it",
     ("cfdp/sender.py", 268, "ReplaceTrueWithFalse"): "Transaction.save ignores force: every "
     "save writes the state",
     ("reconfig/recovery.py", 166, "ReplaceBinaryOperator_Add_Sub"): "while the OBC lines read 0 "
@@ -102,9 +114,20 @@ EQUIVALENT = {
     "afresh",
     ("frames/fop.py", 401, "NumberReplacer"): "Look for Directive runs only in state S5 "
     "(Initializing with BC frame), where the sent queue holds the one BC frame: first is last",
-    ("pus/tc.py", 87, "ReplaceComparisonOperator_IsNot_Is"): "the C codec's path (not taken under "
+    ("pus/tc.py", 74, "ReplaceComparisonOperator_IsNot_Is"): "the C codec's path (not taken under "
     "OBSW_PURE); where it runs, the Python code after it packs the same octets",
-    ("pus/tc.py", 154, "ReplaceComparisonOperator_Lt_LtE"): "only decides whether _check runs: "
+    ("pus/tc.py", 153, "ReplaceComparisonOperator_IsNot_Is"): "the C codec's path (not taken "
+    "under OBSW_PURE); where it runs, the Python code after it decodes the same packet",
+    ("pus/tc.py", 134, "NumberReplacer"): "< 1 sends all-zero fields to _check, which passes "
+    "them; < -1 lets -1 through _lax: CPython's struct.pack refuses it and pack names the field "
+    "as _check does; on the unix port (struct.pack truncates) test_pus_boundaries.py kills it",
+    ("pus/tc.py", 135, "NumberReplacer"): ">> 7 sends 128..255 to _check, which passes them; "
+    ">> 9 lets 256 through _lax: CPython's struct.pack refuses it and pack names the field as "
+    "_check does; on the unix port (struct.pack truncates) test_pus_boundaries.py kills it",
+    ("pus/tc.py", 135, "ReplaceOrWithAnd"): "lets a service or subtype of 256 through _lax: "
+    "CPython's struct.pack refuses it and pack names the field as _check does; on the unix port "
+    "(struct.pack truncates) test_pus_boundaries.py kills it",
+    ("pus/tc.py", 134, "ReplaceComparisonOperator_Lt_LtE"): "only decides whether _check runs: "
     "with all four fields zero it passes them, so running it too changes nothing",
 }
 
@@ -155,6 +178,88 @@ def run_module(module, sample, seed):
         if r.returncode:
             raise RuntimeError("cosmic-ray exec: %s" % r.stderr.strip()[-500:])
         return results(session, module, kept, time.monotonic() - t0)
+
+
+def mutants(work, modules):
+    """Every kept mutant (OPERATORS) of ``modules`` in the tree copied to ``work``: a list of
+    (module, line, operator, occurrence), in the order of the files."""
+    config = os.path.join(work, "all.toml")
+    paths = ", ".join('"micropython/obsw/%s"' % m for m in modules)
+    with open(config, "w") as f:
+        f.write('[cosmic-ray]\nmodule-path = [%s]\ntimeout = %s\nexcluded-modules = []\n'
+                'test-command = "true"\n[cosmic-ray.distributor]\nname = "local"\n'
+                % (paths, TIMEOUT))  # fmt: skip
+    session = os.path.join(work, "all.sqlite")
+    r = cosmic(["init", config, session], work)
+    if r.returncode:
+        raise RuntimeError("cosmic-ray init: %s" % r.stderr.strip()[-500:])
+    db = sqlite3.connect(session)
+    rows = db.execute(
+        "select module_path, start_pos_row, start_pos_col, operator_name, occurrence "
+        "from mutation_specs"
+    ).fetchall()
+    db.close()
+    found = []
+    for path, row, col, op, occurrence in sorted(rows):
+        op = op.split("/", 1)[-1]
+        if op in OPERATORS:
+            module = os.path.relpath(os.path.join(work, path), os.path.join(work, "micropython",
+                                                                           "obsw"))  # fmt: skip
+            found.append((module, row, col, op, occurrence))
+    return [(m, row, op, occ) for m, row, _, op, occ in found]
+
+
+def draw(modules, n, seed):
+    """``n`` mutants drawn across ``modules`` with ``seed``, each run against its module's
+    tests: a module at a time in a seeded order, a mutant of it at random. Prints a line for
+    each; True for each that the tests killed (or that EQUIVALENT explains)."""
+    rng = random.Random(seed)
+    with tempfile.TemporaryDirectory(prefix="obsw-mutation-") as work:
+        copy_tree(work)
+        pool = {}
+        for m, line, op, occ in mutants(work, modules):
+            pool.setdefault(m, []).append((line, op, occ))
+        order = [m for m in modules if pool.get(m)]
+        rng.shuffle(order)
+        chosen = []
+        while len(chosen) < n and any(pool.get(m) for m in order):
+            for m in order:
+                if pool.get(m) and len(chosen) < n:
+                    chosen.append((m,) + pool[m].pop(rng.randrange(len(pool[m]))))
+        return [check(work, *c) for c in chosen]
+
+
+def check(work, module, line, op, occurrence):
+    """One mutant run against its module's tests in ``work``; printed; True if killed or
+    equivalent."""
+    why = EQUIVALENT.get((module, line, op))
+    if why:
+        print("ok   %-22s line %4d %-36s equivalent" % (module, line, op))
+        return True
+    path = os.path.join("micropython", "obsw", module)
+    shutil.copy2(os.path.join(ROOT, path), os.path.join(work, path))  # the original again
+    tests = set()
+    for pattern in TARGETS[module]:
+        tests.update(glob.glob(os.path.join(work, "tests", "core", pattern)))
+    command = "%s -m pytest -x -q -p no:cacheprovider %s" % (
+        sys.executable, " ".join(os.path.relpath(t, work) for t in sorted(tests)))  # fmt: skip
+    tool = os.path.join(os.path.dirname(sys.executable), "cosmic-ray")
+    env = dict(os.environ, OBSW_PURE="1")
+    try:
+        r = subprocess.run([tool, "mutate-and-test", path, "core/" + op, str(occurrence),
+                            command], cwd=work, capture_output=True, text=True, env=env,
+                           timeout=TIMEOUT)  # fmt: skip
+        result = json.loads(r.stdout)
+        outcome = (result.get("test_outcome") or "").lower()
+        if (result.get("worker_outcome") or "").lower() != "normal":
+            outcome = "could not run: %s" % result.get("worker_outcome")
+    except subprocess.TimeoutExpired:
+        outcome = "killed"  # the tests hung
+    except ValueError:
+        outcome = "could not run: %s" % (r.stderr.strip()[-300:] or r.stdout[-300:])
+    ok = outcome in ("killed", "incompetent")  # incompetent: not valid Python, no mutant
+    print("%-4s %-22s line %4d %-36s %s" % ("ok" if ok else "FAIL", module, line, op, outcome))
+    return ok
 
 
 def choose(session, sample, seed):
@@ -288,7 +393,11 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("modules", nargs="*", metavar="MODULE", help="of: " + ", ".join(TARGETS))
     ap.add_argument("--sample", type=int, default=0, help="mutants per module (0: all)")
-    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--seed", type=int, help="of the sample or draw (default: 1 for --sample, "
+                    "a fresh one, printed, for --draw)")  # fmt: skip
+    ap.add_argument("--draw", type=int, metavar="N",
+                    help="N mutants drawn across the modules, each run against its module's "
+                    "tests: passed if killed or equivalent")  # fmt: skip
     ap.add_argument("--jobs", type=int, default=2, help="modules mutated at once")
     ap.add_argument("--write", action="store_true", help="write docs/mutation.md")
     ap.add_argument("--json", action="store_true", help="print the results as JSON")
@@ -304,6 +413,19 @@ def main(argv=None):
         print("0 passed, 1 failed")
         return 1
     modules = args.modules or list(TARGETS)
+    if args.draw:
+        seed = args.seed if args.seed is not None else random.SystemRandom().randrange(10**6)
+        print("%d mutants drawn from %d modules, seed %d (again: --draw %d --seed %d)"
+              % (args.draw, len(modules), seed, args.draw, seed))  # fmt: skip
+        try:
+            oks = draw(modules, args.draw, seed)
+        except RuntimeError as e:  # the modules could not be read for mutants
+            print("FAIL %s" % e)
+            oks = [False]
+        print("%d passed, %d failed" % (sum(oks), len(oks) - sum(oks)))
+        return 0 if all(oks) else 1
+    if args.seed is None:
+        args.seed = 1
     done, passed, failed = [], 0, 0
     if args.results:
         done = [explained(r) for r in saved(args.results) if r["module"] in modules]

@@ -1,5 +1,6 @@
 """CFDP edges: the retransmission list's merge, the large file flag at 4 GiB, NAKs clipped to
-what was sent, a prompted NAK that covers the tail gap, and Prompts a receiver must ignore."""
+what was sent, a NAKed gap sent again exactly, a prompted NAK that covers the tail gap, and
+Prompts a receiver must ignore."""
 
 import unittest
 
@@ -31,6 +32,12 @@ def file_offset(pdu):
         return None
     at = 4 + 2 * (((pdu[3] >> 4) & 7) + 1) + (pdu[3] & 7) + 1  # past the fixed header
     return int.from_bytes(pdu[at : at + 4], "big")
+
+
+def file_data_length(pdu):
+    """The octets of file data a raw file data PDU carries (small file, no segment metadata)."""
+    crc = 2 if pdu[0] & 0x02 else 0
+    return int.from_bytes(pdu[1:3], "big") - 4 - crc
 
 
 class SizedFilestore(MemoryFilestore):
@@ -94,6 +101,19 @@ class TestNakClippedToProgress(unittest.TestCase):
         self.assertEqual((tx.state_, tx.progress), (SENDING, 128))
         tx.on_pdu(NakPdu(tx.directive_header(), 0, len(DATA), [(0, len(DATA))]), 1)
         self.assertEqual(tx.resend, [[0, 128]])
+
+
+class TestResendOfAGap(unittest.TestCase):
+    def test_a_nakked_gap_is_sent_again_to_its_last_octet_and_no_further(self):
+        a, _ = make_pair(files_a={"src.bin": DATA}, mode=ACKNOWLEDGED)
+        tid = a.put(2, "src.bin", "dst.bin")
+        a.transmit(0, 3)  # metadata and the first two segments (128 octets)
+        tx = a.find(tid)
+        tx.on_pdu(NakPdu(tx.directive_header(), 0, 128, [(100, 110)]), 1)
+        self.assertEqual(tx.resend, [[100, 110]])
+        (pdu,) = [pdu for _dest, pdu in a.transmit(2, 1)]
+        self.assertEqual((file_offset(pdu), file_data_length(pdu)), (100, 10))
+        self.assertEqual(tx.resend, [])
 
 
 def deliver(src, dst, now, keep=lambda pdu: True):

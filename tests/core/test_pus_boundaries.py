@@ -15,22 +15,7 @@ from obsw.pus.packets import (
 from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm
 from obsw.spp import FieldRangeError
-
-
-def _crc(data):
-    # CRC-16/CCITT-FALSE from its definition (polynomial 0x1021, preset all ones)
-    reg = 0xFFFF
-    for byte in data:
-        reg ^= byte << 8
-        for _ in range(8):
-            reg = ((reg << 1) ^ 0x1021) & 0xFFFF if reg & 0x8000 else (reg << 1) & 0xFFFF
-    return reg
-
-
-def _resealed(body):
-    """``body`` (a packet without its PEC) with a valid PEC appended."""
-    c = _crc(body)
-    return bytes(body) + bytes((c >> 8, c & 0xFF))
+from pus_sealed import resealed
 
 
 class TestAllOnesFields(unittest.TestCase):
@@ -73,14 +58,14 @@ class TestLengthField(unittest.TestCase):
         dlen = raw[4] << 8 | raw[5]
         raw[4:6] = bytes(((dlen + 1) >> 8, (dlen + 1) & 0xFF))
         with self.assertRaises(PusLengthError):
-            PusTc.unpack(_resealed(raw[:-2]))
+            PusTc.unpack(resealed(raw[:-2]))
 
     def test_length_field_one_below_the_packet(self):
         raw = bytearray(PusTc(0x10, 17, 1, b"abcd").pack())
         dlen = raw[4] << 8 | raw[5]
         raw[4:6] = bytes(((dlen - 1) >> 8, (dlen - 1) & 0xFF))
         with self.assertRaises(PusLengthError):
-            PusTc.unpack(_resealed(raw[:-2]))
+            PusTc.unpack(resealed(raw[:-2]))
 
     def test_length_field_exact(self):
         self.assertEqual(PusTc.unpack(PusTc(0x10, 17, 1, b"abcd").pack()).data, b"abcd")
@@ -118,7 +103,7 @@ class TestHeaderErrorsNameTheValue(unittest.TestCase):
         raw = bytearray(PusTc(0x10, 17, 1, b"").pack())
         raw[0] &= ~0x08
         with self.assertRaises(PusHeaderError) as cm:
-            PusTc.unpack(_resealed(raw[:-2]))
+            PusTc.unpack(resealed(raw[:-2]))
         e = cm.exception
         self.assertEqual((e.field, e.expected, e.actual), ("secondary header flag", 1, 0))
 
@@ -145,6 +130,17 @@ class TestPackRangeErrorsNameTheField(unittest.TestCase):
     def test_zero_fields_pass_and_the_wrong_one_is_named(self):
         self.assertEqual(self.field(seq_count=0x4000), ("sequence count", 0x4000))
         self.assertEqual(self.field(apid=0x800), ("APID", 0x800))
+
+    def test_a_negative_field_or_an_octet_of_256_is_named(self):
+        for kw, named in (
+            ({"apid": -1}, ("APID", -1)),
+            ({"seq_count": -1}, ("sequence count", -1)),
+            ({"seq_flags": -1}, ("sequence flags", -1)),
+            ({"ack": -1}, ("acknowledgement flags", -1)),
+            ({"service": 256}, ("service type", 256)),
+            ({"subtype": 256}, ("message subtype", 256)),
+        ):
+            self.assertEqual(self.field(**kw), named)
 
     def test_sequence_flags_3_are_in_range(self):
         self.assertEqual(self.field(seq_flags=3, ack=16), ("acknowledgement flags", 16))

@@ -1,13 +1,16 @@
 """Update package edges: version order (numbers, not text; a suffix before the release), the
-rollback floor and the signed downgrade, a manifest with one of files/tree wrong, and files
-handed out in chunks of at most 1 KiB."""
+rollback floor and the signed downgrade, a manifest with one of files/tree wrong, a manifest of
+1 MiB read and one octet more refused, and files handed out in chunks of at most 1 KiB."""
 
 import io
+import struct
 import unittest
 
 from obsw.update.package import (
+    MAGIC,
     BadManifest,
     BadPath,
+    BadSignature,
     Reader,
     Rollback,
     canonical,
@@ -69,6 +72,17 @@ class TestManifestShape(unittest.TestCase):
             m[key] = value
             with self.assertRaises(BadManifest):
                 check_manifest(m)
+
+
+class TestManifestLength(unittest.TestCase):
+    def test_a_manifest_of_one_mib_at_most(self):
+        limit = 1 << 20
+        for n, error in ((limit, BadSignature), (limit + 1, BadManifest)):  # read, or refused
+            data = MAGIC + struct.pack(">I", n) + bytes(n) + bytes(64)
+            with self.assertRaises(error) as cm:
+                Reader(io.BytesIO(data), verify, KEY, "sat-1", "obc")
+            self.assertIs(type(cm.exception), error)
+        self.assertIn("manifest of 1048577 bytes: more than 1048576", str(cm.exception))
 
 
 class TestChunks(unittest.TestCase):

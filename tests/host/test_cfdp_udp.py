@@ -2,13 +2,12 @@
 transferred, and a receiving process killed mid-transfer and started again."""
 
 import os
-import signal
-import socket
 import subprocess
 import sys
 import time
 
 import pytest
+from mission_ports import free_port, stop
 from obsw.cfdp.defs import NO_ERROR
 from obsw_host.cfdp.filestore import RootedFilestore
 from obsw_host.cfdp.link import UdpEntity, make_entity
@@ -19,14 +18,6 @@ ENV = dict(
     os.environ,
     PYTHONPATH=os.pathsep.join([os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]),
 )
-
-
-def free_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def serve(root, port, peer_port):
@@ -53,13 +44,6 @@ def serve(root, port, peer_port):
     assert "cfdp entity 2" in line
     proc.first_line = line
     return proc
-
-
-def stop(proc):
-    if proc.poll() is None:
-        proc.send_signal(signal.SIGKILL)
-    proc.wait(10)
-    proc.stdout.close()
 
 
 def test_put_and_get_between_two_processes(tmp_path):
@@ -111,7 +95,7 @@ def test_put_and_get_between_two_processes(tmp_path):
         assert get.returncode == 0, get.stdout + get.stderr
         assert (gnd / "down.bin").read_bytes() == data
     finally:
-        stop(proc)
+        stop(proc, grace=0)
 
 
 @pytest.mark.parametrize("kill_at", [400000])
@@ -142,7 +126,7 @@ def test_receiver_killed_mid_transfer_completes_after_restart(tmp_path, kill_at)
             if not restarted:
                 parts = list(part_dir.glob("rx-*.part")) if part_dir.exists() else []
                 if parts and parts[0].stat().st_size > kill_at:
-                    stop(proc)
+                    stop(proc, grace=0)
                     proc = serve(root, onboard_port, ground_port)
                     # the new process picked the transaction up from its persisted state
                     assert "1 transaction(s) restored" in proc.first_line
@@ -152,4 +136,4 @@ def test_receiver_killed_mid_transfer_completes_after_restart(tmp_path, kill_at)
         assert (root / "big.bin").read_bytes() == data
     finally:
         udp.close()
-        stop(proc)
+        stop(proc, grace=0)

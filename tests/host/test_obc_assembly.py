@@ -9,6 +9,7 @@ import socket
 import time
 
 import pytest
+from mission_ports import free_port
 from obsw.pus import sdb as sdb_module
 from obsw.pus.services.s02_device_access import DeviceUser
 from obsw.pus.tm import PusTm
@@ -28,14 +29,6 @@ def wait_for(predicate, timeout=WAIT, step=0.02):
             return v
         time.sleep(step)
     return predicate()
-
-
-def free_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def sample():

@@ -85,20 +85,28 @@ def test_context_and_time_across_a_restart(cables, tmp_path):
     for _ in range(5):
         app.sequence.next(42)
     assert link.save() == 2  # both controllers keep it
+    assert said[-1] == "module link: context kept by 2 of 2 controllers"
+    link.save()
+    assert (
+        said[-1] == "module link: context kept by 2 of 2 controllers"
+    )  # logged once, not per save
+    assert said.count(said[-1]) == 1
     link.close()
 
     said = []
     link, app, clock = start(cables, tmp_path, said)  # the OBC starts again
     ctx = link.restore()
     assert app.sequence.peek(42) == 5  # its TM counts go on
-    assert ctx.boots == 2 and ctx.saves == 1
+    assert ctx.boots == 2 and ctx.saves == 2
     assert any(s.startswith("module link: context restored") for s in said)
     link.close()
 
 
 def test_one_silent_controller_costs_only_its_timeout(cables, tmp_path):
     cables[0].silent = True  # in reset, or its UART cut
-    link, app, clock = start(cables, tmp_path, [])
+    said = []
+    link, app, clock = start(cables, tmp_path, said)
     link.restore(timeout=0.3)
     assert link.save(timeout=0.3) == 1
+    assert said[-1] == "module link: context kept by 1 of 2 controllers"
     link.close()

@@ -8,12 +8,12 @@ import json
 import logging
 import os
 import random
-import socket
 import sys
 import tracemalloc
 from pathlib import Path
 
 import pytest
+from mission_ports import free_port
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
 
@@ -94,14 +94,6 @@ def check(types, sent, counters, grown):
     ended = counters["failed"] + counters["dropped"] + counters.get("completed", 0)
     assert ended == sent + pings, counters
     assert grown < 256 * 1024, grown
-
-
-def free_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def test_flood_into_the_obc_core_process(tmp_path):

@@ -15,7 +15,8 @@ between) holds the output of its lines in order, as a terminal shows it (standar
 error; a server's output, lines skipped here and ``export`` lines print nothing). The test
 compares it line by line, trailing spaces aside. What varies from run to run (times, process
 ids, ports, paths) is written ``...``: within a line it stands for any text, and a line that
-is only ``...`` for any number of lines, none included.
+is only ``...`` for any number of lines, none included. An output block that reads
+``(prints nothing)`` says the block prints nothing at all.
 """
 
 import json
@@ -51,6 +52,7 @@ SKIP = {  # a piece of the line -> why it does not run here
     "can0": "needs CAN hardware (the Raspberry Pi's can0, can1)",
     "tests/fuzz/run.py --inputs 1000000": "the long fuzz run takes hours",
     "mkdocs serve": "serves the site until Ctrl-C (tools/test builds it)",
+    "tools/mutation.py": "the mutation stage of tools/test draws its sample of mutants",
 }
 EXPORT = re.compile(r"^export ([A-Z_][A-Z0-9_]*)=(\S+)$")  # a variable the terminal keeps
 # lines a SKIP piece names that run in seconds and change nothing: they run
@@ -58,8 +60,9 @@ RUN_ANYWAY = ("tools/bench/report.py check", "tools/bootstrap")
 TOP_FOLDER = "# from the top folder"  # a shell block that starts so runs from the top folder
 RAN_AT_LEAST = 100  # examples run over all pages
 # every skip names where it is covered or what it needs; most are the hardware guides' lines
-# (docs/pyboard.md, docs/raspberry-pi.md: root, a Pyboard, CAN interfaces)
-SKIPPED_AT_MOST = 60
+# (docs/pyboard.md, docs/raspberry-pi.md: root, a Pyboard, CAN interfaces), and the mutation
+# sample of docs/testing.md (its own stage)
+SKIPPED_AT_MOST = 61
 
 
 def pages():
@@ -85,9 +88,14 @@ def _line_pattern(line):
     return re.compile(".*".join(re.escape(part) for part in line.split("...")) + r"\Z")
 
 
+NOTHING = "(prints nothing)"  # an output block that says so: the block prints nothing
+
+
 def printed_as_stated(expected, actual):
     """True if ``actual`` (what ran printed) is ``expected`` (a page's output block), where
     ``...`` stands for any text within a line and a line of only ``...`` for any lines."""
+    if expected.strip() == NOTHING:
+        return actual.strip() == ""
     want = expected.strip("\n").splitlines()
     got = [x.rstrip() for x in actual.strip("\n").splitlines()]
     pats = [None if w.strip() == "..." else _line_pattern(w.rstrip()) for w in want]
@@ -176,7 +184,8 @@ class Forks:
             self.proc.stdout.close()
 
 
-READY = {}  # a server's ready line (else: its first); `obsw obc serve`: see Server.is_ready
+# a server's ready line (else: its first); `obsw obc serve`: see Server.is_ready
+READY = {"obsw spacecan master": "served by pid"}
 OBC = "obsw obc serve"
 OBC_PROCESSES = re.compile(r", processes (.*?), state in ")  # its first line names them
 
@@ -401,6 +410,9 @@ def test_stated_output_matching():
     assert not printed_as_stated("a\n", "a\nb\n")  # no line left over unstated
     assert printed_as_stated("x [1.5]  \n", "x [1.5]\n")  # trailing spaces aside; [ literal
     assert printed_as_stated("", "")
+    assert printed_as_stated("(prints nothing)\n", "")
+    assert printed_as_stated("(prints nothing)\n", "\n")
+    assert not printed_as_stated("(prints nothing)\n", "saved\n")
 
 
 def test_examples_are_many_and_every_skip_has_a_reason():
@@ -409,6 +421,22 @@ def test_examples_are_many_and_every_skip_has_a_reason():
     python = sum(kind == "python" for page in pages() for kind, _ in blocks(page))
     assert len(found) - len(skipped) + python >= RAN_AT_LEAST
     assert len(skipped) <= SKIPPED_AT_MOST, skipped
+
+
+# pages with an example that runs here without stating its output, and why
+UNSTATED = {"docs/benchmarks.md": "its report block's other lines run benchmarks (skipped here)"}
+
+
+def runs(kind, body):
+    """True if the block runs here: Python, or a shell block with a line not skipped."""
+    return kind == "python" or any(not why for _, _, why in shell_lines(body))
+
+
+def test_every_example_that_runs_states_what_it_prints():
+    unstated = [(str(page), body.splitlines()[0]) for page in pages()
+                for kind, body, printed in stated(page)
+                if printed is None and runs(kind, body) and str(page) not in UNSTATED]  # fmt: skip
+    assert unstated == []
 
 
 @pytest.mark.parametrize("name", ["node.json", "proc.pluto", "system.json", "turn.plt"])

@@ -5,7 +5,6 @@ in-memory tests (test_cfdp_peer.py) cover the protocol cases on a simulated cloc
 the same transfers survive the real transport. Sockets bind free ports only."""
 
 import os
-import socket
 import subprocess
 import sys
 import threading
@@ -14,9 +13,11 @@ import time
 import pytest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "core"))
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "host"))
 
 from cfdp_peer import PeerEntity  # noqa: E402
 from cfdp_sim import payload  # noqa: E402
+from mission_ports import free_port, stop  # noqa: E402
 from obsw.cfdp.defs import DATA_COMPLETE, NO_ERROR  # noqa: E402
 from obsw.cfdp.filestore import MemoryFilestore  # noqa: E402
 from obsw_host.cfdp.link import UdpEntity, make_entity  # noqa: E402
@@ -160,14 +161,6 @@ class Lines:
         return next((x for x in self.lines if x.startswith(prefix)), None)
 
 
-def free_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
 def peer_alone(peer):
     apid = load_sdb().apid("cfdp")
     return UdpEntity(peer, ("127.0.0.1", 0), {}, apid=apid, pace=False)
@@ -200,9 +193,7 @@ def test_cfdp_py_sender_to_our_serve_process(tmp_path):
         assert int(peer.user.finished[0].condition_code) == NO_ERROR
         assert (root / "dst.bin").read_bytes() == DATA
     finally:
-        proc.kill()
-        proc.wait(10)
-        proc.stdout.close()
+        stop(proc, grace=0)
         udp.close()
 
 
@@ -225,8 +216,5 @@ def test_our_put_process_to_cfdp_py(tmp_path):
         assert dst.read_bytes() == DATA
         assert int(peer.user.finished[0].condition_code) == NO_ERROR
     finally:
-        if proc.poll() is None:
-            proc.kill()
-        proc.wait(10)
-        proc.stdout.close()
+        stop(proc, grace=0)
         udp.close()

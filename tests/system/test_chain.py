@@ -90,6 +90,16 @@ def restored_context(chain):
     return boots, saves, re.search(r"seq=(\{[^}]*\})", text).group(1) != "{}"
 
 
+def in_stride(chain):
+    """The OBC in its stride: since its last start a context save reached the module (its
+    heartbeats flow on the same UARTs), and no TC frame is outstanding."""
+    texts = [text for _, text in chain.sim.log_lines()]
+    starts = [i for i, t in enumerate(texts) if "module link: context restored" in t
+              or "module link: no context kept" in t]  # fmt: skip
+    kept = starts and any("module link: context kept by" in t for t in texts[starts[-1] :])
+    return bool(kept) and chain.station.ground.fop.outstanding == 0
+
+
 def master_proxy(chain):
     from obsw.il.node import Node
     from obsw_host.il.transport import SocketTransport
@@ -197,7 +207,7 @@ def test_twelve_steps_and_faults(mission, tmp_path, capsys):
         # the whole OBC hung (every process stopped): the reconfiguration module misses its
         # SpaceCAN heartbeat and power-cycles it by itself, without any ground TC
         led.ping_until_ok()
-        time.sleep(2.0)  # the OBC in its stride: heartbeats flowing, no TC frame outstanding
+        assert wait_for(lambda: in_stride(chain))
         boots = chain.sim.obc_boots
         t = time.monotonic()
         chain.sim.hang_obc()
@@ -237,7 +247,7 @@ def test_switch_over_to_the_redundant_obc(tmp_path, capsys):
                   ("hung", chain.sim.hang_obc, "switch_over"))  # fmt: skip
         for fault, inject, decision in faults:  # no ground TC: the module acts by itself
             led.ping_until_ok()
-            time.sleep(1.0)  # heartbeats flowing, no TC frame outstanding
+            assert wait_for(lambda: in_stride(chain))
             boots = chain.sim.obc_boots
             t = time.monotonic()
             inject()

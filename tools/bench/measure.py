@@ -5,12 +5,14 @@ to start an obsw process and stop it, and to write a row of the common format.
 """
 
 import os
-import socket
 import statistics
-import subprocess
+import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "tests", "host"))
+
+from mission_ports import free_port, stop  # noqa: E402, F401 (the tests' own, for the benchmarks)
 
 
 def rate(fn, seconds, repeats):
@@ -62,25 +64,3 @@ def child_env():
     """The environment of an obsw process started from the source tree."""
     path = os.pathsep.join([os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")])
     return dict(os.environ, PYTHONPATH=path)
-
-
-def free_port():
-    """A UDP port of 127.0.0.1 that nothing holds now."""
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
-def stop(proc):
-    """End ``proc`` (terminate, then kill after 10 s) and close its output pipe."""
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(10)
-    if proc.stdout is not None:
-        proc.stdout.close()

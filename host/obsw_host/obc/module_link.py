@@ -98,8 +98,11 @@ class ModuleLink:
             states = self.engine.states
             ctx.obcps = [n for n in self.engine.obcps if states.get(n, INACTIVE) != INACTIVE]
         ctx.saves += 1
-        self.kept = self.link.write_context(ctx, timeout)
-        return self.kept
+        kept = self.link.write_context(ctx, timeout)
+        if kept != self.kept:  # the first save that was kept, then each change
+            self.say("module link: context kept by %d of %d controllers" % (kept, len(self.fds)))
+        self.kept = kept
+        return kept
 
     async def run(self, beat, running):
         """Heartbeats every ``beat`` s and a save every ``period`` s while ``running()``."""

@@ -2,7 +2,8 @@
 
 With ``--uart FD,FD`` (the OBC ends of the controllers' OBC UARTs) it first reads its onboard
 time from the DS3231 and its context back from the safeguard memory through the module, then
-sends heartbeats on the UARTs and saves its context every ``--context-period`` seconds.
+sends heartbeats on the UARTs and saves its context every ``--context-period`` seconds (each
+save logged: a test waits for the saves it needs).
 It distributes its time (UTC and SCET frames), then runs the commands given with
 ``--call NODE:FUNCTION:VALUE`` (service 8 with one argument) all at once, prints each result
 and keeps sending heartbeats until it is killed (or powered off through the CPDU).
@@ -110,8 +111,7 @@ def main(argv=None):
                 ctx.saves += 1
                 kept = link.write_context(ctx, timeout=0.5)
                 next_save = time.monotonic() + args.context_period
-                if ctx.saves == 1:
-                    say("context saved (%d controllers)" % kept)
+                say("context saved (save %d, %d controllers)" % (ctx.saves, kept))
             time.sleep(args.heartbeat)
     except KeyboardInterrupt:
         pass

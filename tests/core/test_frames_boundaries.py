@@ -272,6 +272,15 @@ class TestCltuBlockNamed(unittest.TestCase):
             self.assertEqual(cm.exception.block, k)
 
 
+class TestSdlsEventIds(unittest.TestCase):
+    def test_each_rejection_has_its_own_event_in_outcome_order(self):
+        # the default IDs the spacecraft database gives frames.tc_<outcome> (0xFF31 up)
+        self.assertEqual(len(sdls.EVENT_IDS), len(sdls.OUTCOME_NAMES))
+        self.assertEqual(sdls.EVENT_IDS[sdls.OK], 0)  # accepted: no event
+        for outcome in range(1, len(sdls.OUTCOME_NAMES)):
+            self.assertEqual(sdls.EVENT_IDS[outcome], 0xFF30 + outcome)
+
+
 if __name__ == "__main__":
     unittest.main()
 

@@ -15,6 +15,36 @@ class TestDefaults(unittest.TestCase):
         self.assertIsNone(p.poll(29.5, 0x001))
         self.assertEqual(p.poll(30.0, 0x001)[0], R.POWER_CYCLE)
 
+    def three_power_cycles(self):
+        """The defaults' power cycles at 30, 61 and 92 s (boot grace 30 s, 1 s off)."""
+        p = R.Recovery()
+        p.start(0.0)
+        for t in (30.0, 61.0, 92.0):
+            self.assertEqual(p.poll(t, 0x001)[0], R.POWER_CYCLE)
+            p.done(t, True)
+        self.assertEqual(p.failures, [30.0, 61.0, 92.0])
+        return p
+
+    def test_the_window_is_900_s_and_a_failure_that_old_is_forgotten(self):
+        p = self.three_power_cycles()
+        p.heartbeat(R.SOURCE_UART, 920.0)
+        self.assertIsNone(p.poll(929.5, 0x001))  # the deadline is 10 s
+        self.assertEqual(p.poll(930.0, 0x001)[0], R.POWER_CYCLE)  # 930 - 30 = the window
+        self.assertEqual(p.failures, [61.0, 92.0])
+
+    def test_three_failures_within_900_s_switch_over(self):
+        p = self.three_power_cycles()
+        p.heartbeat(R.SOURCE_UART, 919.0)
+        self.assertEqual(p.poll(929.0, 0x001)[0], R.SWITCH_OVER)
+
+    def test_heartbeats_are_kept_per_source(self):
+        p = R.Recovery()
+        p.start(0.0)
+        p.heartbeat(R.SOURCE_UART, 5.0)
+        self.assertEqual(p.last_seen, [None, 5.0])
+        p.heartbeat(R.SOURCE_CAN, 6.0)
+        self.assertEqual(p.last_seen, [6.0, 5.0])
+
 
 class TestWindow(unittest.TestCase):
     def two_failures(self):

@@ -127,6 +127,9 @@ EQUIVALENT = {
     ("pus/tc.py", 135, "ReplaceOrWithAnd"): "lets a service or subtype of 256 through _lax: "
     "CPython's struct.pack refuses it and pack names the field as _check does; on the unix port "
     "(struct.pack truncates) test_pus_boundaries.py kills it",
+    ("pus/tc.py", 165, "ReplaceOrWithAnd"): "only picks the fast path or the careful one: with "
+    "a PEC no packet takes the fast path, without one only those whose CRC comes to 0, and the "
+    "careful path checks and decodes the rest alike",
     ("pus/tc.py", 134, "ReplaceComparisonOperator_Lt_LtE"): "only decides whether _check runs: "
     "with all four fields zero it passes them, so running it too changes nothing",
 }

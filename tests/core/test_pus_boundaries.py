@@ -10,12 +10,13 @@ from obsw.pus.packets import (
     PusHeaderError,
     PusLengthError,
     PusTooShortError,
+    PusVersionError,
     RequestId,
 )
 from obsw.pus.tc import PusTc
 from obsw.pus.tm import PusTm
 from obsw.spp import FieldRangeError
-from pus_sealed import resealed
+from pus_sealed import crc_bitwise, resealed
 
 
 class TestAllOnesFields(unittest.TestCase):
@@ -82,6 +83,25 @@ class TestPec(unittest.TestCase):
                 reg = ((reg << 1) ^ 0x1021) & 0xFFFF if reg & 0x8000 else (reg << 1) & 0xFFFF
         with self.assertRaises(PusCrcError):
             PusTc.unpack(body + bytes((reg >> 8, reg & 0xFF)))
+
+    def test_a_pec_that_leaves_a_remainder_of_one_is_refused(self):
+        # the check over packet and PEC must come to 0; 0x9D71 fed into a cleared register
+        # leaves 1, so the right PEC XOR 0x9D71 leaves a remainder of exactly 1
+        body = PusTc(0x10, 17, 1, b"abcd").pack()[:-2]
+        pec = crc_bitwise(body) ^ 0x9D71
+        with self.assertRaises(PusCrcError):
+            PusTc.unpack(body + bytes((pec >> 8, pec & 0xFF)))
+
+
+class TestPusVersion(unittest.TestCase):
+    def test_only_version_2_is_a_pus_c_tc(self):
+        body = bytearray(PusTc(0x10, 17, 1, b"abcd").pack()[:-2])
+        for version in [v for v in range(16) if v != 2]:
+            for ack in (0, 0xF):
+                body[6] = version << 4 | ack
+                with self.assertRaises(PusVersionError) as cm:
+                    PusTc.unpack(resealed(body))
+                self.assertEqual(cm.exception.version, version)
 
 
 class TestHeaderErrorsNameTheValue(unittest.TestCase):

@@ -219,14 +219,12 @@ class Receiver(Transaction):
         )
         try:
             if pdu.checksum_type != CHECKSUM_NULL:
+                # from offset 0: data that came before the metadata is read back at the end
                 self.ck = FileChecksum(pdu.checksum_type)
         except UnsupportedChecksumError:
             self.ck = None
             if not self.fault(UNSUPPORTED_CHECKSUM_TYPE, now):
                 return
-        if self.ck is not None and self.progress and self.received:
-            # data came before the metadata; the checksum catches up at the end
-            self.ck = FileChecksum(pdu.checksum_type)
         self.save(force=True)
         self._check_done(now)
 

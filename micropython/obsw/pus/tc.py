@@ -160,9 +160,9 @@ class PusTc(PusPacket):
             if (
                 pid & 0xF800 == _TC_ID
                 and dlen + 7 == n
-                and b0 & 0xF0 == 0x20
+                and b0 >> 4 == PUS_VERSION
                 and n <= config.max_packet_size
-                and (not config.pec or _crc(buf, 0xFFFF) == 0)
+                and (not config.pec or not _crc(buf, 0xFFFF))
             ):
                 data = buf[config.tc_data_offset : n - config.pec_size]
                 tc = _new(cls)

@@ -12,7 +12,6 @@ failed' over the checks of the run (exit status 1 if any failed).
 """
 
 import argparse
-import datetime
 import os
 import sys
 import tempfile
@@ -23,41 +22,24 @@ sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
 from obsw_host.mission.check import load  # noqa: E402
 from obsw_host.ops.passes import from_mission  # noqa: E402
-from obsw_host.ops.tle import format_time  # noqa: E402
 from obsw_sim import faketime  # noqa: E402
+from obsw_sim.ditl_checks import checks  # noqa: E402
+from obsw_sim.ditl_checks import utc as _utc  # noqa: E402
 
 MISSION = os.path.join(ROOT, "examples", "sample")
 
 
-def _utc(t):
-    return format_time(datetime.datetime.fromtimestamp(t, datetime.timezone.utc))
-
-
-def checks(day, f, full):
-    """(name, ok, detail) of each check of the run."""
-    out = []
-    if full:
-        out.append(("24 hours, 15 orbits, 4 passes", f["hours"] >= 24 and f["orbits"] >= 15
-                    and f["contacts"] >= 4, "%.1f h, %.1f orbits, %d passes flown" % (
-                        f["hours"], f["orbits"], f["contacts"])))  # fmt: skip
-    else:
-        out.append(("two orbits, two passes", f["orbits"] >= 2 and f["contacts"] >= 2,
-                    "%.1f orbits, %d passes flown" % (f["orbits"], f["contacts"])))  # fmt: skip
-    out.append(("housekeeping delivered exactly once", f["missing"] == 0 and
-                f["duplicates"] == 0 and f["hk_high"] > 0, "%d reports of the high-priority "
-                "structure, %d missing, %d duplicates, %d resends asked" % (
-                    f["hk_high"], f["missing"], f["duplicates"], f["resends"])))  # fmt: skip
-    out.append(("planned commands executed within 1 s", f["executed"] == f["planned"] > 0
-                and f["max_lateness"] <= 1.0, "%d of %d, at most %.3f s from its time" % (
-                    f["executed"], f["planned"], f["max_lateness"])))  # fmt: skip
-    out.append(
-        (
-            "stores never overflow",
-            f["max_backlog"] < f["store_size"],
-            "largest backlog %d octets of %d" % (f["max_backlog"], f["store_size"]),
-        )
-    )
-    return out
+def common(day, f):
+    """The figures in the form of obsw_sim.ditl_checks."""
+    files = {}
+    for name in ("down", "up"):
+        same, count, prog = f["files"][name]
+        files[name] = {"size": f[name + "_size"], "identical": same, "transactions": count,
+                       "progress": prog}  # fmt: skip
+    return dict(f, passes=f["contacts"], hk_due=f["hk_high"], files=files,
+                overflow=f["max_backlog"] >= f["store_size"],
+                store_detail="largest backlog %d octets of %d" % (
+                    f["max_backlog"], f["store_size"]))  # fmt: skip
 
 
 def plot(day, f, path):
@@ -164,6 +146,8 @@ def main(argv=None):
     ap.add_argument("--speed", type=float, help="times faster (default 60, bounded run 100)")
     ap.add_argument("--before", type=float, default=1800.0,
                     help="seconds of orbit before the first pass (default 1800)")  # fmt: skip
+    ap.add_argument("--down", type=int, help="octets of the file down (3 MB; bounded 2 MB)")
+    ap.add_argument("--up", type=int, help="octets of the file up (800 kB; bounded 450 kB)")
     ap.add_argument("--write", action="store_true", help="write docs/ditl-last-run.md, ditl.png")
     ap.add_argument("--work", help="folder for the chain's files (default: a temporary one)")
     args = ap.parse_args(argv)
@@ -182,7 +166,9 @@ def main(argv=None):
     orbit_s = 86400.0 / pred.tle.mean_motion
     seconds = args.orbits * orbit_s if args.orbits else args.hours * 3600
     work = args.work or tempfile.mkdtemp(prefix="obsw-ditl-")
-    day = ChainDay(work, pred, seconds, speed, out=print)
+    down = args.down or (2_000_000 if args.orbits else 3_000_000)
+    up = args.up or (450_000 if args.orbits else 800_000)
+    day = ChainDay(work, pred, seconds, speed, out=print, down_size=down, up_size=up)
     began = time.monotonic()
 
     def progress(t, d):
@@ -192,7 +178,7 @@ def main(argv=None):
 
     f = day.run(progress)
     took = (time.monotonic() - began) / speed  # the monotonic clock runs fast too
-    results = checks(day, f, full=not args.orbits)
+    results = checks(common(day, f), full=not args.orbits)
     for name, ok, detail in results:
         print("%s %s: %s" % ("ok  " if ok else "FAIL", name, detail))
     print("%.1f h of orbit in %.0f s here (%g times)" % (f["hours"], took, speed))

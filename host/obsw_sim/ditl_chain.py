@@ -18,13 +18,28 @@ planned commands, store 2 for the routine housekeeping and the OBC's store backl
 - in a pass the ground archives what comes down, by store and time tag, and every
   ``ack_every`` s and just before LOS acknowledges what it has (``Passes.acknowledge``, after
   the ``passes.dumped`` events: through the last sequence number whose reports all came) or
-  asks again for the rest (``Passes.resend``).
+  asks again for the rest (``Passes.resend``);
+- files go through the frames (``Chain.cfdp_frames``): the ground's CFDP entity (class 2,
+  its own ``PassHold`` driven by the prediction, its file data at most ``up_rate`` octets/s)
+  puts ``up_size`` octets up and asks the OBC by proxy put for ``down_size`` octets; the
+  OBC's entity sends its PDUs into the frame processor's TM input, paced by the radio's rate
+  (the station's downlink rate, ``frames.downlink_bps``), and holds them across passes with
+  the OBC's own ``Passes``.
 
 ``run()`` returns the figures (a dict) and keeps the series for the plots.
 """
 
+import os
+import random
+import select
 import time
 
+from obsw.cfdp import msgs
+from obsw.cfdp.contact import PassHold
+from obsw.cfdp.defs import ACKNOWLEDGED
+from obsw.spp import TYPE_TC
+from obsw_host.cfdp.filestore import RootedFilestore
+from obsw_host.cfdp.link import UdpEntity, make_entity
 from obsw_host.obc.passes import pack_table
 from obsw_host.ops.pass_table import windows
 from obsw_host.ops.plan import plan
@@ -59,7 +74,8 @@ class ChainDay:
     """One run of the whole chain (see the module text)."""
 
     def __init__(self, work, predictor, seconds, speed, out=None, hk_period=10.0,
-                 ack_every=60.0, lead=60.0, lag=30.0):  # fmt: skip
+                 ack_every=60.0, lead=60.0, lag=30.0, down_size=5_000_000,
+                 up_size=1_000_000, up_rate=1000.0, frame_length=1024):  # fmt: skip
         self.work = work
         self.pred = predictor
         self.station = predictor.stations[0]
@@ -73,6 +89,27 @@ class ChainDay:
                            timeout=10.0 * max(1.0, speed / 2.0))  # fmt: skip
         self.chain.sections["contact"] = {"stores": [HIGH, ROUTINE], "hold": 5.0}
         chain_settings(self.chain, speed)
+        # files through the frames, on a radio of the station's downlink rate
+        self.chain.cfdp_frames = True
+        self.chain.tm_frame_length = frame_length
+        self.chain.sections["frames"].update(downlink_bps=self.station.downlink_bps,
+                                             tm_frame_length=frame_length)  # fmt: skip
+        rng = random.Random(7)
+        self.down_data = rng.randbytes(down_size)
+        self.up_data = rng.randbytes(up_size)
+        self.up_rate = up_rate
+        self.onboard_files = os.path.join(self.chain.state, "files")
+        self.ground_files = os.path.join(work, "ground-files")
+        for folder, name, data in ((self.onboard_files, "payload.bin", self.down_data),
+                                   (self.ground_files, "update.bin", self.up_data)):  # fmt: skip
+            os.makedirs(folder, exist_ok=True)
+            with open(os.path.join(folder, name), "wb") as f:
+                f.write(data)
+        self.cfdp = None  # the ground's entity (UdpEntity), once the chain is up
+        self.hold = None
+        self.cfdp_progress = {"down": [], "up": []}  # (time, octets) at each AOS
+        self.cfdp_log = []  # (time, kind, info) of the ground entity's main indications
+        self.transactions = {"down": set(), "up": set()}  # ids seen per file
         self.archive = {HIGH: {}, ROUTINE: {}}  # store -> {key: arrival (onboard s)}
         self.duplicates = 0
         self.dumped = {HIGH: [], ROUTINE: []}  # (first, last, count) of passes.dumped
@@ -87,6 +124,7 @@ class ChainDay:
         self.generated = {HK_HIGH: [], HK_ROUTINE: []}  # time tags seen, to count them
         self.contacts = 0
         self._tx_steps = {}  # request id -> plan step index
+        self.seen = {}  # (service, subtype) -> TM packets the ground decoded
 
     def say(self, text):
         if self.out is not None:
@@ -96,6 +134,8 @@ class ChainDay:
 
     def _tm(self, tm, decoded, tx):
         """Every TM the ground decodes: archive, dump events, plan verification."""
+        k = (tm.service, tm.subtype)
+        self.seen[k] = self.seen.get(k, 0) + 1
         if tm.service == 3 and tm.subtype == 25 and len(tm.data) >= 2:
             sid = tm.data[0] << 8 | tm.data[1]
             store = HIGH if sid == HK_HIGH else ROUTINE if sid == HK_ROUTINE else None
@@ -109,9 +149,11 @@ class ChainDay:
                 v = decoded["values"].get("Passes.backlog")
                 if v is not None:
                     self.backlog.append((_seconds(tm), v))
-        elif tm.service == 1 and tm.subtype == 7 and decoded:
+        elif tm.service == 1 and tm.subtype in (7, 8) and decoded:
             step = self._tx_steps.get(decoded.get("request_id"))
-            if step is not None:
+            if step is not None and tm.subtype == 8:
+                self.say("planned command %d failed: %r" % (step, decoded))
+            elif step is not None:
                 key = ("tc", step)
                 if key in self.archive[HIGH]:
                     self.duplicates += 1
@@ -152,6 +194,7 @@ class ChainDay:
         period = float(chain.config.section("pus").get("period", 0.1))
         ticks = lambda s: max(1, int(round(s / period)))  # noqa: E731
         ok = [
+            g.perform("SolarPanel.deploy").ok,  # the plan turns the panel: deployed first
             g.create_hk(HK_ROUTINE, ticks(self.hk_period * 6),
                         ["Passes.backlog", "Obc.cpu_load", "Obc.restarts"]).ok,
             g.set_hk_interval(HK_HIGH, ticks(self.hk_period)).ok,
@@ -184,6 +227,74 @@ class ChainDay:
             if not tx.ok:
                 raise RuntimeError("plan step %d refused: %s" % (i, tx.verification()))
 
+    def _files(self):
+        """The ground's CFDP entity on the chain's ground port, behind the station; the two
+        transfers asked (they start at the first AOS: the hold keeps them till then). Its
+        segments are 512 octets: a PDU in its space packet fits one signed TC frame."""
+        chain = self.chain
+        onboard, ground = chain.ids.cfdp_entities
+        entity = make_entity(ground, [onboard], RootedFilestore(self.ground_files),
+                             state=os.path.join(self.work, "ground-cfdp"),
+                             segment=512, limit=30, inactivity=600.0)  # fmt: skip
+        self.cfdp = UdpEntity(entity, ("127.0.0.1", chain.cfdp_ground_port),
+                              {onboard: chain.station.address}, apid=chain.ids.apid("cfdp"),
+                              packet_type=TYPE_TC, rate=self.up_rate)  # fmt: skip
+        self.hold = PassHold(entity)
+        now = time.monotonic()
+        self.hold.update(False, now)
+        entity.put(onboard, "update.bin", "update.bin", mode=ACKNOWLEDGED, now=now)
+        entity.put(
+            onboard,
+            mode=ACKNOWLEDGED,
+            now=now,
+            messages=[msgs.proxy_put_request(ground, "payload.bin", "payload.bin")],
+        )
+        self.hold.update(False, now)
+
+    def _cfdp_step(self, in_pass, aos):
+        ent = self.cfdp.entity
+        now = time.monotonic()
+        self.hold.update(in_pass, now)
+        for ind in self.cfdp.step(0):
+            if ind.kind in ("finished", "fault", "abandoned", "suspended", "resumed"):
+                self.cfdp_log.append((time.time(), ind.kind, dict(ind.info)))
+        for t in list(ent.tx.values()):
+            if t.role == "R":
+                name = "down"
+            elif getattr(t, "source_name", None) == "update.bin":
+                name = "up"
+            else:
+                continue  # the proxy put request: options only
+            self.transactions[name].add(tuple(t.tid))
+            if aos:
+                self.cfdp_progress[name].append((time.time(), t.progress_of()))
+
+    def _say_files(self):
+        st = self.chain.station
+        txs = ["%s %s %d%s" % (t.role, getattr(t, "source_name", None) or "-", t.progress_of(),
+                               " suspended" if t.suspended else "")
+               for t in self.cfdp.entity.tx.values()]  # fmt: skip
+        self.say("files at LOS: ground entity sent %d PDUs, received %d; station uplinked %d, "
+                 "refused %d; transactions: %s; TM so far %s" % (self.cfdp.sent,
+                  self.cfdp.received, st.uplinked, st.refused, ", ".join(txs) or "none",
+                  sorted(self.seen.items())))  # fmt: skip
+
+    def file_results(self):
+        """(identical, transactions, octets at each AOS) of each file."""
+        out = {}
+        for name, path, data in (("down", os.path.join(self.ground_files, "payload.bin"),
+                                  self.down_data),
+                                 ("up", os.path.join(self.onboard_files, "update.bin"),
+                                  self.up_data)):  # fmt: skip
+            try:
+                with open(path, "rb") as f:
+                    same = f.read() == data
+            except OSError:
+                same = False
+            out[name] = (same, len(self.transactions[name]),
+                         [p for _, p in self.cfdp_progress[name]])  # fmt: skip
+        return out
+
     # ---------------------------------------------------------------- the day
 
     def in_pass(self, t):
@@ -208,6 +319,7 @@ class ChainDay:
             self.passes = [p for p in self.pred.passes(self.start, self.end, [self.station])
                            if p.aos > self.start + 60.0]  # fmt: skip
             self._uplink()
+            self._files()
             self.say("chain up and set in %.0f s here; %d passes to fly" % (
                 time.monotonic() - began, len(self.passes)))  # fmt: skip
             self._fly(progress)
@@ -226,6 +338,7 @@ class ChainDay:
             if now >= self.end:
                 break
             p = self.in_pass(now)
+            self._cfdp_step(p is not None, p is not None and current is None)
             if p is not None and current is None:  # AOS
                 self._carrier(True)
                 self.contacts += 1
@@ -237,12 +350,14 @@ class ChainDay:
                 current[2] = sum(len(a) for a in self.archive.values()) - current[2]
                 self.pass_use.append(tuple(current))
                 current = None
+                self._say_files()
             # once more within 15 s of LOS, whatever the period
             closing = current is not None and now > current[1] - 15.0 > last_ack
             if current is not None and (now - last_ack >= self.ack_every or closing):
                 last_ack = now
                 self._acknowledge()
-            g.poll(0.05)
+            select.select([g.sock, self.cfdp.sock], [], [], 0.05)
+            g.poll(0)
             if now >= next_sample:
                 next_sample += 60.0
                 self.series["t"].append(now)
@@ -312,6 +427,9 @@ class ChainDay:
             "lateness": lateness,
             "pass_use": self.pass_use,
             "obc_boots": self.chain.sim.obc_boots if self.chain.sim else None,
+            "files": self.file_results(),
+            "down_size": len(self.down_data),
+            "up_size": len(self.up_data),
         }
 
 

@@ -146,8 +146,8 @@ def main(argv=None):
     ap.add_argument("--speed", type=float, help="times faster (default 60, bounded run 100)")
     ap.add_argument("--before", type=float, default=1800.0,
                     help="seconds of orbit before the first pass (default 1800)")  # fmt: skip
-    ap.add_argument("--down", type=int, help="octets of the file down (3 MB; bounded 2 MB)")
-    ap.add_argument("--up", type=int, help="octets of the file up (800 kB; bounded 450 kB)")
+    ap.add_argument("--down", type=int, help="octets of the file down (3 MB; bounded 1.6 MB)")
+    ap.add_argument("--up", type=int, help="octets of the file up (400 kB; bounded 200 kB)")
     ap.add_argument("--write", action="store_true", help="write docs/ditl-last-run.md, ditl.png")
     ap.add_argument("--work", help="folder for the chain's files (default: a temporary one)")
     args = ap.parse_args(argv)
@@ -166,8 +166,8 @@ def main(argv=None):
     orbit_s = 86400.0 / pred.tle.mean_motion
     seconds = args.orbits * orbit_s if args.orbits else args.hours * 3600
     work = args.work or tempfile.mkdtemp(prefix="obsw-ditl-")
-    down = args.down or (2_000_000 if args.orbits else 3_000_000)
-    up = args.up or (450_000 if args.orbits else 800_000)
+    down = args.down or (1_600_000 if args.orbits else 3_000_000)
+    up = args.up or (200_000 if args.orbits else 400_000)
     day = ChainDay(work, pred, seconds, speed, out=print, down_size=down, up_size=up)
     began = time.monotonic()
 

@@ -22,9 +22,9 @@ planned commands, store 2 for the routine housekeeping and the OBC's store backl
 - files go through the frames (``Chain.cfdp_frames``): the ground's CFDP entity (class 2,
   its own ``PassHold`` driven by the prediction, its file data at most ``up_rate`` octets/s)
   puts ``up_size`` octets up and asks the OBC by proxy put for ``down_size`` octets; the
-  OBC's entity sends its PDUs into the frame processor's TM input, paced by the radio's rate
-  (the station's downlink rate, ``frames.downlink_bps``), and holds them across passes with
-  the OBC's own ``Passes``.
+  OBC's entity sends its PDUs into the frame processor's TM input at the rate of the stores'
+  dump (``share`` of the station's downlink rate, ``contact.downlink_bps``) and holds them
+  across passes with the OBC's own ``Passes``.
 
 ``run()`` returns the figures (a dict) and keeps the series for the plots.
 """
@@ -74,8 +74,8 @@ class ChainDay:
     """One run of the whole chain (see the module text)."""
 
     def __init__(self, work, predictor, seconds, speed, out=None, hk_period=10.0,
-                 ack_every=60.0, lead=60.0, lag=30.0, down_size=5_000_000,
-                 up_size=1_000_000, up_rate=1000.0, frame_length=1024):  # fmt: skip
+                 ack_every=60.0, lead=60.0, lag=30.0, down_size=3_000_000,
+                 up_size=400_000, up_rate=400.0, frame_length=1024):  # fmt: skip
         self.work = work
         self.pred = predictor
         self.station = predictor.stations[0]
@@ -89,11 +89,13 @@ class ChainDay:
                            timeout=10.0 * max(1.0, speed / 2.0))  # fmt: skip
         self.chain.sections["contact"] = {"stores": [HIGH, ROUTINE], "hold": 5.0}
         chain_settings(self.chain, speed)
-        # files through the frames, on a radio of the station's downlink rate
+        # files through the frames; the OBC paces its dump and its file data at a share of the
+        # station's downlink rate (contact.downlink_bps; the frame processor does not pace:
+        # a radio paced in accelerated time needs a wake-up per frame)
         self.chain.cfdp_frames = True
         self.chain.tm_frame_length = frame_length
-        self.chain.sections["frames"].update(downlink_bps=self.station.downlink_bps,
-                                             tm_frame_length=frame_length)  # fmt: skip
+        self.chain.sections["frames"].update(tm_frame_length=frame_length)
+        self.chain.sections["contact"]["downlink_bps"] = self.station.downlink_bps
         rng = random.Random(7)
         self.down_data = rng.randbytes(down_size)
         self.up_data = rng.randbytes(up_size)
@@ -116,6 +118,7 @@ class ChainDay:
         self.acked = {HIGH: 0, ROUTINE: 0}
         self.resends = 0
         self._asked = {}
+        self._resent = {}  # store -> asked again since its last acknowledgement
         self.backlog = []  # (onboard s, octets) from store 2's reports
         self.executed = {}  # planned step index -> onboard time of its TM[1,7]
         self.plan = []
@@ -141,23 +144,21 @@ class ChainDay:
             store = HIGH if sid == HK_HIGH else ROUTINE if sid == HK_ROUTINE else None
             if store is None:
                 return
-            key = ("hk", sid, tm.time)
-            if key in self.archive[store]:
-                self.duplicates += 1
-            self.archive[store][key] = self.onboard()
+            self._archive(store, ("hk", sid, tm.time))
             if sid == HK_ROUTINE and decoded and "values" in decoded:
                 v = decoded["values"].get("Passes.backlog")
                 if v is not None:
                     self.backlog.append((_seconds(tm), v))
         elif tm.service == 1 and tm.subtype in (7, 8) and decoded:
-            step = self._tx_steps.get(decoded.get("request_id"))
+            rid = decoded.get("request_id")
+            if rid is None:
+                return
+            # store 1 keeps every completion report: each counted, whoever asked
+            self._archive(HIGH, ("v", tm.subtype, tm.time, hash(rid)))
+            step = self._tx_steps.get(rid)
             if step is not None and tm.subtype == 8:
                 self.say("planned command %d failed: %r" % (step, decoded))
             elif step is not None:
-                key = ("tc", step)
-                if key in self.archive[HIGH]:
-                    self.duplicates += 1
-                self.archive[HIGH][key] = self.onboard()
                 self.executed[step] = _seconds(tm)
         elif tm.service == 5 and len(tm.data) >= 2:
             eid = tm.data[0] << 8 | tm.data[1]
@@ -165,6 +166,13 @@ class ChainDay:
                 d = self._dumped.unpack(tm.data[2:])
                 if d["store"] in self.dumped:
                     self.dumped[d["store"]].append((d["first"], d["last"], d["count"]))
+
+    def _archive(self, store, key):
+        """One report into the ground's archive; one already there is a duplicate unless the
+        ground asked for the store's reports again since its last acknowledgement."""
+        if key in self.archive[store] and not self._resent.get(store):
+            self.duplicates += 1
+        self.archive[store][key] = self.onboard()
 
     def onboard(self):
         return time.time() + TAI_MINUS_UNIX
@@ -258,6 +266,8 @@ class ChainDay:
         for ind in self.cfdp.step(0):
             if ind.kind in ("finished", "fault", "abandoned", "suspended", "resumed"):
                 self.cfdp_log.append((time.time(), ind.kind, dict(ind.info)))
+            if ind.kind in ("finished", "fault", "abandoned"):
+                self.say("file transfer %s: %r" % (ind.kind, dict(ind.info)))
         for t in list(ent.tx.values()):
             if t.role == "R":
                 name = "down"
@@ -311,6 +321,8 @@ class ChainDay:
         chain = self.chain
         began = time.monotonic()
         chain.start()
+        # the two links' copies of a frame, paired however far apart a busy machine reads them
+        chain.station.ground.dedup.window = 5.0 * max(1.0, self.speed / 2.0)
         try:
             self._wait_up()
             self._setup()
@@ -385,10 +397,12 @@ class ChainDay:
                         tx = g.perform("Passes.acknowledge", store=store, seq=last, timeout=10.0)
                         if tx.ok:
                             self.acked[store] = last
+                            self._resent[store] = False
                 elif not self._asked.get(store):
                     g.perform("Passes.resend", store=store, first=self.acked[store] + 1,
                               last=last, timeout=10.0)  # fmt: skip
                     self._asked[store] = True
+                    self._resent[store] = True
                     self.resends += 1
                 else:
                     self._asked[store] = False  # asked last round: ask again next round

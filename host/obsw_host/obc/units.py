@@ -225,7 +225,8 @@ class PusUnit:
 
     def _passes(self, topology):
         """Contact awareness (``obsw_host.obc.passes``): the pass table, the stores' dump,
-        CFDP held across passes."""
+        CFDP held across passes and its file data at the dump's rate (``share`` of the
+        downlink rate: a sender paced by losses would flood the radio's queue first)."""
         from obsw_host.frames.coding import LinkSettings
 
         opts = topology.section("contact")
@@ -244,6 +245,9 @@ class PusUnit:
         )
         if passes.enabled:
             self.app.tm_filters.append(passes.realtime)
+            if self.cfdp is not None:  # files share the passes' radio: paced to the dump's rate
+                self.cfdp.rate = passes.cycle_octets
+                self.cfdp.pace = False
         self.onboard.tc_listeners.append(passes.heard)
         return passes
 

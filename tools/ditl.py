@@ -73,10 +73,12 @@ def plot(day, f, path):
     ax[2].set_xticklabels(["pass %d" % (i + 1) for i in n])
     ax[2].set_ylabel("packets down")
     ax[2].set_title("link use per pass")
+    ax[3].plot([h(t) for t in day.series["t"]], day.series["generated"],
+               label="generated on board")  # fmt: skip
     ax[3].plot([h(t) for t in day.series["t"]], day.series["delivered"],
                label="delivered to the ground")  # fmt: skip
     ax[3].set_ylabel("reports")
-    ax[3].set_title("data delivered (generated: one report every %g s on board)" % day.hk_period)
+    ax[3].set_title("high-priority housekeeping (one report every %g s on board)" % day.hk_period)
     ax[3].legend()
     planned = [(s.time, i) for i, s in enumerate(day.plan) if s.time < day.end]
     ax[4].scatter([h(t) for t, _ in planned], [0] * len(planned), marker="|", s=200,
@@ -108,6 +110,18 @@ def page(day, f, results, took, speed):
         te = day.executed.get(i)
         plan.append("| %s | %s | `%s` |" % (_utc(s.time), _utc(te - TAI_MINUS_UNIX)
                                             if te else "not seen", s.request))  # fmt: skip
+    files = ["| file | octets | identical | transactions | at each AOS (octets) |",
+             "|---|---|---|---|---|"]  # fmt: skip
+    for name in ("down", "up"):
+        same, count, prog = f["files"][name]
+        files.append("| %s | %d | %s | %d | %s |" % (name, f[name + "_size"], same, count,
+                                                     ", ".join(str(p) for p in prog)))  # fmt: skip
+    for t, kind, info in day.cfdp_log:
+        if kind in ("finished", "fault", "abandoned"):
+            files.append("")
+            octets = info.get("size", info.get("progress"))
+            files.append("- %s: %s, condition %s, %s octets" % (
+                _utc(t), kind, info.get("condition"), octets))  # fmt: skip
     checks_md = ["| check | result | figures |", "|---|---|---|"]
     for name, ok, detail in results:
         checks_md.append("| %s | %s | %s |" % (name, "pass" if ok else "FAIL", detail))
@@ -125,6 +139,13 @@ def page(day, f, results, took, speed):
         "## Checks",
         "",
         *checks_md,
+        "",
+        "## Files",
+        "",
+        "The receiver's octets at each AOS: for the file down the ground's (the start of its "
+        "first gap), for the file up what the ground had sent (the receiver is on board).",
+        "",
+        *files,
         "",
         "## Passes",
         "",

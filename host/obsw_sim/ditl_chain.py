@@ -243,7 +243,7 @@ class ChainDay:
         onboard, ground = chain.ids.cfdp_entities
         entity = make_entity(ground, [onboard], RootedFilestore(self.ground_files),
                              state=os.path.join(self.work, "ground-cfdp"),
-                             segment=512, limit=30, inactivity=600.0)  # fmt: skip
+                             segment=512, limit=100, inactivity=3600.0)  # fmt: skip
         self.cfdp = UdpEntity(entity, ("127.0.0.1", chain.cfdp_ground_port),
                               {onboard: chain.station.address}, apid=chain.ids.apid("cfdp"),
                               packet_type=TYPE_TC, rate=self.up_rate)  # fmt: skip
@@ -373,7 +373,8 @@ class ChainDay:
             if now >= next_sample:
                 next_sample += 60.0
                 self.series["t"].append(now)
-                self.series["delivered"].append(sum(len(a) for a in self.archive.values()))
+                self.series["delivered"].append(sum(1 for k in self.archive[HIGH] if k[0] == "hk"))
+                self.series["generated"].append((now - self.start) / self.hk_period)
             if progress is not None and now >= next_progress:
                 next_progress += 3600.0
                 progress(now - self.start, self)

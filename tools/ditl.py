@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """A day in the life of the whole chain (obsw_sim.ditl_chain) under time acceleration.
 
-python tools/ditl.py                    24 hours at 60 times (24 minutes here), checked
-python tools/ditl.py --orbits 2         the bounded run (tools/test): two orbits at 100 times
+python tools/ditl.py                    24 hours at 52 times (28 minutes here), checked
+python tools/ditl.py --orbits 2         a bounded run: two orbits at 48 times (4 minutes)
 python tools/ditl.py --write            also write docs/ditl-last-run.md and docs/ditl.png
 
 It starts itself again under libfaketime (obsw_sim.faketime: every process of the chain on one
 clock, SPEED times faster), the clock set so that the day begins ``--before`` seconds before
-the first pass over the mission's first station after now. The closing line is 'N passed, N
+the first pass over the mission's first station after now. The downlink runs at ``--downlink``
+bit/s (default 19200, half the station's: the rig's station decodes both UARTs' frames in
+Python, and at 52 times faster could not keep up with more). The closing line is 'N passed, N
 failed' over the checks of the run (exit status 1 if any failed).
 """
 
@@ -164,17 +166,18 @@ def main(argv=None):
     )
     ap.add_argument("--orbits", type=float, help="a bounded run of this many orbits")
     ap.add_argument("--hours", type=float, default=24.0, help="the full run's length")
-    ap.add_argument("--speed", type=float, help="times faster (default 60, bounded run 100)")
+    ap.add_argument("--speed", type=float, help="times faster (default 52, bounded run 48)")
+    ap.add_argument("--downlink", type=float, default=19200.0, help="downlink bit/s (19200)")
     ap.add_argument("--before", type=float, default=1800.0,
                     help="seconds of orbit before the first pass (default 1800)")  # fmt: skip
-    ap.add_argument("--down", type=int, help="octets of the file down (3 MB; bounded 1.6 MB)")
+    ap.add_argument("--down", type=int, help="octets of the file down (1.5 MB; bounded 800 kB)")
     ap.add_argument("--up", type=int, help="octets of the file up (400 kB; bounded 200 kB)")
     ap.add_argument("--write", action="store_true", help="write docs/ditl-last-run.md, ditl.png")
     ap.add_argument("--work", help="folder for the chain's files (default: a temporary one)")
     args = ap.parse_args(argv)
     m = load(MISSION)
     pred = from_mission(m.config.doc)
-    speed = args.speed or (100.0 if args.orbits else 60.0)
+    speed = args.speed or (48.0 if args.orbits else 52.0)
     if faketime.active() is None:  # start again, the whole process tree on the fast clock
         now = time.time()
         first = pred.passes(now, now + 86400, pred.stations[:1])[0]
@@ -187,9 +190,18 @@ def main(argv=None):
     orbit_s = 86400.0 / pred.tle.mean_motion
     seconds = args.orbits * orbit_s if args.orbits else args.hours * 3600
     work = args.work or tempfile.mkdtemp(prefix="obsw-ditl-")
-    down = args.down or (1_600_000 if args.orbits else 3_000_000)
+    down = args.down or (800_000 if args.orbits else 1_500_000)
     up = args.up or (200_000 if args.orbits else 400_000)
-    day = ChainDay(work, pred, seconds, speed, out=print, down_size=down, up_size=up)
+    day = ChainDay(
+        work,
+        pred,
+        seconds,
+        speed,
+        out=print,
+        down_size=down,
+        up_size=up,
+        downlink_bps=args.downlink,
+    )
     began = time.monotonic()
 
     def progress(t, d):

@@ -75,7 +75,8 @@ class ChainDay:
 
     def __init__(self, work, predictor, seconds, speed, out=None, hk_period=10.0,
                  ack_every=60.0, lead=60.0, lag=30.0, down_size=3_000_000,
-                 up_size=400_000, up_rate=400.0, frame_length=1024):  # fmt: skip
+                 up_size=400_000, up_rate=400.0, frame_length=1024,
+                 downlink_bps=None):  # fmt: skip
         self.work = work
         self.pred = predictor
         self.station = predictor.stations[0]
@@ -90,12 +91,15 @@ class ChainDay:
         self.chain.sections["contact"] = {"stores": [HIGH, ROUTINE], "hold": 5.0}
         chain_settings(self.chain, speed)
         # files through the frames; the OBC paces its dump and its file data at a share of the
-        # station's downlink rate (contact.downlink_bps; the frame processor does not pace:
-        # a radio paced in accelerated time needs a wake-up per frame)
+        # downlink rate (``downlink_bps``, default the station's; contact.downlink_bps: the
+        # frame processor does not pace, a radio paced in accelerated time needs a wake-up
+        # per frame)
         self.chain.cfdp_frames = True
         self.chain.tm_frame_length = frame_length
-        self.chain.sections["frames"].update(tm_frame_length=frame_length)
-        self.chain.sections["contact"]["downlink_bps"] = self.station.downlink_bps
+        # the UARTs' queues hold a burst rather than drop it while the station reads
+        self.chain.sections["frames"].update(tm_frame_length=frame_length, uart_queue=4096)
+        self.downlink_bps = downlink_bps or self.station.downlink_bps
+        self.chain.sections["contact"]["downlink_bps"] = self.downlink_bps
         rng = random.Random(7)
         self.down_data = rng.randbytes(down_size)
         self.up_data = rng.randbytes(up_size)
@@ -355,7 +359,7 @@ class ChainDay:
                 self._carrier(True)
                 self.contacts += 1
                 current = [p.aos, p.los, sum(len(a) for a in self.archive.values()),
-                           self.station.downlink_bps * (p.los - p.aos) / 8]  # fmt: skip
+                           self.downlink_bps * (p.los - p.aos) / 8]  # fmt: skip
                 last_ack = now
             elif p is None and current is not None:  # LOS
                 self._carrier(False)

@@ -122,7 +122,7 @@ class ChainDay:
         self.acked = {HIGH: 0, ROUTINE: 0}
         self.resends = 0
         self._asked = {}
-        self._resent = {}  # store -> asked again since its last acknowledgement
+        self._resent = {}  # store -> reports asked again, not yet come twice
         self.backlog = []  # (onboard s, octets) from store 2's reports
         self.executed = {}  # planned step index -> onboard time of its TM[1,7]
         self.plan = []
@@ -173,9 +173,13 @@ class ChainDay:
 
     def _archive(self, store, key):
         """One report into the ground's archive; one already there is a duplicate unless the
-        ground asked for the store's reports again since its last acknowledgement."""
-        if key in self.archive[store] and not self._resent.get(store):
-            self.duplicates += 1
+        ground asked for it again (``Passes.resend`` of a range: as many reports of the store
+        as the range holds may come twice)."""
+        if key in self.archive[store]:
+            if self._resent.get(store, 0) > 0:
+                self._resent[store] -= 1
+            else:
+                self.duplicates += 1
         self.archive[store][key] = self.onboard()
 
     def onboard(self):
@@ -402,12 +406,12 @@ class ChainDay:
                         tx = g.perform("Passes.acknowledge", store=store, seq=last, timeout=10.0)
                         if tx.ok:
                             self.acked[store] = last
-                            self._resent[store] = False
                 elif not self._asked.get(store):
-                    g.perform("Passes.resend", store=store, first=self.acked[store] + 1,
-                              last=last, timeout=10.0)  # fmt: skip
+                    first = self.acked[store] + 1
+                    g.perform("Passes.resend", store=store, first=first, last=last,
+                              timeout=10.0)  # fmt: skip
                     self._asked[store] = True
-                    self._resent[store] = True
+                    self._resent[store] = self._resent.get(store, 0) + last - first + 1
                     self.resends += 1
                 else:
                     self._asked[store] = False  # asked last round: ask again next round
@@ -417,8 +421,11 @@ class ChainDay:
     # ---------------------------------------------------------------- figures
 
     def figures(self):
+        # a command's completion report comes down in the first pass after it: those planned
+        # before the AOS of the last pass flown are the ones the ground can have seen
+        horizon = max((u[0] for u in self.pass_use), default=self.start)
         planned = [(i, s.time + TAI_MINUS_UNIX) for i, s in enumerate(self.plan)
-                   if s.time < self.end]  # fmt: skip
+                   if s.time < min(horizon, self.end)]  # fmt: skip
         lateness = [self.executed[i] - t for i, t in planned if i in self.executed]
         hk = sorted(k[2] for k in self.archive[HIGH] if k[0] == "hk")
         hk_s = [c + f / 65536.0 for c, f in hk]

@@ -58,7 +58,7 @@ def chain_settings(chain, speed):
     """The chain's timers for a run at ``speed``: heartbeats and deadlines in onboard seconds
     that leave a loaded machine room (a deadline of 2 s is 20 ms here at 100 times)."""
     slack = max(1.0, speed / 2.0)
-    chain.platform.update(heartbeat=1.0, deadline=3.0 * slack, start_timeout=60.0 * slack,
+    chain.platform.update(heartbeat=1.0, deadline=6.0 * slack, start_timeout=60.0 * slack,
                           context_period=5.0, module_timeout=1.0 * slack)  # fmt: skip
     chain.sections["spacecan"] = {"heartbeat_period": 1.0, "timeout": 1.0 * slack}
     chain.sections["frames"] = {"clcw_period": 1.0}

@@ -251,7 +251,8 @@ class ChainDay:
         onboard, ground = chain.ids.cfdp_entities
         entity = make_entity(ground, [onboard], RootedFilestore(self.ground_files),
                              state=os.path.join(self.work, "ground-cfdp"),
-                             segment=512, limit=100, inactivity=3600.0)  # fmt: skip
+                             segment=512, limit=100, inactivity=3600.0, ack_interval=5.0,
+                             nak_interval=5.0)  # fmt: skip
         self.cfdp = UdpEntity(entity, ("127.0.0.1", chain.cfdp_ground_port),
                               {onboard: chain.station.address}, apid=chain.ids.apid("cfdp"),
                               packet_type=TYPE_TC, rate=self.up_rate)  # fmt: skip

@@ -134,7 +134,11 @@ def page(day, f, results, took, speed):
         "[Operations across passes](passes.md)). %.1f hours of orbit (%.1f orbits) of the "
         "sample spacecraft from %s, the whole chain (the OBC's processes, both reconfiguration "
         "controllers, frames on the UARTs, the station, the ground) under libfaketime at %g "
-        "times: %.0f s here." % (f["hours"], f["orbits"], _utc(day.start), speed, took),
+        "times: %.0f s here; the downlink at %d bit/s, files through the frames. Power "
+        "cycles of the OBC by its module: %d; processes restarted by its platform manager: "
+        "%d; controllers reset: %d." % (f["hours"], f["orbits"], _utc(day.start), speed, took,
+                                        day.downlink_bps, max(0, (f["obc_boots"] or 1) - 1),
+                                        f["process_restarts"], f["controller_resets"]),
         "",
         "![the day: passes, store backlog, link use, data delivered, commands](ditl.png)",
         "",

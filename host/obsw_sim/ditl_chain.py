@@ -454,6 +454,12 @@ class ChainDay:
             "lateness": lateness,
             "pass_use": self.pass_use,
             "obc_boots": self.chain.sim.obc_boots if self.chain.sim else None,
+            "process_restarts": sum(
+                1
+                for _, text in self.chain.sim.log_lines()
+                if "[platform]" in text and "restarting" in text
+            ),
+            "controller_resets": sum(len(r) for r in self.chain.sim.resets),
             "files": self.file_results(),
             "down_size": len(self.down_data),
             "up_size": len(self.up_data),

@@ -85,7 +85,8 @@ def plot(day, f, path):
     planned = [(s.time, i) for i, s in enumerate(day.plan) if s.time < day.end]
     ax[4].scatter([h(t) for t, _ in planned], [0] * len(planned), marker="|", s=200,
                   label="planned")  # fmt: skip
-    ex = [(day.executed[i] - TAI_MINUS_UNIX) for _, i in planned if i in day.executed]
+    ex = [(day.started.get(i, day.executed[i]) - TAI_MINUS_UNIX) for _, i in planned
+          if i in day.executed]  # fmt: skip
     ax[4].scatter([h(t) for t in ex], [1] * len(ex), marker="|", s=200, label="executed")
     ax[4].set_yticks([0, 1])
     ax[4].set_yticklabels(["planned", "executed"])
@@ -107,9 +108,9 @@ def page(day, f, results, took, speed):
             i + 1, _utc(p.aos), _utc(p.los), p.max_elevation, u[3], u[2]))  # fmt: skip
     from obsw_host.pus.tai import TAI_MINUS_UNIX
 
-    plan = ["| planned (UTC) | executed (onboard, UTC) | request |", "|---|---|---|"]
+    plan = ["| planned (UTC) | started (onboard, UTC) | request |", "|---|---|---|"]
     for i, s in enumerate(day.plan):
-        te = day.executed.get(i)
+        te = day.started.get(i, day.executed.get(i)) if i in day.executed else None
         plan.append("| %s | %s | `%s` |" % (_utc(s.time), _utc(te - TAI_MINUS_UNIX)
                                             if te else "not seen", s.request))  # fmt: skip
     files = ["| file | octets | identical | transactions | at each AOS (octets) |",

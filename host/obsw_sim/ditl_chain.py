@@ -125,6 +125,7 @@ class ChainDay:
         self._resent = {}  # store -> reports asked again, not yet come twice
         self.backlog = []  # (onboard s, octets) from store 2's reports
         self.executed = {}  # planned step index -> onboard time of its TM[1,7]
+        self.started = {}  # planned step index -> onboard time of its TM[1,3]
         self.plan = []
         self.pass_use = []  # (aos, los, packets down, volume octets)
         self.series = {"t": [], "generated": [], "delivered": []}
@@ -153,16 +154,20 @@ class ChainDay:
                 v = decoded["values"].get("Passes.backlog")
                 if v is not None:
                     self.backlog.append((_seconds(tm), v))
-        elif tm.service == 1 and tm.subtype in (7, 8) and decoded:
+        elif tm.service == 1 and tm.subtype in (3, 7, 8) and decoded:
             rid = decoded.get("request_id")
             if rid is None:
                 return
-            # store 1 keeps every completion report: each counted, whoever asked
+            # store 1 keeps every start and completion report: each counted, whoever asked
             self._archive(HIGH, ("v", tm.subtype, tm.time, hash(rid)))
             step = self._tx_steps.get(rid)
-            if step is not None and tm.subtype == 8:
+            if step is None:
+                return
+            if tm.subtype == 3:  # the start of its execution: when it was released
+                self.started[step] = _seconds(tm)
+            elif tm.subtype == 8:
                 self.say("planned command %d failed: %r" % (step, decoded))
-            elif step is not None:
+            else:
                 self.executed[step] = _seconds(tm)
         elif tm.service == 5 and len(tm.data) >= 2:
             eid = tm.data[0] << 8 | tm.data[1]
@@ -216,7 +221,7 @@ class ChainDay:
             g.set_hk_interval(HK_HIGH, ticks(self.hk_period)).ok,
             g.enable_hk([HK_HIGH, HK_ROUTINE]).ok,
         ]  # fmt: skip
-        for store, types, sids in ((HIGH, {3: [25], 1: [7, 8]}, [HK_HIGH]),
+        for store, types, sids in ((HIGH, {3: [25], 1: [3, 7, 8]}, [HK_HIGH]),
                                    (ROUTINE, {3: [25]}, [HK_ROUTINE])):  # fmt: skip
             ok.append(sg.create_store(store, 4_000_000, kind=1).ok)
             ok.append(sg.store_types(store, {apid: types}).ok)
@@ -278,12 +283,13 @@ class ChainDay:
             if ind.kind in ("finished", "fault", "abandoned"):
                 self.say("file transfer %s: %r" % (ind.kind, dict(ind.info)))
         for t in list(ent.tx.values()):
-            if t.role == "R":
+            meta = getattr(t, "meta", None) or {}
+            if t.role == "R" and meta.get("dest_name") == "payload.bin":
                 name = "down"
-            elif getattr(t, "source_name", None) == "update.bin":
+            elif t.role == "S" and getattr(t, "source_name", None) == "update.bin":
                 name = "up"
             else:
-                continue  # the proxy put request: options only
+                continue  # the proxy put request and its response: options only
             self.transactions[name].add(tuple(t.tid))
             if aos:
                 self.cfdp_progress[name].append((time.time(), t.progress_of()))
@@ -409,10 +415,11 @@ class ChainDay:
                             self.acked[store] = last
                 elif not self._asked.get(store):
                     first = self.acked[store] + 1
+                    # counted before it goes: a TC whose report is late may still have run
+                    self._resent[store] = self._resent.get(store, 0) + last - first + 1
+                    self._asked[store] = True
                     g.perform("Passes.resend", store=store, first=first, last=last,
                               timeout=10.0)  # fmt: skip
-                    self._asked[store] = True
-                    self._resent[store] = self._resent.get(store, 0) + last - first + 1
                     self.resends += 1
                 else:
                     self._asked[store] = False  # asked last round: ask again next round
@@ -427,7 +434,9 @@ class ChainDay:
         horizon = max((u[0] for u in self.pass_use), default=self.start)
         planned = [(i, s.time + TAI_MINUS_UNIX) for i, s in enumerate(self.plan)
                    if s.time < min(horizon, self.end)]  # fmt: skip
-        lateness = [self.executed[i] - t for i, t in planned if i in self.executed]
+        # executed: completed (TM[1,7]); its time: the start of its execution (TM[1,3])
+        lateness = [self.started.get(i, self.executed[i]) - t for i, t in planned
+                    if i in self.executed]  # fmt: skip
         hk = sorted(k[2] for k in self.archive[HIGH] if k[0] == "hk")
         hk_s = [c + f / 65536.0 for c, f in hk]
         gaps = [b - a for a, b in zip(hk_s, hk_s[1:])]

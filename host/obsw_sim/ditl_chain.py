@@ -185,6 +185,9 @@ class ChainDay:
                 self._resent[store] -= 1
             else:
                 self.duplicates += 1
+                if self.duplicates <= 5:  # what they are, for the record
+                    self.say("a report came twice: store %d, %r, first %.1f s before" % (
+                        store, key, self.onboard() - self.archive[store][key]))  # fmt: skip
         self.archive[store][key] = self.onboard()
 
     def onboard(self):

@@ -65,7 +65,8 @@ def plot(day, f, path):
     ax[0].set_title("passes over %s (green)" % st.name)
     from obsw_host.pus.tai import TAI_MINUS_UNIX
 
-    ax[1].plot([h(t - TAI_MINUS_UNIX) for t, _ in day.backlog], [v / 1e3 for _, v in day.backlog])
+    backlog = sorted(day.backlog)  # by the reports' time tags: the dumps bring them late
+    ax[1].plot([h(t - TAI_MINUS_UNIX) for t, _ in backlog], [v / 1e3 for _, v in backlog])
     ax[1].set_ylabel("kB")
     ax[1].set_title("the stores' backlog on board (Passes.backlog), store size %d kB" % (
         f["store_size"] / 1e3))  # fmt: skip

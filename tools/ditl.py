@@ -1,18 +1,19 @@
 #!/usr/bin/env python3
 """A day in the life of the whole chain (obsw_sim.ditl_chain) under time acceleration.
 
-python tools/ditl.py                    24 hours at 60 times (24 minutes here), checked
-python tools/ditl.py --orbits 2         the bounded run (tools/test): two orbits at 100 times
+python tools/ditl.py                    24 hours at 52 times (28 minutes here), checked
+python tools/ditl.py --orbits 2         a bounded run: two orbits at 48 times (4 minutes)
 python tools/ditl.py --write            also write docs/ditl-last-run.md and docs/ditl.png
 
 It starts itself again under libfaketime (obsw_sim.faketime: every process of the chain on one
 clock, SPEED times faster), the clock set so that the day begins ``--before`` seconds before
-the first pass over the mission's first station after now. The closing line is 'N passed, N
+the first pass over the mission's first station after now. The downlink runs at ``--downlink``
+bit/s (default 19200, half the station's: the rig's station decodes both UARTs' frames in
+Python, and at 52 times faster could not keep up with more). The closing line is 'N passed, N
 failed' over the checks of the run (exit status 1 if any failed).
 """
 
 import argparse
-import datetime
 import os
 import sys
 import tempfile
@@ -23,41 +24,24 @@ sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
 from obsw_host.mission.check import load  # noqa: E402
 from obsw_host.ops.passes import from_mission  # noqa: E402
-from obsw_host.ops.tle import format_time  # noqa: E402
 from obsw_sim import faketime  # noqa: E402
+from obsw_sim.ditl_checks import checks  # noqa: E402
+from obsw_sim.ditl_checks import utc as _utc  # noqa: E402
 
 MISSION = os.path.join(ROOT, "examples", "sample")
 
 
-def _utc(t):
-    return format_time(datetime.datetime.fromtimestamp(t, datetime.timezone.utc))
-
-
-def checks(day, f, full):
-    """(name, ok, detail) of each check of the run."""
-    out = []
-    if full:
-        out.append(("24 hours, 15 orbits, 4 passes", f["hours"] >= 24 and f["orbits"] >= 15
-                    and f["contacts"] >= 4, "%.1f h, %.1f orbits, %d passes flown" % (
-                        f["hours"], f["orbits"], f["contacts"])))  # fmt: skip
-    else:
-        out.append(("two orbits, two passes", f["orbits"] >= 2 and f["contacts"] >= 2,
-                    "%.1f orbits, %d passes flown" % (f["orbits"], f["contacts"])))  # fmt: skip
-    out.append(("housekeeping delivered exactly once", f["missing"] == 0 and
-                f["duplicates"] == 0 and f["hk_high"] > 0, "%d reports of the high-priority "
-                "structure, %d missing, %d duplicates, %d resends asked" % (
-                    f["hk_high"], f["missing"], f["duplicates"], f["resends"])))  # fmt: skip
-    out.append(("planned commands executed within 1 s", f["executed"] == f["planned"] > 0
-                and f["max_lateness"] <= 1.0, "%d of %d, at most %.3f s from its time" % (
-                    f["executed"], f["planned"], f["max_lateness"])))  # fmt: skip
-    out.append(
-        (
-            "stores never overflow",
-            f["max_backlog"] < f["store_size"],
-            "largest backlog %d octets of %d" % (f["max_backlog"], f["store_size"]),
-        )
-    )
-    return out
+def common(day, f):
+    """The figures in the form of obsw_sim.ditl_checks."""
+    files = {}
+    for name in ("down", "up"):
+        same, count, prog = f["files"][name]
+        files[name] = {"size": f[name + "_size"], "identical": same, "transactions": count,
+                       "progress": prog}  # fmt: skip
+    return dict(f, passes=f["contacts"], hk_due=f["hk_high"], files=files,
+                overflow=f["max_backlog"] >= f["store_size"],
+                store_detail="largest backlog %d octets of %d" % (
+                    f["max_backlog"], f["store_size"]))  # fmt: skip
 
 
 def plot(day, f, path):
@@ -81,7 +65,8 @@ def plot(day, f, path):
     ax[0].set_title("passes over %s (green)" % st.name)
     from obsw_host.pus.tai import TAI_MINUS_UNIX
 
-    ax[1].plot([h(t - TAI_MINUS_UNIX) for t, _ in day.backlog], [v / 1e3 for _, v in day.backlog])
+    backlog = sorted(day.backlog)  # by the reports' time tags: the dumps bring them late
+    ax[1].plot([h(t - TAI_MINUS_UNIX) for t, _ in backlog], [v / 1e3 for _, v in backlog])
     ax[1].set_ylabel("kB")
     ax[1].set_title("the stores' backlog on board (Passes.backlog), store size %d kB" % (
         f["store_size"] / 1e3))  # fmt: skip
@@ -91,15 +76,18 @@ def plot(day, f, path):
     ax[2].set_xticklabels(["pass %d" % (i + 1) for i in n])
     ax[2].set_ylabel("packets down")
     ax[2].set_title("link use per pass")
+    ax[3].plot([h(t) for t in day.series["t"]], day.series["generated"],
+               label="generated on board")  # fmt: skip
     ax[3].plot([h(t) for t in day.series["t"]], day.series["delivered"],
                label="delivered to the ground")  # fmt: skip
     ax[3].set_ylabel("reports")
-    ax[3].set_title("data delivered (generated: one report every %g s on board)" % day.hk_period)
+    ax[3].set_title("high-priority housekeeping (one report every %g s on board)" % day.hk_period)
     ax[3].legend()
     planned = [(s.time, i) for i, s in enumerate(day.plan) if s.time < day.end]
     ax[4].scatter([h(t) for t, _ in planned], [0] * len(planned), marker="|", s=200,
                   label="planned")  # fmt: skip
-    ex = [(day.executed[i] - TAI_MINUS_UNIX) for _, i in planned if i in day.executed]
+    ex = [(day.started.get(i, day.executed[i]) - TAI_MINUS_UNIX) for _, i in planned
+          if i in day.executed]  # fmt: skip
     ax[4].scatter([h(t) for t in ex], [1] * len(ex), marker="|", s=200, label="executed")
     ax[4].set_yticks([0, 1])
     ax[4].set_yticklabels(["planned", "executed"])
@@ -121,11 +109,23 @@ def page(day, f, results, took, speed):
             i + 1, _utc(p.aos), _utc(p.los), p.max_elevation, u[3], u[2]))  # fmt: skip
     from obsw_host.pus.tai import TAI_MINUS_UNIX
 
-    plan = ["| planned (UTC) | executed (onboard, UTC) | request |", "|---|---|---|"]
+    plan = ["| planned (UTC) | started (onboard, UTC) | request |", "|---|---|---|"]
     for i, s in enumerate(day.plan):
-        te = day.executed.get(i)
+        te = day.started.get(i, day.executed.get(i)) if i in day.executed else None
         plan.append("| %s | %s | `%s` |" % (_utc(s.time), _utc(te - TAI_MINUS_UNIX)
                                             if te else "not seen", s.request))  # fmt: skip
+    files = ["| file | octets | identical | transactions | at each AOS (octets) |",
+             "|---|---|---|---|---|"]  # fmt: skip
+    for name in ("down", "up"):
+        same, count, prog = f["files"][name]
+        files.append("| %s | %d | %s | %d | %s |" % (name, f[name + "_size"], same, count,
+                                                     ", ".join(str(p) for p in prog)))  # fmt: skip
+    for t, kind, info in day.cfdp_log:
+        if kind in ("finished", "fault", "abandoned"):
+            files.append("")
+            octets = info.get("size", info.get("progress"))
+            files.append("- %s: %s, condition %s, %s octets" % (
+                _utc(t), kind, info.get("condition"), octets))  # fmt: skip
     checks_md = ["| check | result | figures |", "|---|---|---|"]
     for name, ok, detail in results:
         checks_md.append("| %s | %s | %s |" % (name, "pass" if ok else "FAIL", detail))
@@ -136,13 +136,24 @@ def page(day, f, results, took, speed):
         "[Operations across passes](passes.md)). %.1f hours of orbit (%.1f orbits) of the "
         "sample spacecraft from %s, the whole chain (the OBC's processes, both reconfiguration "
         "controllers, frames on the UARTs, the station, the ground) under libfaketime at %g "
-        "times: %.0f s here." % (f["hours"], f["orbits"], _utc(day.start), speed, took),
+        "times: %.0f s here; the downlink at %d bit/s, files through the frames. Power "
+        "cycles of the OBC by its module: %d; processes restarted by its platform manager: "
+        "%d; controllers reset: %d." % (f["hours"], f["orbits"], _utc(day.start), speed, took,
+                                        day.downlink_bps, max(0, (f["obc_boots"] or 1) - 1),
+                                        f["process_restarts"], f["controller_resets"]),
         "",
         "![the day: passes, store backlog, link use, data delivered, commands](ditl.png)",
         "",
         "## Checks",
         "",
         *checks_md,
+        "",
+        "## Files",
+        "",
+        "The receiver's octets at each AOS: for the file down the ground's (the start of its "
+        "first gap), for the file up what the ground had sent (the receiver is on board).",
+        "",
+        *files,
         "",
         "## Passes",
         "",
@@ -161,15 +172,18 @@ def main(argv=None):
     )
     ap.add_argument("--orbits", type=float, help="a bounded run of this many orbits")
     ap.add_argument("--hours", type=float, default=24.0, help="the full run's length")
-    ap.add_argument("--speed", type=float, help="times faster (default 60, bounded run 100)")
+    ap.add_argument("--speed", type=float, help="times faster (default 52, bounded run 48)")
+    ap.add_argument("--downlink", type=float, default=19200.0, help="downlink bit/s (19200)")
     ap.add_argument("--before", type=float, default=1800.0,
                     help="seconds of orbit before the first pass (default 1800)")  # fmt: skip
+    ap.add_argument("--down", type=int, help="octets of the file down (1.5 MB; bounded 800 kB)")
+    ap.add_argument("--up", type=int, help="octets of the file up (400 kB; bounded 200 kB)")
     ap.add_argument("--write", action="store_true", help="write docs/ditl-last-run.md, ditl.png")
     ap.add_argument("--work", help="folder for the chain's files (default: a temporary one)")
     args = ap.parse_args(argv)
     m = load(MISSION)
     pred = from_mission(m.config.doc)
-    speed = args.speed or (100.0 if args.orbits else 60.0)
+    speed = args.speed or (48.0 if args.orbits else 52.0)
     if faketime.active() is None:  # start again, the whole process tree on the fast clock
         now = time.time()
         first = pred.passes(now, now + 86400, pred.stations[:1])[0]
@@ -182,7 +196,18 @@ def main(argv=None):
     orbit_s = 86400.0 / pred.tle.mean_motion
     seconds = args.orbits * orbit_s if args.orbits else args.hours * 3600
     work = args.work or tempfile.mkdtemp(prefix="obsw-ditl-")
-    day = ChainDay(work, pred, seconds, speed, out=print)
+    down = args.down or (800_000 if args.orbits else 1_500_000)
+    up = args.up or (200_000 if args.orbits else 400_000)
+    day = ChainDay(
+        work,
+        pred,
+        seconds,
+        speed,
+        out=print,
+        down_size=down,
+        up_size=up,
+        downlink_bps=args.downlink,
+    )
     began = time.monotonic()
 
     def progress(t, d):
@@ -192,7 +217,7 @@ def main(argv=None):
 
     f = day.run(progress)
     took = (time.monotonic() - began) / speed  # the monotonic clock runs fast too
-    results = checks(day, f, full=not args.orbits)
+    results = checks(common(day, f), full=not args.orbits)
     for name, ok, detail in results:
         print("%s %s: %s" % ("ok  " if ok else "FAIL", name, detail))
     print("%.1f h of orbit in %.0f s here (%g times)" % (f["hours"], took, speed))

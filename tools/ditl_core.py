@@ -13,7 +13,6 @@ failed).
 """
 
 import argparse
-import datetime
 import os
 import sys
 import time
@@ -23,47 +22,25 @@ sys.path[:0] = [os.path.join(ROOT, "micropython"), os.path.join(ROOT, "host")]
 
 from obsw_host.mission.check import load  # noqa: E402
 from obsw_host.ops.passes import from_mission  # noqa: E402
-from obsw_host.ops.tle import format_time  # noqa: E402
 from obsw_sim.ditl import HK, Day  # noqa: E402
+from obsw_sim.ditl_checks import checks  # noqa: E402
+from obsw_sim.ditl_checks import utc as _utc  # noqa: E402
 
 MISSION = os.path.join(ROOT, "examples", "sample")
 
 
-def _utc(t):
-    return format_time(datetime.datetime.fromtimestamp(t, datetime.timezone.utc))
-
-
-def checks(day, f, full):
-    """(name, ok, detail) of each check of the run."""
-    out = []
-    if full:
-        out.append(("24 hours, 15 orbits, 4 passes", f["hours"] >= 24 and f["orbits"] >= 15
-                    and f["passes"] >= 4, "%.1f h, %.1f orbits, %d passes" % (
-                        f["hours"], f["orbits"], f["passes"])))  # fmt: skip
-    else:
-        out.append(("two orbits, two passes", f["orbits"] >= 2 and f["passes"] >= 2,
-                    "%.1f orbits, %d passes" % (f["orbits"], f["passes"])))  # fmt: skip
-    due = sum(f["due"].values())
-    out.append(("housekeeping delivered exactly once", f["missing"] == 0 and
-                f["duplicates"] == 0 and due > 0, "%d due, %d missing, %d duplicates, %d asked "
-                "again" % (due, f["missing"], f["duplicates"], f["resend_requests"])))  # fmt: skip
-    out.append(("planned commands executed within 1 s", f["executed"] == f["planned"] > 0
-                and f["max_lateness"] <= 1.0, "%d of %d, latest %.3f s after its time" % (
-                    f["executed"], f["planned"], f["max_lateness"])))  # fmt: skip
-    for name, ok in (("down", f["down_file"]), ("up", f["up_file"])):
-        prog = [p for _t, p in f[name + "_resumes"]]
-        across = len([p for p in prog if p > 0]) >= 1
-        never_restarted = prog == sorted(prog)
-        size = len(day.down_data if name == "down" else day.up_data)
-        out.append(("%s file (%d octets) identical across passes" % (name, size),
-                    ok and across and never_restarted, "identical %s; received at each AOS %s" % (
-                        ok, prog)))  # fmt: skip
+def common(day, f):
+    """The figures in the form of obsw_sim.ditl_checks."""
     volume = sum(u[3] for u in f["pass_use"])
     generated = sum(HK[s][1] * f["generated"][s] for s in HK)
-    out.append(("stores never overflow", f["overflow"] == 0 and volume > generated,
-                "peak fill %d %%, %d octets of passes against %d generated" % (
-                    f["max_store_fill"], volume, generated)))  # fmt: skip
-    return out
+    files = {}
+    for name, data in (("down", day.down_data), ("up", day.up_data)):
+        files[name] = {"size": len(data), "identical": f[name + "_file"], "transactions": None,
+                       "progress": [p for _t, p in f[name + "_resumes"]]}  # fmt: skip
+    return dict(f, hk_due=sum(f["due"].values()), resends=f["resend_requests"], files=files,
+                overflow=f["overflow"] != 0 or volume <= generated,
+                store_detail="peak fill %d %%, %d octets of passes against %d generated" % (
+                    f["max_store_fill"], volume, generated))  # fmt: skip
 
 
 def plot(day, f, path):
@@ -170,7 +147,7 @@ def main(argv=None):
     began = time.monotonic()
     f = day.run()
     took = time.monotonic() - began
-    results = checks(day, f, full=not args.orbits)
+    results = checks(common(day, f), full=not args.orbits)
     for name, ok, detail in results:
         print("%s %s: %s" % ("ok  " if ok else "FAIL", name, detail))
     print("%.1f h of orbit in %.1f s" % (f["hours"], took))

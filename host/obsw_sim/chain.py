@@ -119,6 +119,11 @@ class Chain:
         self.platform = {}  # platform manager settings for the OBC's next boot
         self.sections = {}  # more mission file sections for the OBC's next boot ("contact")
         self.sim_options = {}  # more options of the reconfiguration module (ReconfigSim)
+        # CFDP through the frames: the OBC's entity sends its PDUs to the frame processor's TM
+        # input, the station hands the CFDP APID's packets to the ground entity on
+        # ``cfdp_ground_port`` and takes its TC packets up (else CFDP goes over UDP directly)
+        self.cfdp_frames = False
+        self.tm_frame_length = 256  # the OBC's TM frames, as the station decodes them
         self._stop = threading.Event()
         self._thread = None
 
@@ -166,6 +171,7 @@ class Chain:
             uart_a=uart_a,
             uart_b=uart_b,
             clcw_period=0.2,
+            tm_frame_length=self.tm_frame_length,
             keys=self.sim.key_file,  # the mission's TC keys: the OBC's and the module's
         )
         platform = doc.setdefault("platform", {})
@@ -173,6 +179,9 @@ class Chain:
         # the UART link to the module: context and time across power cycles and switch-overs
         platform.update(module_uarts=list(self.sim.obc_uart_paths), context_period=0.5)
         platform.update(self.platform)
+        if self.cfdp_frames:
+            ground = self.ids.cfdp_entities[1]
+            doc.setdefault("cfdp", {})["peers"] = {str(ground): "127.0.0.1:%d" % self.tm_port}
         for name, section in self.sections.items():  # over what the chain set
             doc.setdefault(name, {}).update(section)
         if redundant:
@@ -231,14 +240,18 @@ class Chain:
             **self.sim_options,
         )
         security, state = keys.load(self.sim.key_file, os.path.join(self.work, "station.state"))
+        routes = None
+        if self.cfdp_frames:
+            routes = {self.ids.apid("cfdp"): ("127.0.0.1", self.cfdp_ground_port)}
         self.station = _station_class()(
             self.links,
             self.ids.scid,
             vcid=self.ids.tc_vc,
             map_id=self.ids.maps["packets"],
-            tm_frame_length=256,
+            tm_frame_length=self.tm_frame_length,
             security=security,
             state=state,
+            routes=routes,
         )
         self._thread = threading.Thread(target=self.station.run, args=(self._stop,), daemon=True)
         self._thread.start()

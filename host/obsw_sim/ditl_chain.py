@@ -18,13 +18,28 @@ planned commands, store 2 for the routine housekeeping and the OBC's store backl
 - in a pass the ground archives what comes down, by store and time tag, and every
   ``ack_every`` s and just before LOS acknowledges what it has (``Passes.acknowledge``, after
   the ``passes.dumped`` events: through the last sequence number whose reports all came) or
-  asks again for the rest (``Passes.resend``).
+  asks again for the rest (``Passes.resend``);
+- files go through the frames (``Chain.cfdp_frames``): the ground's CFDP entity (class 2,
+  its own ``PassHold`` driven by the prediction, its file data at most ``up_rate`` octets/s)
+  puts ``up_size`` octets up and asks the OBC by proxy put for ``down_size`` octets; the
+  OBC's entity sends its PDUs into the frame processor's TM input at the rate of the stores'
+  dump (``share`` of the station's downlink rate, ``contact.downlink_bps``) and holds them
+  across passes with the OBC's own ``Passes``.
 
 ``run()`` returns the figures (a dict) and keeps the series for the plots.
 """
 
+import os
+import random
+import select
 import time
 
+from obsw.cfdp import msgs
+from obsw.cfdp.contact import PassHold
+from obsw.cfdp.defs import ACKNOWLEDGED
+from obsw.spp import TYPE_TC
+from obsw_host.cfdp.filestore import RootedFilestore
+from obsw_host.cfdp.link import UdpEntity, make_entity
 from obsw_host.obc.passes import pack_table
 from obsw_host.ops.pass_table import windows
 from obsw_host.ops.plan import plan
@@ -43,7 +58,7 @@ def chain_settings(chain, speed):
     """The chain's timers for a run at ``speed``: heartbeats and deadlines in onboard seconds
     that leave a loaded machine room (a deadline of 2 s is 20 ms here at 100 times)."""
     slack = max(1.0, speed / 2.0)
-    chain.platform.update(heartbeat=1.0, deadline=3.0 * slack, start_timeout=60.0 * slack,
+    chain.platform.update(heartbeat=1.0, deadline=6.0 * slack, start_timeout=60.0 * slack,
                           context_period=5.0, module_timeout=1.0 * slack)  # fmt: skip
     chain.sections["spacecan"] = {"heartbeat_period": 1.0, "timeout": 1.0 * slack}
     chain.sections["frames"] = {"clcw_period": 1.0}
@@ -59,7 +74,9 @@ class ChainDay:
     """One run of the whole chain (see the module text)."""
 
     def __init__(self, work, predictor, seconds, speed, out=None, hk_period=10.0,
-                 ack_every=60.0, lead=60.0, lag=30.0):  # fmt: skip
+                 ack_every=60.0, lead=60.0, lag=30.0, down_size=3_000_000,
+                 up_size=400_000, up_rate=400.0, frame_length=1024,
+                 downlink_bps=None):  # fmt: skip
         self.work = work
         self.pred = predictor
         self.station = predictor.stations[0]
@@ -73,20 +90,49 @@ class ChainDay:
                            timeout=10.0 * max(1.0, speed / 2.0))  # fmt: skip
         self.chain.sections["contact"] = {"stores": [HIGH, ROUTINE], "hold": 5.0}
         chain_settings(self.chain, speed)
+        # files through the frames; the OBC paces its dump and its file data at a share of the
+        # downlink rate (``downlink_bps``, default the station's; contact.downlink_bps: the
+        # frame processor does not pace, a radio paced in accelerated time needs a wake-up
+        # per frame)
+        self.chain.cfdp_frames = True
+        self.chain.tm_frame_length = frame_length
+        # the UARTs' queues hold a burst rather than drop it while the station reads
+        self.chain.sections["frames"].update(tm_frame_length=frame_length, uart_queue=4096)
+        self.downlink_bps = downlink_bps or self.station.downlink_bps
+        self.chain.sections["contact"]["downlink_bps"] = self.downlink_bps
+        rng = random.Random(7)
+        self.down_data = rng.randbytes(down_size)
+        self.up_data = rng.randbytes(up_size)
+        self.up_rate = up_rate
+        self.onboard_files = os.path.join(self.chain.state, "files")
+        self.ground_files = os.path.join(work, "ground-files")
+        for folder, name, data in ((self.onboard_files, "payload.bin", self.down_data),
+                                   (self.ground_files, "update.bin", self.up_data)):  # fmt: skip
+            os.makedirs(folder, exist_ok=True)
+            with open(os.path.join(folder, name), "wb") as f:
+                f.write(data)
+        self.cfdp = None  # the ground's entity (UdpEntity), once the chain is up
+        self.hold = None
+        self.cfdp_progress = {"down": [], "up": []}  # (time, octets) at each AOS
+        self.cfdp_log = []  # (time, kind, info) of the ground entity's main indications
+        self.transactions = {"down": set(), "up": set()}  # ids seen per file
         self.archive = {HIGH: {}, ROUTINE: {}}  # store -> {key: arrival (onboard s)}
         self.duplicates = 0
         self.dumped = {HIGH: [], ROUTINE: []}  # (first, last, count) of passes.dumped
         self.acked = {HIGH: 0, ROUTINE: 0}
         self.resends = 0
         self._asked = {}
+        self._resent = {}  # store -> reports asked again, not yet come twice
         self.backlog = []  # (onboard s, octets) from store 2's reports
         self.executed = {}  # planned step index -> onboard time of its TM[1,7]
+        self.started = {}  # planned step index -> onboard time of its TM[1,3]
         self.plan = []
         self.pass_use = []  # (aos, los, packets down, volume octets)
         self.series = {"t": [], "generated": [], "delivered": []}
         self.generated = {HK_HIGH: [], HK_ROUTINE: []}  # time tags seen, to count them
         self.contacts = 0
         self._tx_steps = {}  # request id -> plan step index
+        self.seen = {}  # (service, subtype) -> TM packets the ground decoded
 
     def say(self, text):
         if self.out is not None:
@@ -96,26 +142,32 @@ class ChainDay:
 
     def _tm(self, tm, decoded, tx):
         """Every TM the ground decodes: archive, dump events, plan verification."""
+        k = (tm.service, tm.subtype)
+        self.seen[k] = self.seen.get(k, 0) + 1
         if tm.service == 3 and tm.subtype == 25 and len(tm.data) >= 2:
             sid = tm.data[0] << 8 | tm.data[1]
             store = HIGH if sid == HK_HIGH else ROUTINE if sid == HK_ROUTINE else None
             if store is None:
                 return
-            key = ("hk", sid, tm.time)
-            if key in self.archive[store]:
-                self.duplicates += 1
-            self.archive[store][key] = self.onboard()
+            self._archive(store, ("hk", sid, tm.time))
             if sid == HK_ROUTINE and decoded and "values" in decoded:
                 v = decoded["values"].get("Passes.backlog")
                 if v is not None:
                     self.backlog.append((_seconds(tm), v))
-        elif tm.service == 1 and tm.subtype == 7 and decoded:
-            step = self._tx_steps.get(decoded.get("request_id"))
-            if step is not None:
-                key = ("tc", step)
-                if key in self.archive[HIGH]:
-                    self.duplicates += 1
-                self.archive[HIGH][key] = self.onboard()
+        elif tm.service == 1 and tm.subtype in (3, 7, 8) and decoded:
+            rid = decoded.get("request_id")
+            if rid is None:
+                return
+            # store 1 keeps every start and completion report: each counted, whoever asked
+            self._archive(HIGH, ("v", tm.subtype, tm.time, hash(rid)))
+            step = self._tx_steps.get(rid)
+            if step is None:
+                return
+            if tm.subtype == 3:  # the start of its execution: when it was released
+                self.started[step] = _seconds(tm)
+            elif tm.subtype == 8:
+                self.say("planned command %d failed: %r" % (step, decoded))
+            else:
                 self.executed[step] = _seconds(tm)
         elif tm.service == 5 and len(tm.data) >= 2:
             eid = tm.data[0] << 8 | tm.data[1]
@@ -123,6 +175,20 @@ class ChainDay:
                 d = self._dumped.unpack(tm.data[2:])
                 if d["store"] in self.dumped:
                     self.dumped[d["store"]].append((d["first"], d["last"], d["count"]))
+
+    def _archive(self, store, key):
+        """One report into the ground's archive; one already there is a duplicate unless the
+        ground asked for it again (``Passes.resend`` of a range: as many reports of the store
+        as the range holds may come twice)."""
+        if key in self.archive[store]:
+            if self._resent.get(store, 0) > 0:
+                self._resent[store] -= 1
+            else:
+                self.duplicates += 1
+                if self.duplicates <= 5:  # what they are, for the record
+                    self.say("a report came twice: store %d, %r, first %.1f s before" % (
+                        store, key, self.onboard() - self.archive[store][key]))  # fmt: skip
+        self.archive[store][key] = self.onboard()
 
     def onboard(self):
         return time.time() + TAI_MINUS_UNIX
@@ -152,12 +218,13 @@ class ChainDay:
         period = float(chain.config.section("pus").get("period", 0.1))
         ticks = lambda s: max(1, int(round(s / period)))  # noqa: E731
         ok = [
+            g.perform("SolarPanel.deploy").ok,  # the plan turns the panel: deployed first
             g.create_hk(HK_ROUTINE, ticks(self.hk_period * 6),
                         ["Passes.backlog", "Obc.cpu_load", "Obc.restarts"]).ok,
             g.set_hk_interval(HK_HIGH, ticks(self.hk_period)).ok,
             g.enable_hk([HK_HIGH, HK_ROUTINE]).ok,
         ]  # fmt: skip
-        for store, types, sids in ((HIGH, {3: [25], 1: [7, 8]}, [HK_HIGH]),
+        for store, types, sids in ((HIGH, {3: [25], 1: [3, 7, 8]}, [HK_HIGH]),
                                    (ROUTINE, {3: [25]}, [HK_ROUTINE])):  # fmt: skip
             ok.append(sg.create_store(store, 4_000_000, kind=1).ok)
             ok.append(sg.store_types(store, {apid: types}).ok)
@@ -184,6 +251,78 @@ class ChainDay:
             if not tx.ok:
                 raise RuntimeError("plan step %d refused: %s" % (i, tx.verification()))
 
+    def _files(self):
+        """The ground's CFDP entity on the chain's ground port, behind the station; the two
+        transfers asked (they start at the first AOS: the hold keeps them till then). Its
+        segments are 512 octets: a PDU in its space packet fits one signed TC frame."""
+        chain = self.chain
+        onboard, ground = chain.ids.cfdp_entities
+        entity = make_entity(ground, [onboard], RootedFilestore(self.ground_files),
+                             state=os.path.join(self.work, "ground-cfdp"),
+                             segment=512, limit=100, inactivity=3600.0, ack_interval=5.0,
+                             nak_interval=5.0)  # fmt: skip
+        self.cfdp = UdpEntity(entity, ("127.0.0.1", chain.cfdp_ground_port),
+                              {onboard: chain.station.address}, apid=chain.ids.apid("cfdp"),
+                              packet_type=TYPE_TC, rate=self.up_rate)  # fmt: skip
+        self.hold = PassHold(entity)
+        now = time.monotonic()
+        self.hold.update(False, now)
+        entity.put(onboard, "update.bin", "update.bin", mode=ACKNOWLEDGED, now=now)
+        entity.put(
+            onboard,
+            mode=ACKNOWLEDGED,
+            now=now,
+            messages=[msgs.proxy_put_request(ground, "payload.bin", "payload.bin")],
+        )
+        self.hold.update(False, now)
+
+    def _cfdp_step(self, in_pass, aos):
+        ent = self.cfdp.entity
+        now = time.monotonic()
+        self.hold.update(in_pass, now)
+        for ind in self.cfdp.step(0):
+            if ind.kind in ("finished", "fault", "abandoned", "suspended", "resumed"):
+                self.cfdp_log.append((time.time(), ind.kind, dict(ind.info)))
+            if ind.kind in ("finished", "fault", "abandoned"):
+                self.say("file transfer %s: %r" % (ind.kind, dict(ind.info)))
+        for t in list(ent.tx.values()):
+            meta = getattr(t, "meta", None) or {}
+            if t.role == "R" and meta.get("dest_name") == "payload.bin":
+                name = "down"
+            elif t.role == "S" and getattr(t, "source_name", None) == "update.bin":
+                name = "up"
+            else:
+                continue  # the proxy put request and its response: options only
+            self.transactions[name].add(tuple(t.tid))
+            if aos:
+                self.cfdp_progress[name].append((time.time(), t.progress_of()))
+
+    def _say_files(self):
+        st = self.chain.station
+        txs = ["%s %s %d%s" % (t.role, getattr(t, "source_name", None) or "-", t.progress_of(),
+                               " suspended" if t.suspended else "")
+               for t in self.cfdp.entity.tx.values()]  # fmt: skip
+        self.say("files at LOS: ground entity sent %d PDUs, received %d; station uplinked %d, "
+                 "refused %d; transactions: %s; TM so far %s" % (self.cfdp.sent,
+                  self.cfdp.received, st.uplinked, st.refused, ", ".join(txs) or "none",
+                  sorted(self.seen.items())))  # fmt: skip
+
+    def file_results(self):
+        """(identical, transactions, octets at each AOS) of each file."""
+        out = {}
+        for name, path, data in (("down", os.path.join(self.ground_files, "payload.bin"),
+                                  self.down_data),
+                                 ("up", os.path.join(self.onboard_files, "update.bin"),
+                                  self.up_data)):  # fmt: skip
+            try:
+                with open(path, "rb") as f:
+                    same = f.read() == data
+            except OSError:
+                same = False
+            out[name] = (same, len(self.transactions[name]),
+                         [p for _, p in self.cfdp_progress[name]])  # fmt: skip
+        return out
+
     # ---------------------------------------------------------------- the day
 
     def in_pass(self, t):
@@ -200,6 +339,8 @@ class ChainDay:
         chain = self.chain
         began = time.monotonic()
         chain.start()
+        # the two links' copies of a frame, paired however far apart a busy machine reads them
+        chain.station.ground.dedup.window = 5.0 * max(1.0, self.speed / 2.0)
         try:
             self._wait_up()
             self._setup()
@@ -208,6 +349,7 @@ class ChainDay:
             self.passes = [p for p in self.pred.passes(self.start, self.end, [self.station])
                            if p.aos > self.start + 60.0]  # fmt: skip
             self._uplink()
+            self._files()
             self.say("chain up and set in %.0f s here; %d passes to fly" % (
                 time.monotonic() - began, len(self.passes)))  # fmt: skip
             self._fly(progress)
@@ -226,27 +368,31 @@ class ChainDay:
             if now >= self.end:
                 break
             p = self.in_pass(now)
+            self._cfdp_step(p is not None, p is not None and current is None)
             if p is not None and current is None:  # AOS
                 self._carrier(True)
                 self.contacts += 1
                 current = [p.aos, p.los, sum(len(a) for a in self.archive.values()),
-                           self.station.downlink_bps * (p.los - p.aos) / 8]  # fmt: skip
+                           self.downlink_bps * (p.los - p.aos) / 8]  # fmt: skip
                 last_ack = now
             elif p is None and current is not None:  # LOS
                 self._carrier(False)
                 current[2] = sum(len(a) for a in self.archive.values()) - current[2]
                 self.pass_use.append(tuple(current))
                 current = None
+                self._say_files()
             # once more within 15 s of LOS, whatever the period
             closing = current is not None and now > current[1] - 15.0 > last_ack
             if current is not None and (now - last_ack >= self.ack_every or closing):
                 last_ack = now
                 self._acknowledge()
-            g.poll(0.05)
+            select.select([g.sock, self.cfdp.sock], [], [], 0.05)
+            g.poll(0)
             if now >= next_sample:
                 next_sample += 60.0
                 self.series["t"].append(now)
-                self.series["delivered"].append(sum(len(a) for a in self.archive.values()))
+                self.series["delivered"].append(sum(1 for k in self.archive[HIGH] if k[0] == "hk"))
+                self.series["generated"].append((now - self.start) / self.hk_period)
             if progress is not None and now >= next_progress:
                 next_progress += 3600.0
                 progress(now - self.start, self)
@@ -271,9 +417,12 @@ class ChainDay:
                         if tx.ok:
                             self.acked[store] = last
                 elif not self._asked.get(store):
-                    g.perform("Passes.resend", store=store, first=self.acked[store] + 1,
-                              last=last, timeout=10.0)  # fmt: skip
+                    first = self.acked[store] + 1
+                    # counted before it goes: a TC whose report is late may still have run
+                    self._resent[store] = self._resent.get(store, 0) + last - first + 1
                     self._asked[store] = True
+                    g.perform("Passes.resend", store=store, first=first, last=last,
+                              timeout=10.0)  # fmt: skip
                     self.resends += 1
                 else:
                     self._asked[store] = False  # asked last round: ask again next round
@@ -283,9 +432,14 @@ class ChainDay:
     # ---------------------------------------------------------------- figures
 
     def figures(self):
+        # a command's completion report comes down in the first pass after it: those planned
+        # before the AOS of the last pass flown are the ones the ground can have seen
+        horizon = max((u[0] for u in self.pass_use), default=self.start)
         planned = [(i, s.time + TAI_MINUS_UNIX) for i, s in enumerate(self.plan)
-                   if s.time < self.end]  # fmt: skip
-        lateness = [self.executed[i] - t for i, t in planned if i in self.executed]
+                   if s.time < min(horizon, self.end)]  # fmt: skip
+        # executed: completed (TM[1,7]); its time: the start of its execution (TM[1,3])
+        lateness = [self.started.get(i, self.executed[i]) - t for i, t in planned
+                    if i in self.executed]  # fmt: skip
         hk = sorted(k[2] for k in self.archive[HIGH] if k[0] == "hk")
         hk_s = [c + f / 65536.0 for c, f in hk]
         gaps = [b - a for a, b in zip(hk_s, hk_s[1:])]
@@ -312,6 +466,15 @@ class ChainDay:
             "lateness": lateness,
             "pass_use": self.pass_use,
             "obc_boots": self.chain.sim.obc_boots if self.chain.sim else None,
+            "process_restarts": sum(
+                1
+                for _, text in self.chain.sim.log_lines()
+                if "[platform]" in text and "restarting" in text
+            ),
+            "controller_resets": sum(len(r) for r in self.chain.sim.resets),
+            "files": self.file_results(),
+            "down_size": len(self.down_data),
+            "up_size": len(self.up_data),
         }
 
 

@@ -13,6 +13,7 @@ to them over the OBC UARTs too (heartbeats, context, DS3231 time).
 import collections
 import os
 import platform
+import select
 import shutil
 import signal
 import subprocess
@@ -308,6 +309,7 @@ class ReconfigSim:
         self._restart_at = [None, None]
         self._spawned_at = [0.0, 0.0]
         self._powered = {}
+        self._hung_up = {}  # fd -> until when _idle leaves it out
 
     # -- log ----------------------------------------------------------------------------------
 
@@ -378,12 +380,29 @@ class ReconfigSim:
         self._cables.append((controller_end, mine, device))
         self.obc_uart_paths.append(os.ttyname(device))
 
+    def _idle(self, timeout):
+        """Wait up to ``timeout`` s for bytes on a cable between a controller and the OBC
+        (carried at once; the supervisor's checks run at least that often). An end whose
+        other side is closed (a controller being reset) reads as ready with nothing to read:
+        it is left out for a while."""
+        now = time.monotonic()
+        fds = [fd for a, b, _ in self._cables for fd in (a, b)]
+        fds = [fd for fd in fds if self._hung_up.get(fd, 0.0) <= now]
+        if timeout > 0:
+            try:
+                select.select(fds, [], [], timeout)
+            except (OSError, ValueError):
+                time.sleep(timeout)
+
     def _carry(self):
         for a, b, _ in self._cables:
             for src, dst in ((a, b), (b, a)):
                 try:
                     data = os.read(src, 4096)
-                except (BlockingIOError, OSError):
+                except BlockingIOError:
+                    continue
+                except OSError:  # the other side closed: a controller being reset
+                    self._hung_up[src] = time.monotonic() + 0.1
                     continue
                 try:
                     os.write(dst, data)
@@ -567,7 +586,7 @@ class ReconfigSim:
             if now >= next_com:
                 next_com = now + 0.05
                 self.poll_tm()
-            time.sleep(0.005)
+            self._idle(next_com - time.monotonic())
 
     # -- faults -------------------------------------------------------------------------------
 

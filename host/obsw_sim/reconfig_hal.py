@@ -22,7 +22,7 @@ W_DRIVE = 0  # 1 while driving the D lines
 W_DATA = 1  # D lines, 2 bytes little-endian
 W_CLOCK = 3  # 0 / 1, 2 = high impedance
 W_REQ = 4
-W_ALIVE = 5
+W_ALIVE = 5  # edges of the alive line, counted modulo 256 (no edge missed between reads)
 W_KICKS = 6  # TPS3813 WDI pulses, counted modulo 256
 W_FAULT = 7  # set by the supervisor: 1 = firmware hangs with CPDU_REQ high
 W_STEPS = 8  # main loop passes modulo 256 (progress, for the supervisor)
@@ -98,6 +98,8 @@ class SimHal(Hal):
         self._rx = bytearray(512)
         self._kicks = 0
         self._steps = 0
+        self._level = 0
+        self._edges = self.wire.get(self.base + W_ALIVE)
         self.wire.put(self.base + W_REQ, b"\x00")
 
     def _open_tty(self, path):
@@ -164,7 +166,10 @@ class SimHal(Hal):
 
     def alive(self, level):
         self._steps = (self._steps + 1) & 0xFF
-        self.wire.put(self.base + W_ALIVE, bytes((level,)))
+        if level != self._level:  # an edge: the other controller's edge detector counts it
+            self._level = level
+            self._edges = (self._edges + 1) & 0xFF
+            self.wire.put(self.base + W_ALIVE, bytes((self._edges,)))
         self.wire.put(self.base + W_STEPS, bytes((self._steps,)))
         if self.wire.get(self.base + W_FAULT):
             self._hang()
@@ -177,6 +182,9 @@ class SimHal(Hal):
             time.sleep_ms(50)
 
     def other_alive(self):
+        """The other controller's alive line as its edge count: changed since the last read
+        when the line moved, however often (a level read between two passes of a loop that
+        idles may find it back where it was)."""
         return self.wire.get(self.other + W_ALIVE)
 
     def wdi(self, level):

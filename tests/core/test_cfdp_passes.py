@@ -16,15 +16,17 @@ PERIOD = 200.0  # seconds from AOS to AOS: far longer than the inactivity timer 
 WINDOWS = [(50.0 + i * PERIOD, 50.0 + i * PERIOD + PASS) for i in range(12)]
 
 
-def fly(hold=True, limit=8000.0):
+def fly(hold=True, limit=8000.0, early=0.0):
+    """``early``: the receiving side's passes end that many seconds before the sender's (it
+    is suspended while PDUs still come: a late frame, a sender that has not heard LOS)."""
     a, b = make_pair(files_a={"down.bin": DOWN}, files_b={"up.bin": UP}, mode=ACKNOWLEDGED)
     a.put(2, "down.bin", "down.bin")
     b.put(1, "up.bin", "up.bin")
     link = Link(a, b, drop=lambda side, pdu: not contacts[side].contact(link.now))
     contacts = [Contact(hold=0.5), Contact(hold=0.5)]
     holds = [PassHold(a), PassHold(b)]
-    for c in contacts:
-        c.load(WINDOWS)
+    contacts[0].load(WINDOWS)
+    contacts[1].load([(s, e - early) for s, e in WINDOWS])
     edges = []
     while link.now < limit:
         for side in (0, 1):
@@ -74,6 +76,25 @@ class TestCfdpAcrossPasses(unittest.TestCase):
         self.assertTrue(len(faults) >= 1)
         self.assertTrue(all(c != NO_ERROR for c in faults))
         self.assertTrue(len(link.kinds(0, "abandoned")) >= 1)  # its sender gave up
+
+    def test_pdus_that_reach_a_suspended_receiver_move_no_timer(self):
+        # b's passes end before a's: a's file data reach b suspended; its inactivity timer
+        # must not run from them through the 194 s out of contact (it is 30 s)
+        a, b, link, holds, edges = fly(early=2.0)
+        self.assertEqual(bytes(b.fs.files["down.bin"]), DOWN)
+        self.assertEqual(link.kinds(1, "fault"), [])
+
+    def test_a_timer_started_while_suspended_runs_from_the_resume(self):
+        from obsw.cfdp.timers import Timer
+
+        t = Timer(30.0)
+        t.start(0.0)
+        t.suspend(10.0)
+        t.start(12.0)  # a PDU while suspended
+        self.assertFalse(t.expired(1000.0))
+        t.resume(1000.0)
+        self.assertFalse(t.expired(1029.0))
+        self.assertTrue(t.expired(1030.0))
 
     def test_a_transfer_the_user_suspended_stays_suspended(self):
         a, b = make_pair(files_a={"down.bin": DOWN}, mode=ACKNOWLEDGED)

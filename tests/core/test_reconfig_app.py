@@ -37,7 +37,9 @@ class Rig:
         for _ in range(n):
             for bus, can_id, data in self.ctrl.take_frames():
                 self.hal.can_rx[bus].append((can_id, data))
-            self.hal.idle(self.app.step())
+            ms = self.app.step()
+            self.at = self.now()  # the time of the last pass (the idle after it moves on)
+            self.hal.idle(ms)
             for bus, can_id, data in self.hal.can_tx:
                 self.ctrl.receive(bus, can_id, data, self.now())
             self.hal.can_tx = []
@@ -116,9 +118,9 @@ class TestEssential(unittest.TestCase):
         r.app.lines(0xFFF, 0x003)
         r.hal.uart_rx[0].extend(hpc_cltu(E.Hpc(E.HPC_POWER_CYCLE, (0, 300))))
         r.until(lambda: r.hal.q == 0x002)
-        t_off = r.now()
+        t_off = r.at  # the pass that switched the line off
         r.until(lambda: r.hal.q == 0x003)
-        self.assertTrue(r.now() - t_off >= 0.3)
+        self.assertTrue(r.at - t_off >= 0.3)
         self.assertEqual(r.app.essential.counters["hpcs"], 1)
         r.step(10)
         dec = CaduDecoder(64)
@@ -250,3 +252,23 @@ class TestHealth(unittest.TestCase):
         self.assertTrue(r.app.counters["loop_errors"] > 0)
         self.assertEqual(r.hal.kick_count, n)
         self.assertFalse(r.app.healthy(r.now()))
+
+
+class TestIdle(unittest.TestCase):
+    def test_the_loop_idles_until_its_next_deadline(self):
+        r = Rig()
+        r.step(5)
+        ms = r.app.step()
+        now_ms = r.hal.now // 1000
+        kick = r.app.watchdog.next_deadline()
+        self.assertTrue(0 <= ms <= max(0, kick - now_ms) + 1)
+        self.assertTrue(ms <= r.app.takeover_ms // 4)
+        # ten seconds of a quiet bus: far fewer passes than a 10 ms poll, no kick late
+        steps = r.app.counters["steps"]
+        end = r.hal.now + 10_000_000
+        while r.hal.now < end:
+            r.step()
+        passes = r.app.counters["steps"] - steps
+        self.assertTrue(passes < 500, passes)
+        self.assertEqual(r.app.watchdog.late, 0)
+        self.assertTrue(r.app.watchdog.kicks >= 10_000 // r.app.watchdog.target_ms - 1)

@@ -77,3 +77,33 @@ def test_only_a_rate_the_sender_reaches_grows():
         assert udp.rate == rate * 1.1
     finally:
         udp.close()
+
+
+def test_a_fixed_rate_below_ten_segments_a_second_sends():
+    import socket
+    import time
+
+    from obsw.spp import SpacePacket
+
+    rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    rx.bind(("127.0.0.1", 0))
+    rx.setblocking(False)
+    fs = MemoryFilestore()
+    fs.files["f.bin"] = bytearray(4 * SEG)
+    ent = make_entity(1, [2], fs, segment=SEG, persist=False)
+    udp = UdpEntity(ent, ("127.0.0.1", 0), {2: rx.getsockname()}, apid=100, rate=SEG / 2)
+    try:
+        ent.put(2, "f.bin", "f.bin", now=time.monotonic())
+        data = 0
+        end = time.monotonic() + 30.0
+        while not data and time.monotonic() < end:
+            udp.step(0.05)
+            try:
+                pdu = SpacePacket.unpack(rx.recv(70000)).data
+            except BlockingIOError:
+                continue
+            data += bool(pdu[0] & 0x10)  # a file data PDU (not a directive)
+        assert data
+    finally:
+        udp.close()
+        rx.close()

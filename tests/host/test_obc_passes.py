@@ -173,3 +173,16 @@ def test_a_restart_goes_on_after_the_last_packet_sent(tmp_path):
     clock.t = 1002.0
     again.step()
     assert sent[4:] == [b"H00004"]  # nothing twice
+
+
+def test_a_restart_keeps_the_pass_table(tmp_path):
+    path = str(tmp_path / "passes.json")
+    p, storage, clock, sent, _ = make()
+    p.path = path
+    p.load(pack_table([(1000, 1100), (2000, 2100)]))
+    again = Passes(storage, lambda raw, vc: sent.append(raw), clock, lambda n, v: None,
+                   stores=(1, 2), bps=8000.0, share=1.0, clock=clock, path=path)  # fmt: skip
+    assert again.passes == 2
+    clock.t = 1050.0
+    again.step()
+    assert again.contact.in_contact

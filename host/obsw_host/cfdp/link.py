@@ -211,9 +211,11 @@ class UdpEntity:
         limit = 64
         self._grow(now)
         if self.rate is not None:
-            self._budget = min(self.rate * 0.1, self._budget + (now - self._last) * self.rate)
-            self._last = now
             seg = max(1, max((r.max_segment for r in ent.mib.remotes.values()), default=1024))
+            # a tenth of a second's worth, and never less than a segment (a slow rate sends)
+            cap = max(self.rate * 0.1, seg)
+            self._budget = min(cap, self._budget + (now - self._last) * self.rate)
+            self._last = now
             limit = max(0, int(self._budget // seg))
         out = ent.transmit(now, limit)
         for dest, pdu in out:

@@ -93,7 +93,7 @@ class Ground:
         else:
             self.decoders = [CodedInput(tm_decoder(), getattr(link, "soft", False))
                              for link in self.links]  # fmt: skip
-        self.dedup = Deduplicator(5.0)
+        self.dedup = Deduplicator(5.0, depth=4096)  # one link may lag by a burst
         self.demux = TmDemultiplexer(scid, security=tm_security)
         self.queue = deque()
         self.notifications = []

@@ -3,7 +3,9 @@
 TC packets that arrive on the station's UDP socket go up through FOP-1 (AD service, MAP
 ``map_id``) as CLTUs on every link; TM frames read from the links are decoded and their
 packets go, unchanged, to the mission control process (``mcs``, or whoever sent the last TC)
-on UDP. ``downlinked`` keeps (VC ID, packet) of the packets forwarded, so a test or the demo
+on UDP; ``routes`` (APID -> UDP address) sends the packets of those APIDs elsewhere (a ground
+CFDP entity, say), whose TC packets then go up without taking the mission control process's
+place. ``downlinked`` keeps (VC ID, packet) of the packets forwarded, so a test or the demo
 can tell real-time telemetry from playback.
 
 ``GroundStation.for_mission(ids, links)`` configures it from a mission (SCID, TC VC and MAP,
@@ -26,9 +28,19 @@ class GroundStation:
     """``Ground`` (FOP-1, CLTUs, TM decoding) between ``links`` and one UDP socket."""
 
     def __init__(
-        self, links, scid, host=DEFAULT_HOST, port=0, mcs=None, keep=10000, clock=None, **options
+        self,
+        links,
+        scid,
+        host=DEFAULT_HOST,
+        port=0,
+        mcs=None,
+        keep=10000,
+        clock=None,
+        routes=None,
+        **options,
     ):
         self.ground = Ground(links, scid, **options)
+        self.routes = dict(routes or {})
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind((host, port))
         self.sock.setblocking(False)
@@ -72,7 +84,7 @@ class GroundStation:
                 packet, sender = self.sock.recvfrom(65542)
             except OSError:
                 break
-            if self.mcs is None or self.mcs != sender:
+            if self.mcs != sender and sender not in self.routes.values():
                 self.mcs = sender
             try:
                 self.ground.send(packet, now)
@@ -85,9 +97,12 @@ class GroundStation:
         while ch:
             vcid, packet = ch.popleft()
             self.downlinked.append((vcid, packet))
-            if self.mcs is not None:
+            to = self.mcs
+            if self.routes and len(packet) >= 2:
+                to = self.routes.get((packet[0] & 7) << 8 | packet[1], to)
+            if to is not None:
                 try:
-                    self.sock.sendto(packet, self.mcs)
+                    self.sock.sendto(packet, to)
                 except OSError:
                     pass  # the mission control process is gone: UDP drops it
         self.ground.packets.clear()  # kept in ``downlinked`` with their VC

@@ -14,7 +14,8 @@ a TM that one of those stores keeps does not go out in real time: it waits in th
 in contact ``StoreForward`` (``obsw.frames.downlink``) hands it to the store's virtual channel
 in storage order, by priority, at ``share`` of the downlink rate and only what the pass can
 still carry; where it stands in each store is kept in the state folder (``passes.json``), so
-a restarted process goes on after the last packet it sent. Each cycle that sent packets of
+a restarted process goes on after the last packet it sent, and so is the pass table last
+loaded (``passes.json.table``), so it knows its passes at once. Each cycle that sent packets of
 a store raises the event ``passes.dumped`` (store, first and last storage sequence number,
 count); the ground acknowledges what it has
 with TC[8,1] ``Passes.acknowledge`` (store, seq: deletes through it, the room is free again)
@@ -117,6 +118,7 @@ class Passes:
         self.dumped = 0
         self._last = None
         self._credit = 0.0
+        self._restore_table()
 
     def _restore(self):
         import json
@@ -143,6 +145,35 @@ class Passes:
         except OSError:
             pass  # a full disk: after a restart the unacknowledged packets go again
 
+    def _table_path(self):
+        return None if self.path is None else self.path + ".table"
+
+    def _restore_table(self):
+        """The pass table last loaded (kept beside the pointers): a restarted process knows
+        its passes without waiting for the ground to load them again."""
+        path = self._table_path()
+        if path is None:
+            return
+        try:
+            with open(path, "rb") as f:
+                self.contact.load(unpack_table(f.read()))
+        except (OSError, ValueError, PassTableError):
+            return  # none yet, or unreadable: the ground loads it again
+        self.passes = len(self.contact.windows)
+
+    def _save_table(self, table):
+        import os
+
+        path = self._table_path()
+        if path is None:
+            return
+        try:
+            with open(path + ".part", "wb") as f:
+                f.write(bytes(table))
+            os.replace(path + ".part", path)
+        except OSError:
+            pass  # a full disk: after a restart the ground loads the table again
+
     def il_bind(self, provider):
         self.il = provider
 
@@ -163,6 +194,7 @@ class Passes:
             self.contact.load(unpack_table(table))
         except PassTableError as e:
             raise ComponentError("BAD_TABLE", str(e)) from None
+        self._save_table(table)
         self._set("passes", len(self.contact.windows))
         return True
 

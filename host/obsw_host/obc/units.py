@@ -62,6 +62,18 @@ class PlatformEvents:
         return self.app.event(e.id, e.severity, e.pack({"process": process, "pid": pid}))
 
 
+def space_link_timers(remote):
+    """CFDP timers for a peer across the space link (contact awareness on): the round trip
+    goes through COP-1 and the frames, behind the stores' dump, so the UDP values (1 s, ten
+    tries, 60 s of inactivity) would give up within a pass; here 5 s, 30 tries, 30 minutes."""
+    remote.ack_interval = max(remote.ack_interval, 5.0)
+    remote.nak_interval = max(remote.nak_interval, 5.0)
+    remote.check_interval = max(remote.check_interval, 5.0)
+    remote.ack_limit = max(remote.ack_limit, 30)
+    remote.nak_limit = max(remote.nak_limit, 30)
+    remote.inactivity = max(remote.inactivity, 1800.0)
+
+
 async def drive_transport(transport, node):
     """Serve a ``SocketTransport`` from an asyncio loop: its sockets wake the loop."""
     loop = asyncio.get_running_loop()
@@ -225,7 +237,8 @@ class PusUnit:
 
     def _passes(self, topology):
         """Contact awareness (``obsw_host.obc.passes``): the pass table, the stores' dump,
-        CFDP held across passes."""
+        CFDP held across passes and its file data at the dump's rate (``share`` of the
+        downlink rate: a sender paced by losses would flood the radio's queue first)."""
         from obsw_host.frames.coding import LinkSettings
 
         opts = topology.section("contact")
@@ -244,6 +257,11 @@ class PusUnit:
         )
         if passes.enabled:
             self.app.tm_filters.append(passes.realtime)
+            if self.cfdp is not None:  # files share the passes' radio: paced to the dump's rate
+                self.cfdp.rate = passes.cycle_octets
+                self.cfdp.pace = False
+                for r in self.cfdp.entity.mib.remotes.values():
+                    space_link_timers(r)
         self.onboard.tc_listeners.append(passes.heard)
         return passes
 

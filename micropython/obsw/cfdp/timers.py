@@ -10,10 +10,15 @@ class Timer:
         self.deadline = None
         self.count = 0
         self._left = None  # remaining time while suspended
+        self._held = False  # suspended: a start waits for the resume
 
     def start(self, now, reset_count=False):
-        self.deadline = None if self.interval is None else now + self.interval
-        self._left = None
+        if self._held:  # started while its transaction is suspended: runs from the resume
+            self.deadline = None
+            self._left = self.interval
+        else:
+            self.deadline = None if self.interval is None else now + self.interval
+            self._left = None
         if reset_count:
             self.count = 0
 
@@ -35,11 +40,15 @@ class Timer:
         return self.count > self.limit
 
     def suspend(self, now):
+        """Freeze: what is left waits for ``resume``, and so does a ``start`` meanwhile (a PDU
+        that arrives while the transaction is suspended moves no timer on)."""
         if self.deadline is not None:
             self._left = max(0, self.deadline - now)
             self.deadline = None
+        self._held = True
 
     def resume(self, now):
+        self._held = False
         if self._left is not None:
             self.deadline = now + self._left
             self._left = None

@@ -59,6 +59,7 @@ H_IN_CHARGE = const(0x20)
 
 _STATE_FMT = ">HBBBBH"
 FRAMES_PER_BUS = const(32)  # SpaceCAN frames taken from each bus per loop pass
+IDLE_MAX_MS = const(250)  # the longest idle of the main loop between passes
 
 
 def _sdls_record(security):
@@ -535,8 +536,28 @@ class ReconfigApp:
         )
 
     def _idle_ms(self, now):
-        best = 10
-        for t in (self.essential.next_deadline(), self.sync.next_deadline()):
+        """Milliseconds until the loop has something to do that no input announces: the next
+        deadline of the essential writes, the time sync, the SpaceCAN node, the recovery, the
+        status, the report, the save and the watchdog kick, and at most IDLE_MAX_MS and a
+        quarter of ``takeover_ms`` (the alive line the other controller watches toggles once a
+        pass). A HAL's ``idle`` returns early when input comes (a board sleeps till then)."""
+        best = IDLE_MAX_MS
+        if self.takeover_ms // 4 < best:
+            best = self.takeover_ms // 4
+        ts = [
+            self.essential.next_deadline(),
+            self.sync.next_deadline(),
+            self.node.responder.next_deadline(),
+            self.recovery.next_deadline(),
+            self._next_status,
+            self._next_report,
+        ]
+        if self._dirty:
+            ts.append(self._next_save)
+        kick = self.watchdog.next_deadline()
+        if kick is not None:
+            ts.append(kick / 1000)
+        for t in ts:
             if t is not None:
                 ms = int((t - now) * 1000) + 1 if t > now else 0
                 if ms < best:

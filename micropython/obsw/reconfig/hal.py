@@ -71,7 +71,8 @@ class Hal:
         """Own alive line, toggled by the main loop; the other controller watches it."""
 
     def other_alive(self):
-        """The other controller's alive line level (None if not wired)."""
+        """The other controller's alive line: its level, or a count of its edges (anything
+        that changes when the line moves); None if not wired."""
         return None
 
     def wdi(self, level):

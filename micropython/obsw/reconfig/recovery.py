@@ -155,6 +155,12 @@ class Recovery:
         elif obc == 2:
             self.active = 1
 
+    def next_deadline(self):
+        """When ``poll`` may next act (None: not before something else happens)."""
+        if not self.enabled or self._pending is not None:
+            return None
+        return self._due
+
     def poll(self, now, bits):
         """The action due now, or None. ``bits``: the latched CPDU state (None: unknown)."""
         self.observe(bits, now)

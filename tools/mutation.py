@@ -109,7 +109,7 @@ EQUIVALENT = {
     "progress, and every gap ends at or below it: no gap starts at it",
     ("cfdp/sender.py", 268, "ReplaceTrueWithFalse"): "Transaction.save ignores force: every "
     "save writes the state",
-    ("reconfig/recovery.py", 166, "ReplaceBinaryOperator_Add_Sub"): "while the OBC lines read 0 "
+    ("reconfig/recovery.py", 172, "ReplaceBinaryOperator_Add_Sub"): "while the OBC lines read 0 "
     "every poll returns None whatever the deadline, and the first change of the lines sets it "
     "afresh",
     ("frames/fop.py", 401, "NumberReplacer"): "Look for Directive runs only in state S5 "

@@ -41,7 +41,8 @@ def _free_base():
             return port + 1
 
 
-def test_for_apid_follows_ports_fixed_by_name():
+def test_for_apid_follows_ports_fixed_by_name(monkeypatch):
+    monkeypatch.delenv("OBSW_PORT_BASE", raising=False)  # it would move the base given here
     ports = Ports(6000, {"pus": 10, "cfdp": 100, "frames": 12}, {"pus": 7001, "cfdp": 7002})
     assert ports.for_apid(10) == 7001 and ports.for_apid(100) == 7002
     assert ports.for_apid(12) == 6012 and ports.for_apid(11) == 6011

@@ -45,6 +45,11 @@ PASSES = (
     "files of 30 KB in RAM filestores at both ends of a transfer across passes (the data, "
     "the partial file, the expected copy): beyond a 103 KiB heap"
 )
+RESTART = (
+    "the PUS application before and after a restart, both with their services, in one heap "
+    "beside the ground's user process: beyond a 103 KiB heap"
+)
+MIB = "a manifest of 1 MiB and one of 1 MiB + 1 octet: ten times the Pyboard's heap"
 VITERBI = (
     "the ground's soft-decision Viterbi decoder over a four-frame stream (64 path metrics, the "
     "traceback window) beyond a 103 KiB heap: the board only encodes"
@@ -96,6 +101,9 @@ CORTEX_M_SKIPS = {
     "test_reconfig_time.py::TestWatchdog::test_unhealthy_is_reset_by_timeout": EEPROM,
     "test_reconfig_time.py::TestWatchdog::test_window_respected_with_jittery_loop": EEPROM,
     "test_spp.py::TestSpacePacket::test_largest_packet": BIG,
+    "test_pus_s22_position_scheduling.py::TestPositionScheduling::"
+    "test_restart_keeps_the_schedule": RESTART,
+    "test_update_boundaries.py::TestManifestLength::test_a_manifest_of_one_mib_at_most": MIB,
 }
 # the board's test runner collects after every 8 KiB allocated (gc.threshold), as a small-heap
 # application does: collecting only when the heap is exhausted scatters the live objects of a

@@ -85,11 +85,13 @@ def test_context_and_time_across_a_restart(cables, tmp_path):
     for _ in range(5):
         app.sequence.next(42)
     assert link.save() == 2  # both controllers keep it
-    assert said[-1] == "module link: context kept by 2 of 2 controllers"
+    assert said[-1] == "module link: context kept by 2 of 2 controllers (TM counts of APID 42)"
     link.save()
-    assert (
-        said[-1] == "module link: context kept by 2 of 2 controllers"
-    )  # logged once, not per save
+    assert said[-1] == "module link: context kept by 2 of 2 controllers (TM counts of APID 42)"
+    assert said.count(said[-1]) == 1  # logged once, not per save
+    app.sequence.next(7)
+    link.save()  # a save that carries another APID's counts is said
+    assert said[-1] == "module link: context kept by 2 of 2 controllers (TM counts of APIDs 7, 42)"
     assert said.count(said[-1]) == 1
     link.close()
 
@@ -97,7 +99,7 @@ def test_context_and_time_across_a_restart(cables, tmp_path):
     link, app, clock = start(cables, tmp_path, said)  # the OBC starts again
     ctx = link.restore()
     assert app.sequence.peek(42) == 5  # its TM counts go on
-    assert ctx.boots == 2 and ctx.saves == 2
+    assert ctx.boots == 2 and ctx.saves == 3
     assert any(s.startswith("module link: context restored") for s in said)
     link.close()
 

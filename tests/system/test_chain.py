@@ -91,12 +91,15 @@ def restored_context(chain):
 
 
 def in_stride(chain):
-    """The OBC in its stride: since its last start a context save reached the module (its
-    heartbeats flow on the same UARTs), and no TC frame is outstanding."""
+    """The OBC in its stride: since its last start a context save that carries its TM counts
+    reached the module (its heartbeats flow on the same UARTs), and no TC frame is
+    outstanding."""
     texts = [text for _, text in chain.sim.log_lines()]
     starts = [i for i, t in enumerate(texts) if "module link: context restored" in t
               or "module link: no context kept" in t]  # fmt: skip
-    kept = starts and any("module link: context kept by" in t for t in texts[starts[-1] :])
+    kept = starts and any(
+        "module link: context kept by" in t and "TM counts" in t for t in texts[starts[-1] :]
+    )
     return bool(kept) and chain.station.ground.fop.outstanding == 0
 
 

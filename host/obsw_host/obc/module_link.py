@@ -52,6 +52,7 @@ class ModuleLink:
         self.say = say
         self.context = ObcContext()
         self.kept = 0  # controllers that acknowledged the last save
+        self.apids = []  # the APIDs whose TM counts the last save logged carried
 
     def restore(self, timeout=1.0):
         """Time and context from the module at start; the context (a first start: empty)."""
@@ -99,8 +100,21 @@ class ModuleLink:
             ctx.obcps = [n for n in self.engine.obcps if states.get(n, INACTIVE) != INACTIVE]
         ctx.saves += 1
         kept = self.link.write_context(ctx, timeout)
-        if kept != self.kept:  # the first save that was kept, then each change
-            self.say("module link: context kept by %d of %d controllers" % (kept, len(self.fds)))
+        apids = sorted(int(a) for a in ctx.seq)
+        # the first save that was kept, then each change in how many keep it or in the APIDs
+        # whose TM counts it carries (a first start's first saves may carry none)
+        if kept != self.kept or (kept and apids != self.apids):
+            counts = ""
+            if apids:
+                counts = " (TM counts of APID%s %s)" % (
+                    "s" if len(apids) > 1 else "",
+                    ", ".join(str(a) for a in apids),
+                )
+            self.say(
+                "module link: context kept by %d of %d controllers%s"
+                % (kept, len(self.fds), counts)
+            )
+            self.apids = apids
         self.kept = kept
         return kept
 

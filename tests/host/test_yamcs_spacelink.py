@@ -5,6 +5,7 @@ completes, symbol errors were corrected, no frame was lost. Skipped without Java
 
 import socket
 import threading
+import time
 
 import pytest
 from obsw_host.frames.coding import LinkSettings
@@ -65,6 +66,11 @@ def test_yamcs_over_the_coded_noisy_link(tmp_path):
             cmd = proc.create_command_connection().issue(MISSION + "/PUS/ping")
             cmd.await_complete(timeout=TIMEOUT)
             assert cmd.is_success(), cmd.error
+            # enough frames on the air for the coding figures to mean something, however fast
+            # Yamcs came up
+            deadline = time.monotonic() + TIMEOUT
+            while space.relay.frames <= 10 and time.monotonic() < deadline:
+                time.sleep(0.1)
         finally:
             yamcs.stop()
         coding = space.relay.coding()

@@ -8,6 +8,8 @@ process. ``tree(pid)`` is the process and every process below it.
 
 import os
 
+from obsw_sim.reconfig import descendants
+
 TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
 
 
@@ -43,23 +45,7 @@ def _name(argv):
 
 def tree(pid):
     """``pid`` and the pids of its children, grandchildren, ..."""
-    out = [pid]
-    todo = [pid]
-    while todo:
-        p = todo.pop()
-        try:
-            tasks = os.listdir("/proc/%d/task" % p)
-        except OSError:
-            continue
-        for t in tasks:
-            try:
-                with open("/proc/%d/task/%s/children" % (p, t)) as f:
-                    kids = [int(x) for x in f.read().split()]
-            except (OSError, ValueError):
-                continue
-            out += kids
-            todo += kids
-    return out
+    return [pid] + descendants(pid)
 
 
 def sample(pids, seconds, wait):

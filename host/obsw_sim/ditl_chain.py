@@ -228,7 +228,7 @@ class ChainDay:
                                    (ROUTINE, {3: [25]}, [HK_ROUTINE])):  # fmt: skip
             ok.append(sg.create_store(store, 4_000_000, kind=1).ok)
             ok.append(sg.store_types(store, {apid: types}).ok)
-            ok.append(sg.issue(sg.storage.add_hk(apid, store, {apid: sids})).ok)
+            ok.append(sg.store_hk(store, sids).ok)  # these only, each in one store
         ok.append(sg.enable_storage([HIGH, ROUTINE]).ok)
         if not all(ok):
             raise RuntimeError("the day's stores and housekeeping were not set up: %r" % ok)

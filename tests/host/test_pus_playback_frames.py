@@ -72,3 +72,20 @@ def test_a_store_on_the_realtime_vc_plays_back_in_real_time(tmp_path):
         )
         vcs = {vc for vc, p in _since(station, mark) if _kind(p) == (17, 2)}
         assert vcs == {REALTIME_VCID}
+
+
+def test_a_store_keeps_the_housekeeping_structures_named_only(tmp_path):
+    # a new store keeps every structure of its APID; structures added to "every" would change
+    # nothing, so StorageGround.store_hk deletes that selection first
+    with Segment(str(tmp_path)) as seg:
+        sg, apid = seg.sg, seg.ground.apid
+        assert sg.create_store(STORE, 65536).ok
+        report = lambda: sg.issue(sg.storage.report_hk(apid, STORE)).reply  # noqa: E731
+        assert report() == {"store": STORE, "hk": {apid: []}}
+        assert sg.store_hk(STORE, [1]).ok
+        assert report() == {"store": STORE, "hk": {apid: [1]}}
+        assert sg.store_hk(STORE, [2, 3]).ok  # again: these replace the last ones
+        assert report() == {"store": STORE, "hk": {apid: [2, 3]}}
+        assert sg.store_hk(STORE, []).ok  # none named: every structure again
+        assert report() == {"store": STORE, "hk": {apid: []}}
+        assert not sg.store_hk(STORE + 1, [1]).ok  # no such store: refused

@@ -88,7 +88,7 @@ def test_pass_table_store_and_forward(tmp_path):
         apid = g.apid
         assert sg.create_store(STORE, 200_000, kind=1).ok
         assert sg.store_types(STORE, {apid: {3: [25]}}).ok
-        assert sg.issue(sg.storage.add_hk(apid, STORE, {apid: [HK_SID]})).ok
+        assert sg.store_hk(STORE, [HK_SID]).ok
         assert sg.enable_storage([STORE]).ok
         watch = Watch(chain)
 

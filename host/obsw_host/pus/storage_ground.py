@@ -100,6 +100,16 @@ class StorageGround:
     def store_types(self, store, selection):
         return self.issue(self.storage.add_types(self.apid, store, selection))
 
+    def store_hk(self, store, sids, apid=None):
+        """The store keeps housekeeping structures ``sids`` of ``apid`` only. A new store keeps
+        every structure of its APID, as real-time forwarding does, and structures added to
+        "every" change nothing: this deletes the APID's selection first (TC[15,30]; refused
+        when it had none, which is as good), then adds ``sids`` (TC[15,29], returned)."""
+        apid = apid or self.apid
+        self.issue(self.storage.delete_hk(self.apid, store, {apid: []}))
+        selection = {apid: list(sids)}
+        return self.issue(self.storage.add_hk(self.apid, store, selection))
+
     def enable_storage(self, stores=()):
         return self.issue(self.storage.enable(self.apid, stores))
 

@@ -38,7 +38,7 @@ def common(day, f):
         same, count, prog = f["files"][name]
         files[name] = {"size": f[name + "_size"], "identical": same, "transactions": count,
                        "progress": prog}  # fmt: skip
-    return dict(f, passes=f["contacts"], hk_due=f["hk_high"], files=files,
+    return dict(f, passes=f["contacts"], files=files,
                 overflow=f["max_backlog"] >= f["store_size"],
                 store_detail="largest backlog %d octets of %d" % (
                     f["max_backlog"], f["store_size"]))  # fmt: skip

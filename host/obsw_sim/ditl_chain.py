@@ -15,10 +15,14 @@ planned commands, store 2 for the routine housekeeping and the OBC's store backl
 - the station's links carry nothing out of a pass (``FdLink.carrier``, set from the same
   prediction): the OBC knows its passes from the table only; nothing is sent to it out of
   contact;
-- in a pass the ground archives what comes down, by store and time tag, and every
-  ``ack_every`` s and just before LOS acknowledges what it has (``Passes.acknowledge``, after
-  the ``passes.dumped`` events: through the last sequence number whose reports all came) or
-  asks again for the rest (``Passes.resend``);
+- in a pass the ground archives what comes down by the PUS message type counter of each
+  stored type (housekeeping TM[3,25], verification TM[1,3], [1,7], [1,8]: each counter
+  counts every report of its type, so a number missing between two that came is a report
+  lost), and every ``ack_every`` s and just before LOS, when no number is missing,
+  acknowledges (``Passes.acknowledge``) through the last storage sequence number the
+  ``passes.dumped`` events had named one round before (a report lost since would show as a
+  missing number by now), else asks again for everything after its last acknowledgement
+  (``Passes.resend``);
 - files go through the frames (``Chain.cfdp_frames``): the ground's CFDP entity (class 2,
   its own ``PassHold`` driven by the prediction, its file data at most ``up_rate`` octets/s)
   puts ``up_size`` octets up and asks the OBC by proxy put for ``down_size`` octets; the
@@ -122,6 +126,7 @@ class ChainDay:
         self.acked = {HIGH: 0, ROUTINE: 0}
         self.resends = 0
         self._asked = {}
+        self._ready = {}  # store -> the last sequence number dumped, as of the last round
         self._resent = {}  # store -> reports asked again, not yet come twice
         self.backlog = []  # (onboard s, octets) from store 2's reports
         self.executed = {}  # planned step index -> onboard time of its TM[1,7]
@@ -149,7 +154,7 @@ class ChainDay:
             store = HIGH if sid == HK_HIGH else ROUTINE if sid == HK_ROUTINE else None
             if store is None:
                 return
-            self._archive(store, ("hk", sid, tm.time))
+            self._archive(store, (3, 25, tm.message_counter))
             if sid == HK_ROUTINE and decoded and "values" in decoded:
                 v = decoded["values"].get("Passes.backlog")
                 if v is not None:
@@ -159,7 +164,7 @@ class ChainDay:
             if rid is None:
                 return
             # store 1 keeps every start and completion report: each counted, whoever asked
-            self._archive(HIGH, ("v", tm.subtype, tm.time, hash(rid)))
+            self._archive(HIGH, (1, tm.subtype, tm.message_counter))
             step = self._tx_steps.get(rid)
             if step is None:
                 return
@@ -391,31 +396,39 @@ class ChainDay:
             if now >= next_sample:
                 next_sample += 60.0
                 self.series["t"].append(now)
-                self.series["delivered"].append(sum(1 for k in self.archive[HIGH] if k[0] == "hk"))
+                self.series["delivered"].append(sum(1 for k in self.archive[HIGH] if k[0] == 3))
                 self.series["generated"].append((now - self.start) / self.hk_period)
             if progress is not None and now >= next_progress:
                 next_progress += 3600.0
                 progress(now - self.start, self)
         self._carrier(False)
 
+    def _missing(self):
+        """Reports missing: per stored type, the message type counters between the first and
+        the newest that came (16 bits: a day's reports of one type do not wrap)."""
+        seen = {}
+        for a in self.archive.values():
+            for service, subtype, counter in a:
+                seen.setdefault((service, subtype), set()).add(counter)
+        return {k: max(c) - min(c) + 1 - len(c) for k, c in seen.items()}
+
     def _acknowledge(self):
-        """Acknowledge, per store, through the last sequence number dumped when every packet
-        dumped so far came; else ask again for those after the last acknowledgement."""
+        """With no report missing, acknowledge per store through the last sequence number
+        dumped as of the last round; else ask again for all after the last acknowledgement."""
         g = self.chain.ground
+        missing = sum(self._missing().values())
         for store in (HIGH, ROUTINE):
             dumps = self.dumped[store]
             if not dumps:
                 continue
-            seqs = set()
-            for first, last, _count in dumps:
-                seqs.update(range(first, last + 1))
-            last = max(seqs)
+            last = max(d[1] for d in dumps)
+            ready, self._ready[store] = self._ready.get(store, 0), last
             try:
-                if len(self.archive[store]) >= len(seqs):
-                    if last > self.acked[store]:
-                        tx = g.perform("Passes.acknowledge", store=store, seq=last, timeout=10.0)
+                if not missing:
+                    if ready > self.acked[store]:
+                        tx = g.perform("Passes.acknowledge", store=store, seq=ready, timeout=10.0)
                         if tx.ok:
-                            self.acked[store] = last
+                            self.acked[store] = ready
                 elif not self._asked.get(store):
                     first = self.acked[store] + 1
                     # counted before it goes: a TC whose report is late may still have run
@@ -440,12 +453,10 @@ class ChainDay:
         # executed: completed (TM[1,7]); its time: the start of its execution (TM[1,3])
         lateness = [self.started.get(i, self.executed[i]) - t for i, t in planned
                     if i in self.executed]  # fmt: skip
-        hk = sorted(k[2] for k in self.archive[HIGH] if k[0] == "hk")
-        hk_s = [c + f / 65536.0 for c, f in hk]
-        gaps = [b - a for a, b in zip(hk_s, hk_s[1:])]
-        # every report from the first to the last delivered came: no gap beyond the period
-        missing = sum(int(round(d / self.hk_period)) - 1 for d in gaps
-                      if d > 1.5 * self.hk_period)  # fmt: skip
+        # every housekeeping report from the first to the newest delivered came: no message
+        # type counter of TM[3,25] missing between them (both stores' structures count)
+        hk = sorted(k[2] for a in self.archive.values() for k in a if k[0] == 3)
+        missing = self._missing().get((3, 25), 0)
         orbit_s = 86400.0 / self.pred.tle.mean_motion
         return {
             "hours": self.seconds / 3600.0,
@@ -453,7 +464,7 @@ class ChainDay:
             "passes": len(self.passes),
             "contacts": self.contacts,
             "delivered": {s: len(a) for s, a in self.archive.items()},
-            "hk_high": len(hk),
+            "hk_due": hk[-1] - hk[0] + 1 if hk else 0,
             "missing": missing,
             "duplicates": self.duplicates,
             "resends": self.resends,

@@ -4,7 +4,7 @@
 import unittest
 
 from obsw.frames.contact import AOS, LOS, MAX_WINDOWS, Contact, PassTableError
-from obsw.frames.downlink import StoreForward
+from obsw.frames.downlink import RESEND_RANGES, StoreForward
 from obsw.pus.services.packet_store import BOUNDED, PacketStore
 
 
@@ -138,6 +138,31 @@ class TestStoreForward(unittest.TestCase):
         self.assertIsNone(fw.next(3.0))
         with self.assertRaises(KeyError):
             fw.acknowledge(9, 1)
+
+    def test_a_long_range_goes_again_and_ranges_are_bounded(self):
+        events, hk = _stores()
+        c = Contact()
+        c.load([(0, 1000)])
+        fw = StoreForward([events, hk], c, bps=800000)
+        for i in range(100):
+            hk.append(float(i), _packet(2))
+        while fw.next(1.0) is not None:
+            pass
+        self.assertEqual(fw.acknowledge(2, 10), 10)
+        self.assertTrue(fw.resend(2, 1, 100))  # 1 to 10 acknowledged since: 11 to 100 go
+        self.assertTrue(fw.resend(2, 50, 49))  # an empty range: nothing, and not refused
+        again = []
+        while True:
+            got = fw.next(2.0)
+            if got is None:
+                break
+            again.append(got[1])
+        self.assertEqual(again, list(range(11, 101)))
+        for _ in range(RESEND_RANGES):
+            self.assertTrue(fw.resend(2, 11, 11))
+        self.assertFalse(fw.resend(2, 12, 12))  # full: the ground asks again later
+        self.assertEqual([fw.next(3.0)[1] for _ in range(RESEND_RANGES)], [11] * RESEND_RANGES)
+        self.assertIsNone(fw.next(3.0))
 
     def test_a_full_bounded_store_refuses_and_counts(self):
         st = PacketStore(1, 250, BOUNDED)

@@ -35,7 +35,8 @@ class P:
 def test_windows_merged_ordered_in_onboard_time():
     passes = [P(300.2, 400.5), P(100.0, 200.0), P(150.0, 250.0), P(250.0, 260.0)]
     ws = windows(passes, offset=0)
-    assert ws == [(100, 260), (300, 401)]  # overlapping and touching passes: one window
+    assert ws == [(100, 260), (301, 400)]  # overlapping and touching passes: one window
+    assert windows([P(10.2, 10.9), P(20.5, 21.5)], offset=0) == []  # no whole second inside
     assert windows([P(0.0, 1.0)])[0][0] == TAI_MINUS_UNIX
     many = [P(i * 100.0, i * 100.0 + 50) for i in range(100)]
     assert len(windows(many)) == LIMIT

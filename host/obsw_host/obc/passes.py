@@ -62,9 +62,10 @@ def pack_table(windows):
     """The ``table`` argument of ``Passes.load`` for ``[(aos, los), ..]`` onboard seconds."""
     out = bytearray()
     for aos, los in windows:
-        a, b = int(aos), int(-(-los // 1))  # whole seconds, the window never shorter
+        a, b = int(-(-aos // 1)), int(los)  # whole seconds inside it: never longer
         if not 0 <= a < b < 1 << 32:
-            raise PassTableError("pass %r..%r outside uint32 onboard seconds" % (aos, los))
+            raise PassTableError("pass %r..%r: no whole second inside it, or outside uint32 "
+                                 "onboard seconds" % (aos, los))  # fmt: skip
         out += a.to_bytes(4, "big") + b.to_bytes(4, "big")
     return bytes(out)
 

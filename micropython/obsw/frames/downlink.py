@@ -3,6 +3,8 @@ spill store for packets their virtual channel has no room for (never a silent dr
 
 from collections import deque
 
+RESEND_RANGES = 16  # ranges the ground's resend requests may have waiting at once
+
 
 class Downlink:
     """Pacing of a link of ``bps`` bit/s whose frames are ``frame_octets`` channel octets.
@@ -96,7 +98,7 @@ class StoreForward:
         self.sent_octets = 0
         self.resent = 0
         self.held = 0  # packets that waited for the next pass (did not fit in this one)
-        self._resend = deque((), 64)  # (store, seq)
+        self._resend = deque((), RESEND_RANGES)  # [store, next seq, last seq]: ranges asked
         # the next storage sequence number to send, per store: the forwarder's own pointer
         # (the stores' ST[15] open retrieval stays the operator's, apart from it)
         self.next_seq = {}
@@ -114,15 +116,15 @@ class StoreForward:
         return self.contact.left(now) * self.bps / 8
 
     def resend(self, sid, first, last):
-        """The ground lacks storage sequence numbers ``first`` to ``last`` of store ``sid``;
-        False when its queue is full (it asks again)."""
+        """The ground lacks storage sequence numbers ``first`` to ``last`` of store ``sid``
+        (a range of any length: each packet still kept goes again, in order); False when
+        ``RESEND_RANGES`` ranges are already waiting (it asks again)."""
         st = self.store(sid)
-        q = self._resend
-        for seq, _t, _raw in st.packets:
-            if first <= seq <= last:
-                if len(q) >= 64:
-                    return False
-                q.append((st, seq))
+        if first > last:
+            return True
+        if len(self._resend) >= RESEND_RANGES:
+            return False
+        self._resend.append([st, first, last])
         return True
 
     def acknowledge(self, sid, seq):
@@ -136,22 +138,23 @@ class StoreForward:
             return None
         room = self.budget(now) if budget is None else budget
         while self._resend:
-            st, seq = self._resend[0]
-            raw = _find(st, seq)
-            if raw is None:  # deleted since: acknowledged meanwhile
+            r = self._resend[0]
+            st = r[0]
+            i = _first_at(st.packets, r[1])
+            if i == len(st.packets) or st.packets[i][0] > r[2]:  # sent, or deleted since
                 self._resend.popleft()
                 continue
+            seq, _t, raw = st.packets[i]
             if len(raw) > room:
                 self.held += 1
                 return None
-            self._resend.popleft()
+            r[1] = seq + 1
             self.resent += 1
             return self._out(st, seq, raw)
         for st in self.stores:
-            first = self.next_seq[st.id]
-            for seq, _t, raw in st.packets:
-                if seq < first:
-                    continue
+            i = _first_at(st.packets, self.next_seq[st.id])
+            if i < len(st.packets):
+                seq, _t, raw = st.packets[i]
                 if len(raw) > room:
                     self.held += 1
                     return None  # the highest priority first: lower ones wait behind it
@@ -168,15 +171,20 @@ class StoreForward:
         """Octets stored and not yet sent, over all stores."""
         n = 0
         for st in self.stores:
-            first = self.next_seq[st.id]
-            for seq, _t, raw in st.packets:
-                if seq >= first:
-                    n += len(raw)
+            packets = st.packets
+            for i in range(_first_at(packets, self.next_seq[st.id]), len(packets)):
+                n += len(packets[i][2])
         return n
 
 
-def _find(st, seq):
-    for s, _t, raw in st.packets:
-        if s == seq:
-            return raw
-    return None
+def _first_at(packets, seq):
+    """The index of the first of ``packets`` (``[seq, time, raw]``, in storage order) whose
+    storage sequence number is ``seq`` or later (``len(packets)`` if none)."""
+    lo, hi = 0, len(packets)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if packets[mid][0] < seq:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo

@@ -8,9 +8,8 @@ python tools/ditl.py --write            also write docs/ditl-last-run.md and doc
 It starts itself again under libfaketime (obsw_sim.faketime: every process of the chain on one
 clock, SPEED times faster), the clock set so that the day begins ``--before`` seconds before
 the first pass over the mission's first station after now. The downlink runs at ``--downlink``
-bit/s (default 19200, half the station's: the rig's station decodes both UARTs' frames in
-Python, and at 52 times faster could not keep up with more). The closing line is 'N passed, N
-failed' over the checks of the run (exit status 1 if any failed).
+bit/s (default: the station's), the file up's data at ``--up-rate`` octets/s. The closing
+line is 'N passed, N failed' over the checks of the run (exit status 1 if any failed).
 """
 
 import argparse
@@ -173,11 +172,17 @@ def main(argv=None):
     ap.add_argument("--orbits", type=float, help="a bounded run of this many orbits")
     ap.add_argument("--hours", type=float, default=24.0, help="the full run's length")
     ap.add_argument("--speed", type=float, help="times faster (default 52, bounded run 48)")
-    ap.add_argument("--downlink", type=float, default=19200.0, help="downlink bit/s (19200)")
+    ap.add_argument("--downlink", type=float, help="downlink bit/s (the station's)")
     ap.add_argument("--before", type=float, default=1800.0,
                     help="seconds of orbit before the first pass (default 1800)")  # fmt: skip
-    ap.add_argument("--down", type=int, help="octets of the file down (1.5 MB; bounded 800 kB)")
-    ap.add_argument("--up", type=int, help="octets of the file up (400 kB; bounded 200 kB)")
+    ap.add_argument("--down", type=int, help="octets of the file down (5 MB; bounded 2.4 MB)")
+    ap.add_argument("--up", type=int, help="octets of the file up (1 MB; bounded 600 kB)")
+    ap.add_argument(
+        "--up-rate",
+        type=float,
+        default=900.0,
+        help="octets/s of the file up's data (900: 7.2 of the 9.6 kbit/s uplink)",
+    )
     ap.add_argument("--write", action="store_true", help="write docs/ditl-last-run.md, ditl.png")
     ap.add_argument("--work", help="folder for the chain's files (default: a temporary one)")
     args = ap.parse_args(argv)
@@ -196,8 +201,8 @@ def main(argv=None):
     orbit_s = 86400.0 / pred.tle.mean_motion
     seconds = args.orbits * orbit_s if args.orbits else args.hours * 3600
     work = args.work or tempfile.mkdtemp(prefix="obsw-ditl-")
-    down = args.down or (800_000 if args.orbits else 1_500_000)
-    up = args.up or (200_000 if args.orbits else 400_000)
+    down = args.down or (2_400_000 if args.orbits else 5_000_000)
+    up = args.up or (600_000 if args.orbits else 1_000_000)
     day = ChainDay(
         work,
         pred,
@@ -207,6 +212,7 @@ def main(argv=None):
         down_size=down,
         up_size=up,
         downlink_bps=args.downlink,
+        up_rate=args.up_rate,
     )
     began = time.monotonic()
 

@@ -92,7 +92,9 @@ class ChainDay:
         self.lead, self.lag = lead, lag
         self.chain = Chain(work, out=out, processes=Chain.SAMPLE_PROCESSES,
                            timeout=10.0 * max(1.0, speed / 2.0))  # fmt: skip
-        self.chain.sections["contact"] = {"stores": [HIGH, ROUTINE], "hold": 5.0}
+        # the dump and the files take 95 % of the downlink; the rest is real-time TM (events,
+        # acceptance reports), a few packets a second
+        self.chain.sections["contact"] = {"stores": [HIGH, ROUTINE], "hold": 5.0, "share": 0.95}
         chain_settings(self.chain, speed)
         # files through the frames; the OBC paces its dump and its file data at a share of the
         # downlink rate (``downlink_bps``, default the station's; contact.downlink_bps: the

@@ -118,6 +118,21 @@ def test_the_pass_volume_bounds_the_dump():
     assert p.backlog == sum(100 for _ in range(100)) - sum(len(r) for r in sent)
 
 
+def test_files_have_the_radio_when_the_stores_have_nothing_waiting():
+    p, storage, clock, sent, _ = make()
+    assert p.spare == p.cycle_octets == 1000.0  # 8000 bit/s, all of it the dump's
+    for _i in range(30):
+        storage.stores[1].append(clock.t, bytes(100))
+    p.load(pack_table([(1000, 1100)]))
+    clock.t = 1000.0
+    p.step()
+    assert p.backlog > 0 and p.spare == 0.0  # the stores first: no file data meanwhile
+    while p.backlog:
+        clock.t += 0.5
+        p.step()
+    assert len(sent) == 30 and p.spare == 1000.0  # caught up: the files have it again
+
+
 def test_cfdp_held_out_of_contact():
     class Tx:
         def __init__(self):

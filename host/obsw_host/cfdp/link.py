@@ -212,8 +212,9 @@ class UdpEntity:
         self._grow(now)
         if self.rate is not None:
             seg = max(1, max((r.max_segment for r in ent.mib.remotes.values()), default=1024))
-            # a tenth of a second's worth, and never less than a segment (a slow rate sends)
-            cap = max(self.rate * 0.1, seg)
+            # a tenth of a second's worth, and never less than two segments: a slow rate sends,
+            # and the credit that grows while a segment's worth waits for a late step is kept
+            cap = max(self.rate * 0.1, 2 * seg)
             self._budget = min(cap, self._budget + (now - self._last) * self.rate)
             self._last = now
             limit = max(0, int(self._budget // seg))

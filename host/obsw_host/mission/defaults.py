@@ -124,7 +124,8 @@ PLATFORM = {
     # the OBC's context in its safeguard memory and the DS3231's time at start
     "module_uarts": None,  # the serial devices to its two controllers; None: no link
     "context_period": 1.0,  # seconds between context saves
-    "module_timeout": 1.0,  # seconds to wait for the module's time and context at start
+    # seconds to wait for the module's time and context at start (a save's answer: half of it)
+    "module_timeout": 1.0,
 }
 # in-flight software updates (obsw_host.update): signed packages, two slots, a trial and rollback
 UPDATE = {

@@ -42,20 +42,23 @@ class ModuleLink:
     """The link on ``devices`` for the PUS unit's ``app`` (its sequence counts), ``onboard_time``
     (``OnboardTime``) and ``engine`` (the OBCP engine, or None); ``say`` hears what it does."""
 
-    def __init__(self, devices, app, onboard_time, engine=None, period=1.0, say=print):
+    def __init__(self, devices, app, onboard_time, engine=None, period=1.0, say=print,
+                 timeout=1.0):  # fmt: skip
         self.fds = [open_uart(d) for d in devices]
         self.link = ObcLink(self.fds)
         self.app = app
         self.onboard_time = onboard_time
         self.engine = engine
         self.period = period
+        self.timeout = timeout  # the module's answers: its context at start; a save's, half
         self.say = say
         self.context = ObcContext()
         self.kept = 0  # controllers that acknowledged the last save
         self.apids = []  # the APIDs whose TM counts the last save logged carried
 
-    def restore(self, timeout=1.0):
+    def restore(self, timeout=None):
         """Time and context from the module at start; the context (a first start: empty)."""
+        timeout = self.timeout if timeout is None else timeout
         rtc = self.link.read_time(timeout)
         ctx = self.link.read_context(timeout)
         if ctx is None:
@@ -89,7 +92,7 @@ class ModuleLink:
             self.onboard_time.set_time(t)
             self.say("module link: onboard time from %s" % source)
 
-    def save(self, timeout=0.5):
+    def save(self, timeout=None):
         """Send the context as it is now; how many controllers kept it."""
         ctx = self.context
         ctx.obt = self.onboard_time.now()
@@ -99,7 +102,7 @@ class ModuleLink:
             states = self.engine.states
             ctx.obcps = [n for n in self.engine.obcps if states.get(n, INACTIVE) != INACTIVE]
         ctx.saves += 1
-        kept = self.link.write_context(ctx, timeout)
+        kept = self.link.write_context(ctx, self.timeout / 2 if timeout is None else timeout)
         apids = sorted(int(a) for a in ctx.seq)
         # the first save that was kept, then each change in how many keep it or in the APIDs
         # whose TM counts it carries (a first start's first saves may carry none)

@@ -117,6 +117,9 @@ class Passes:
         self.aos_count = 0
         self.backlog = 0
         self.dumped = 0
+        # octets/s the radio has for files (the CFDP entity's file data): the dump's share
+        # when the stores have nothing waiting, none while they do (they come first)
+        self.spare = self.cycle_octets
         self._last = None
         self._credit = 0.0
         self._restore_table()
@@ -296,4 +299,6 @@ class Passes:
             self.dumped += count
             self.event("passes.dumped", {"store": sid, "first": first, "last": last_seq,
                                          "count": count})  # fmt: skip
-        self._set("backlog", self.forward.backlog())
+        backlog = self.forward.backlog()
+        self.spare = 0.0 if backlog else self.cycle_octets
+        self._set("backlog", backlog)

@@ -188,8 +188,9 @@ class PusUnit:
                 self.engine,
                 float(platform["context_period"]),
                 out,
+                timeout=float(platform["module_timeout"]),
             )
-            self.module.restore(float(platform["module_timeout"]))
+            self.module.restore()
         monitoring.install(self.app, sdb, opts["monitoring"])  # first start: the mission's
         self.app.unsent_listeners.append(self._unsent)
         self._reporting_unsent = False
@@ -257,8 +258,8 @@ class PusUnit:
         )
         if passes.enabled:
             self.app.tm_filters.append(passes.realtime)
-            if self.cfdp is not None:  # files share the passes' radio: paced to the dump's rate
-                self.cfdp.rate = passes.cycle_octets
+            if self.cfdp is not None:  # files share the dump's part of the radio (spare)
+                self.cfdp.rate = passes.spare
                 self.cfdp.pace = False
                 for r in self.cfdp.entity.mib.remotes.values():
                     space_link_timers(r)
@@ -268,6 +269,8 @@ class PusUnit:
     async def _passes_task(self):
         while self._running:
             self.passes.step()
+            if self.cfdp is not None and self.passes.enabled:
+                self.cfdp.rate = self.passes.spare  # the stores' backlog first, then files
             await asyncio.sleep(self.onboard.period)
 
     def _obcp(self, opts):

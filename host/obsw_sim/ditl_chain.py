@@ -26,9 +26,9 @@ planned commands, store 2 for the routine housekeeping and the OBC's store backl
 - files go through the frames (``Chain.cfdp_frames``): the ground's CFDP entity (class 2,
   its own ``PassHold`` driven by the prediction, its file data at most ``up_rate`` octets/s)
   puts ``up_size`` octets up and asks the OBC by proxy put for ``down_size`` octets; the
-  OBC's entity sends its PDUs into the frame processor's TM input at the rate of the stores'
-  dump (``share`` of the station's downlink rate, ``contact.downlink_bps``) and holds them
-  across passes with the OBC's own ``Passes``.
+  OBC's entity sends its PDUs into the frame processor's TM input with the dump's part of
+  the downlink when the stores have nothing waiting (``Passes.spare``: ``share``, here 95 %,
+  of ``contact.downlink_bps``) and holds them across passes with the OBC's own ``Passes``.
 
 ``run()`` returns the figures (a dict) and keeps the series for the plots.
 """
@@ -78,8 +78,8 @@ class ChainDay:
     """One run of the whole chain (see the module text)."""
 
     def __init__(self, work, predictor, seconds, speed, out=None, hk_period=10.0,
-                 ack_every=60.0, lead=60.0, lag=30.0, down_size=3_000_000,
-                 up_size=400_000, up_rate=400.0, frame_length=1024,
+                 ack_every=60.0, lead=60.0, lag=30.0, down_size=5_000_000,
+                 up_size=1_000_000, up_rate=900.0, frame_length=1024,
                  downlink_bps=None):  # fmt: skip
         self.work = work
         self.pred = predictor
@@ -261,12 +261,13 @@ class ChainDay:
     def _files(self):
         """The ground's CFDP entity on the chain's ground port, behind the station; the two
         transfers asked (they start at the first AOS: the hold keeps them till then). Its
-        segments are 512 octets: a PDU in its space packet fits one signed TC frame."""
+        segments are 900 octets: a PDU in its space packet fits one signed TC frame (1024
+        octets at most), which FOP-1's window of five frames then carries best."""
         chain = self.chain
         onboard, ground = chain.ids.cfdp_entities
         entity = make_entity(ground, [onboard], RootedFilestore(self.ground_files),
                              state=os.path.join(self.work, "ground-cfdp"),
-                             segment=512, limit=100, inactivity=3600.0, ack_interval=5.0,
+                             segment=900, limit=100, inactivity=3600.0, ack_interval=5.0,
                              nak_interval=5.0)  # fmt: skip
         self.cfdp = UdpEntity(entity, ("127.0.0.1", chain.cfdp_ground_port),
                               {onboard: chain.station.address}, apid=chain.ids.apid("cfdp"),

@@ -217,3 +217,29 @@ def test_sample_database_names_the_core_event_ids():
     assert ids == sdls.EVENT_IDS
     assert apid == db.apid("frames")
     assert {db.event(i).severity for i in ids[1:]} == {3}  # medium: TM[5,3]
+
+
+def test_station_sends_the_operators_tcs_before_a_files_pdus():
+    from obsw_host.frames.station import GroundStation
+
+    files = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    files.bind(("127.0.0.1", 0))
+    mcs = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    station = GroundStation([], SCID, routes={0x7F0: files.getsockname()})
+    try:
+        for i in range(3):
+            files.sendto(tc_packet(i, b"file data"), station.address)
+        mcs.sendto(tc_packet(9, b"operator"), station.address)
+        station.step(0)  # on the loopback a datagram is in the socket when sendto returns
+        # no links here: FOP-1 holds what it was given, so COP-1's queue stays as it was left
+        queue = station.ground.queue
+        assert len(queue) == 1 and queue[0].endswith(b"operator")  # the TC went first
+        assert len(station.routed) == 3 and station.uplinked == 1
+        queue.clear()  # as if FOP-1 had sent it: the next file PDU goes, one at a time
+        station.step(0)
+        assert len(queue) == 1 and queue[0].endswith(b"file data")
+        assert len(station.routed) == 2 and station.uplinked == 2
+    finally:
+        files.close()
+        mcs.close()
+        station.close()

@@ -5,8 +5,10 @@ TC packets that arrive on the station's UDP socket go up through FOP-1 (AD servi
 packets go, unchanged, to the mission control process (``mcs``, or whoever sent the last TC)
 on UDP; ``routes`` (APID -> UDP address) sends the packets of those APIDs elsewhere (a ground
 CFDP entity, say), whose TC packets then go up without taking the mission control process's
-place. ``downlinked`` keeps (VC ID, packet) of the packets forwarded, so a test or the demo
-can tell real-time telemetry from playback.
+place, and after its TCs: one goes to COP-1 only when no TC waits there, so an operator's TC
+waits at most for FOP-1's window, never behind a file's PDUs. ``downlinked`` keeps (VC ID,
+packet) of the packets forwarded, so a test or the demo can tell real-time telemetry from
+playback.
 
 ``GroundStation.for_mission(ids, links)`` configures it from a mission (SCID, TC VC and MAP,
 TM frame length and coding); the links may be any of ``obsw_host.frames.radio`` (KISS over a
@@ -51,6 +53,7 @@ class GroundStation:
         self._t0 = self.clock()
         self.uplinked = 0
         self.refused = 0  # packets that could not go up (too long, or no operational SA)
+        self.routed = deque()  # TC packets from the routes, waiting for COP-1 to be free
         self._initiated = False
 
     @classmethod
@@ -84,14 +87,14 @@ class GroundStation:
                 packet, sender = self.sock.recvfrom(65542)
             except OSError:
                 break
-            if self.mcs != sender and sender not in self.routes.values():
-                self.mcs = sender
-            try:
-                self.ground.send(packet, now)
-            except FrameError:
-                self.refused += 1
+            if sender in self.routes.values():
+                self.routed.append(packet)
                 continue
-            self.uplinked += 1
+            if self.mcs != sender:
+                self.mcs = sender
+            self._up(packet, now)
+        while self.routed and not self.ground.queue:
+            self._up(self.routed.popleft(), now)
         self.ground.poll(now, timeout)
         ch = self.ground.channel_packets
         while ch:
@@ -108,6 +111,14 @@ class GroundStation:
         self.ground.packets.clear()  # kept in ``downlinked`` with their VC
         if self.ground.fop.state == F.INITIAL and self.ground.fop.outstanding == 0:
             self._initiated = False  # FOP-1 gave up (e.g. links cut): start it again
+
+    def _up(self, packet, now):
+        try:
+            self.ground.send(packet, now)
+        except FrameError:
+            self.refused += 1
+            return
+        self.uplinked += 1
 
     def run(self, stop):
         """Step until ``stop`` (a threading.Event) is set."""

@@ -22,8 +22,10 @@ with TC[8,1] ``Passes.acknowledge`` (store, seq: deletes through it, the room is
 and asks again for what it lacks with ``Passes.resend`` (store, first, last). The forwarder's
 pointer never goes back, so nothing leaves twice unless the ground asks for it. The CFDP
 entity of the same process is held across passes (``obsw.cfdp.contact.PassHold``): suspended
-at LOS, its timers frozen, resumed at AOS. Without ``contact.stores`` the TM stays in real
-time and CFDP is not held (a ground always in view); the pass table still loads.
+at LOS, its timers frozen, resumed at AOS; its file data has the dump's part of the downlink
+(``spare``) when the stores have nothing waiting, and none while they do. Without
+``contact.stores`` the TM stays in real time and CFDP is not held (a ground always in view);
+the pass table still loads.
 
 Pass table layout (``table``, octets, big-endian): 8 octets a pass, at most ``MAX_WINDOWS``
 (64) passes, ordered, disjoint: AOS then LOS, each uint32 whole seconds of onboard time (TAI

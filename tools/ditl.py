@@ -25,6 +25,7 @@ from obsw_host.mission.check import load  # noqa: E402
 from obsw_host.ops.passes import from_mission  # noqa: E402
 from obsw_sim import faketime  # noqa: E402
 from obsw_sim.ditl_checks import checks  # noqa: E402
+from obsw_sim.ditl_checks import page as ditl_page  # noqa: E402
 from obsw_sim.ditl_checks import utc as _utc  # noqa: E402
 
 MISSION = os.path.join(ROOT, "examples", "sample")
@@ -101,18 +102,13 @@ def plot(day, f, path):
 
 
 def page(day, f, results, took, speed):
-    rows = ["| pass | AOS (UTC) | LOS (UTC) | max el | volume (octets) | packets down |",
-            "|---|---|---|---|---|---|"]  # fmt: skip
-    for i, (p, u) in enumerate(zip(day.passes, f["pass_use"])):
-        rows.append("| %d | %s | %s | %.1f | %d | %d |" % (
-            i + 1, _utc(p.aos), _utc(p.los), p.max_elevation, u[3], u[2]))  # fmt: skip
     from obsw_host.pus.tai import TAI_MINUS_UNIX
 
-    plan = ["| planned (UTC) | started (onboard, UTC) | request |", "|---|---|---|"]
+    plan = []
     for i, s in enumerate(day.plan):
         te = day.started.get(i, day.executed.get(i)) if i in day.executed else None
-        plan.append("| %s | %s | `%s` |" % (_utc(s.time), _utc(te - TAI_MINUS_UNIX)
-                                            if te else "not seen", s.request))  # fmt: skip
+        plan.append((_utc(s.time), _utc(te - TAI_MINUS_UNIX) if te else "not seen",
+                     "`%s`" % s.request))  # fmt: skip
     files = ["| file | octets | identical | transactions | at each AOS (octets) |",
              "|---|---|---|---|---|"]  # fmt: skip
     for name in ("down", "up"):
@@ -125,44 +121,32 @@ def page(day, f, results, took, speed):
             octets = info.get("size", info.get("progress"))
             files.append("- %s: %s, condition %s, %s octets" % (
                 _utc(t), kind, info.get("condition"), octets))  # fmt: skip
-    checks_md = ["| check | result | figures |", "|---|---|---|"]
-    for name, ok, detail in results:
-        checks_md.append("| %s | %s | %s |" % (name, "pass" if ok else "FAIL", detail))
-    return "\n".join([
-        "# Day in the life: the last run",
-        "",
+    files = ["The receiver's octets at each AOS: for the file down the ground's (the start of "
+             "its first gap), for the file up what the ground had sent (the receiver is on "
+             "board).", "", *files]  # fmt: skip
+    intro = (
         "Written by `python tools/ditl.py --write` (the rig and its design: "
         "[Operations across passes](passes.md)). %.1f hours of orbit (%.1f orbits) of the "
         "sample spacecraft from %s, the whole chain (the OBC's processes, both reconfiguration "
         "controllers, frames on the UARTs, the station, the ground) under libfaketime at %g "
         "times: %.0f s here; the downlink at %d bit/s, files through the frames. Power "
         "cycles of the OBC by its module: %d; processes restarted by its platform manager: "
-        "%d; controllers reset: %d." % (f["hours"], f["orbits"], _utc(day.start), speed, took,
-                                        day.downlink_bps, max(0, (f["obc_boots"] or 1) - 1),
-                                        f["process_restarts"], f["controller_resets"]),
-        "",
-        "![the day: passes, store backlog, link use, data delivered, commands](ditl.png)",
-        "",
-        "## Checks",
-        "",
-        *checks_md,
-        "",
-        "## Files",
-        "",
-        "The receiver's octets at each AOS: for the file down the ground's (the start of its "
-        "first gap), for the file up what the ground had sent (the receiver is on board).",
-        "",
-        *files,
-        "",
-        "## Passes",
-        "",
-        *rows,
-        "",
-        "## Commands planned and executed",
-        "",
-        *plan,
-        "",
-    ])  # fmt: skip
+        "%d; controllers reset: %d."
+        % (
+            f["hours"],
+            f["orbits"],
+            _utc(day.start),
+            speed,
+            took,
+            day.downlink_bps,
+            max(0, (f["obc_boots"] or 1) - 1),
+            f["process_restarts"],
+            f["controller_resets"],
+        )
+    )
+    return ditl_page(intro, "the day: passes, store backlog, link use, data delivered, commands",
+                     results, day.passes, f["pass_use"], "packets down", plan,
+                     "started (onboard, UTC)", files)  # fmt: skip
 
 
 def main(argv=None):
@@ -191,7 +175,13 @@ def main(argv=None):
     speed = args.speed or (48.0 if args.orbits else 52.0)
     if faketime.active() is None:  # start again, the whole process tree on the fast clock
         now = time.time()
-        first = pred.passes(now, now + 86400, pred.stations[:1])[0]
+        passes = pred.passes(now, now + 2 * 86400, pred.stations[:1])
+        first = passes[0]
+        if args.orbits:  # a bounded run begins before a pass that another follows within it
+            orbit_s = 86400.0 / pred.tle.mean_motion
+            span = args.orbits * orbit_s - args.before
+            first = next((a for a, b in zip(passes, passes[1:]) if b.los - a.aos < span),
+                         first)  # fmt: skip
         offset = first.aos - args.before - now
         env = dict(os.environ, **faketime.environment(speed, offset))
         sys.stdout.flush()

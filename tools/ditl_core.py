@@ -24,6 +24,7 @@ from obsw_host.mission.check import load  # noqa: E402
 from obsw_host.ops.passes import from_mission  # noqa: E402
 from obsw_sim.ditl import HK, Day  # noqa: E402
 from obsw_sim.ditl_checks import checks  # noqa: E402
+from obsw_sim.ditl_checks import page as ditl_page  # noqa: E402
 from obsw_sim.ditl_checks import utc as _utc  # noqa: E402
 
 MISSION = os.path.join(ROOT, "examples", "sample")
@@ -87,40 +88,16 @@ def plot(day, f, path):
 
 
 def page(day, f, results, seconds, args):
-    rows = ["| pass | AOS (UTC) | LOS (UTC) | max el | volume (octets) | sent (octets) |",
-            "|---|---|---|---|---|---|"]  # fmt: skip
-    for i, (p, u) in enumerate(zip(day.passes, f["pass_use"])):
-        rows.append("| %d | %s | %s | %.1f | %d | %d |" % (
-            i + 1, _utc(p.aos), _utc(p.los), p.max_elevation, u[3], u[2]))  # fmt: skip
-    plan = ["| planned (UTC) | executed (onboard) | request |", "|---|---|---|"]
-    for s, (te, _req) in zip(sorted(day.plan, key=lambda s: s.time), sorted(day.executed)):
-        plan.append("| %s | %s | `%s` |" % (_utc(s.time), _utc(te), s.request))
-    checks_md = ["| check | result | figures |", "|---|---|---|"]
-    for name, ok, detail in results:
-        checks_md.append("| %s | %s | %s |" % (name, "pass" if ok else "FAIL", detail))
-    return "\n".join([
-        "# Day in the life: the last run",
-        "",
-        "Written by `python tools/ditl_core.py --write` (the rig and its design: "
-        "[Operations across passes](passes.md)). %.1f hours of orbit (%.1f orbits) of the "
-        "sample spacecraft from %s, computed in %.1f s on one injected clock, "
-        "loss %g each way." % (f["hours"], f["orbits"], _utc(day.start), seconds, args.loss),
-        "",
-        "![the day: passes, store fill, link use, data generated and delivered](ditl.png)",
-        "",
-        "## Checks",
-        "",
-        *checks_md,
-        "",
-        "## Passes",
-        "",
-        *rows,
-        "",
-        "## Commands planned and executed",
-        "",
-        *plan,
-        "",
-    ])  # fmt: skip
+    intro = ("Written by `python tools/ditl_core.py --write` (the rig and its design: "
+             "[Operations across passes](passes.md)). %.1f hours of orbit (%.1f orbits) of the "
+             "sample spacecraft from %s, computed in %.1f s on one injected clock, loss %g each "
+             "way." % (f["hours"], f["orbits"], _utc(day.start), seconds, args.loss))  # fmt: skip
+    plan = [(_utc(s.time), _utc(te), "`%s`" % s.request)
+            for s, (te, _req) in zip(sorted(day.plan, key=lambda s: s.time),
+                                     sorted(day.executed))]  # fmt: skip
+    return ditl_page(intro, "the day: passes, store fill, link use, data generated and delivered",
+                     results, day.passes, f["pass_use"], "sent (octets)", plan,
+                     "executed (onboard)")  # fmt: skip
 
 
 def main(argv=None):

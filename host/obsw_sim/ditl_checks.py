@@ -12,7 +12,8 @@ injected clock, and ``obsw_sim.ditl_chain``, the whole chain under libfaketime).
 - ``overflow`` (true if a store overflowed or the passes could not carry what was generated)
   and ``store_detail`` (the figures behind it);
 
-and returns ``(name, ok, detail)`` for each check. ``utc(t)`` writes POSIX time ``t``.
+and returns ``(name, ok, detail)`` for each check. ``utc(t)`` writes POSIX time ``t``;
+``page(..)`` is the Markdown of the last run's page, laid out alike for both rigs.
 """
 
 import datetime
@@ -54,3 +55,30 @@ def checks(f, full):
             name, d["size"]), ok, detail))  # fmt: skip
     out.append(("stores never overflow", not f["overflow"], f["store_detail"]))
     return out
+
+
+def _table(head, rows):
+    return ["| %s |" % " | ".join(head), "|%s" % ("---|" * len(head))] + [
+        "| %s |" % " | ".join(str(c) for c in r) for r in rows
+    ]
+
+
+def page(intro, plot_alt, results, passes, pass_use, sent_head, plan_rows, executed_head,
+         files=None):  # fmt: skip
+    """The last run's page: ``intro`` (a paragraph), the plots (``plot_alt``), the checks
+    (``results``), the files (``files``: lines, or None), the passes (``pass_use``: ``(aos,
+    los, sent, volume)`` of each of ``passes``, ``sent`` headed ``sent_head``) and the commands
+    (``plan_rows``: ``(planned, executed, request)``, the executed column headed
+    ``executed_head``)."""
+    checks_md = _table(["check", "result", "figures"],
+                       [(n, "pass" if ok else "FAIL", d) for n, ok, d in results])  # fmt: skip
+    pass_md = _table(["pass", "AOS (UTC)", "LOS (UTC)", "max el", "volume (octets)", sent_head],
+                     [(i + 1, utc(p.aos), utc(p.los), "%.1f" % p.max_elevation, int(u[3]),
+                       int(u[2])) for i, (p, u) in enumerate(zip(passes, pass_use))])  # fmt: skip
+    plan_md = _table(["planned (UTC)", executed_head, "request"], plan_rows)
+    out = ["# Day in the life: the last run", "", intro, "",
+           "![%s](ditl.png)" % plot_alt, "", "## Checks", "", *checks_md, ""]  # fmt: skip
+    if files is not None:
+        out += ["## Files", "", *files, ""]
+    out += ["## Passes", "", *pass_md, "", "## Commands planned and executed", "", *plan_md, ""]
+    return "\n".join(out)

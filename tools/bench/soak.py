@@ -13,14 +13,15 @@ alternate, traffic first, each --phase long (default 10 minutes):
 The first --warmup (default 10 minutes) is not counted: caches, pools and bounded buffers fill.
 The figure is the growth after it, in kB per hour: the least-squares slope of the OBC's summed
 RSS over the samples after warm-up (each process's too), next to the goal (100 kB per hour,
-issue 41). The processes also trace their Python allocations (tracemalloc, `--no-trace` leaves it
-out): the slope of the memory they trace, recorded by each process every sample period, is
-given too (it sees a Python leak that a heap's free space would hide from RSS for a while), and
-so is the RSS growth without that of tracemalloc's own tables (they keep every call path they
-have seen: the tracer's memory, not the OBC's); the goal is met when both the latter and the
-Python heap's growth are within it. A snapshot of each process at the end of warm-up and at the
-end names the source lines that grew most when a figure misses the goal. Slopes over short
-runs (--quick) say little: the first hours are what count.
+issue 41). With --trace the processes also trace their Python allocations (tracemalloc): the
+slope of the memory they trace, recorded by each process every sample period, is given too (it
+sees a Python leak that a heap's free space would hide from RSS for a while), and so is the
+RSS growth without that of tracemalloc's own tables (they keep every call path they have seen:
+the tracer's memory, not the OBC's); the goal is then met when both the latter and the Python
+heap's growth are within it, and a snapshot of each process at the end of warm-up and at the
+end names the source lines that grew most. The tracer changes what it measures (below), so the
+figure is the run without it and the traced run is the diagnosis. Slopes over short runs
+(--quick) say little: the first hours are what count.
 
 What it found: under traffic the PUS process's resident memory grew while its Python heap
 did not. The memory was glibc's, in the malloc arena of the thread that runs the PUS loop:
@@ -32,16 +33,16 @@ one buffer of its own and copies what came at its size (tests/host/test_receive_
 
 Two 2-hour runs of that code (commit 66df7bc, 130 minutes each, side by side, 2 hours counted,
 721 samples, about 20,700 pings, 824 report requests and 70 CFDP puts each, no restart) tell the
-OBC from its tracer. Without tracemalloc (`--no-trace`, the OBC as it flies; its output is
-docs/benchmarks/soak-untraced.json) the OBC's RSS grew 22.5 kB per hour (the PUS process 7.9,
-the platform manager 14.7): the goal met. With it (the figures below) the Python heap grew
-23.3 kB per hour, and tracemalloc's own tables 11.1, but the RSS without those tables grew
-235.6. Same code, same traffic, same hours: that growth comes with the tracer (most likely its
-record for every traced block, allocated among the OBC's own, keeps glibc's arenas from reusing
-what the OBC frees; not measured further). The traced run names the growers; the untraced one
-gives the OBC's figure.
+OBC from its tracer. Without tracemalloc (the OBC as it flies: the figures below; the tool then
+took --no-trace, now the default) the OBC's RSS grew 22.5 kB per hour (the PUS process 7.9, the
+platform manager 14.7): the goal met. With it (--trace; its output, with the growers it names,
+is docs/benchmarks/soak-traced.json) the Python heap grew 23.3 kB per hour, and tracemalloc's
+own tables 11.1, but the RSS without those tables grew 235.6. Same code, same traffic, same
+hours: that growth comes with the tracer (most likely its record for every traced block,
+allocated among the OBC's own, keeps glibc's arenas from reusing what the OBC frees; not
+measured further).
 
-Usage: python tools/bench/soak.py [--minutes M] [--quick] [--json]
+Usage: python tools/bench/soak.py [--minutes M] [--quick] [--trace] [--json]
 """
 
 import argparse
@@ -384,7 +385,7 @@ def main(argv=None):
     ap.add_argument("--phase", type=float, help="minutes of each phase (default 10; quick 0.2)")
     ap.add_argument("--sample", type=float, help="seconds between samples (default 10; quick 3)")
     ap.add_argument("--quick", action="store_true", help="1 minute: proves it runs")
-    ap.add_argument("--no-trace", action="store_true", help="no tracemalloc in the processes")
+    ap.add_argument("--trace", action="store_true", help="tracemalloc in the processes")
     ap.add_argument("--json", action="store_true", help="print one JSON object")
     args = ap.parse_args(argv)
     q = args.quick
@@ -396,7 +397,7 @@ def main(argv=None):
     # stopped early (SIGTERM): the OBC is stopped and the folder removed all the same
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(1))
     work = tempfile.mkdtemp(prefix="obsw-soak-")
-    soak = Soak(work, not args.no_trace, sample, out)
+    soak = Soak(work, args.trace, sample, out)
     try:
         soak.run(minutes, warmup, phase, out)
         res = analyse(soak)

@@ -163,10 +163,12 @@ class Campaign:
     # ------------------------------------------------------------------------ power cuts
 
     def _cut_during(self, step):
-        """Run ``step(k)`` for k = 1, 2, .. in a thread; cut the power at a random moment;
-        returns the last k whose step completed."""
+        """Run ``step(k)`` for k = 1, 2, .. in a thread; cut the power at a random moment after
+        the first step completed (a loaded machine may take long for it); returns the last k
+        whose step completed."""
         done = [0]
         stop = threading.Event()
+        first = threading.Event()
 
         def run():
             k = 0
@@ -179,10 +181,12 @@ class Campaign:
                 if not ok:
                     return
                 done[0] = k
+                first.set()
 
         t = threading.Thread(target=run, daemon=True)
         t.start()
-        time.sleep(self.rng.uniform(0.3, 1.5))  # the moment of the cut is the experiment
+        first.wait(30.0)
+        time.sleep(self.rng.uniform(0.0, 1.2))  # the moment of the cut is the experiment
         self.obc.power_cut()
         stop.set()
         t.join(10)

@@ -40,6 +40,9 @@ class Watch:
 
     def __init__(self, chain):
         self.chain = chain
+        # every unsolicited TM kept: the ground drops the oldest beyond 1000 by default, and
+        # this watch reads on from an index into the list
+        chain.ground.keep_unsolicited = 1 << 30
         sdb = chain.sdb
         self.ids = {sdb.event(n).id: n for n in ("passes.dumped", "Passes.aos", "Passes.los")}
         self.dumped = sdb.event("passes.dumped")

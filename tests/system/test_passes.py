@@ -24,6 +24,17 @@ STORE = 1
 HK_SID = 1  # the sample's SolarPanel housekeeping, every second
 
 
+def loaded_chain(tmp_path):
+    """The chain, set for a machine busy with other test lanes: its station thread shares
+    this process, so the OBC's UART queues hold a burst while it is late rather than drop the
+    oldest frames, and a process paused for seconds is not taken for a hung one (a restart
+    between a dump and its event would leave a report the events do not count)."""
+    chain = Chain(str(tmp_path), processes=Chain.SAMPLE_PROCESSES)
+    chain.sections["frames"] = {"uart_queue": 4096}
+    chain.platform.update(deadline=10.0)
+    return chain
+
+
 def refused(tx, *texts):
     """The TC[8,1] failed its completion, the component's reason carrying ``texts``."""
     report = " ".join(tx.verification())
@@ -82,7 +93,7 @@ class Watch:
 
 
 def test_pass_table_store_and_forward(tmp_path):
-    chain = Chain(str(tmp_path), processes=Chain.SAMPLE_PROCESSES)
+    chain = loaded_chain(tmp_path)
     chain.sections["contact"] = {"stores": [STORE], "hold": 1.0}
     with chain:
         chain.wait_up(2 * WAIT)
@@ -165,7 +176,7 @@ def test_a_file_up_across_two_passes(tmp_path):
     from obsw_host.cfdp.link import UdpEntity, make_entity
     from obsw_host.pus.tai import tai_now
 
-    chain = Chain(str(tmp_path), processes=Chain.SAMPLE_PROCESSES)
+    chain = loaded_chain(tmp_path)
     chain.sections["contact"] = {"stores": [STORE], "hold": 1.0}
     data = random.Random(7).randbytes(240_000)
     with chain:

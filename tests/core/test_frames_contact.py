@@ -63,6 +63,26 @@ def _packet(tag, n=100):
     return bytes([tag]) * n
 
 
+def _in_a_long_pass(hk_packets, bps):
+    """The stores and a forwarder in a pass of 1000 s, ``hk_packets`` in store 2."""
+    events, hk = _stores()
+    c = Contact()
+    c.load([(0, 1000)])
+    for i in range(hk_packets):
+        hk.append(float(i), _packet(2))
+    return hk, StoreForward([events, hk], c, bps=bps)
+
+
+def _drain(fw, now):
+    """The storage sequence numbers ``fw`` sends at ``now`` until it has nothing to send."""
+    seqs = []
+    while True:
+        got = fw.next(now)
+        if got is None:
+            return seqs
+        seqs.append(got[1])
+
+
 class TestStoreForward(unittest.TestCase):
     def test_nothing_leaves_out_of_contact_then_priority_first(self):
         events, hk = _stores()
@@ -115,19 +135,8 @@ class TestStoreForward(unittest.TestCase):
         self.assertEqual(fw.budget(90.0), 10.0)  # 10 s left at 1 octet/s
 
     def test_resend_then_acknowledge(self):
-        events, hk = _stores()
-        c = Contact()
-        c.load([(0, 1000)])
-        fw = StoreForward([events, hk], c, bps=80000)
-        for i in range(6):
-            hk.append(float(i), _packet(2))
-        seqs = []
-        while True:
-            got = fw.next(1.0)
-            if got is None:
-                break
-            seqs.append(got[1])
-        self.assertEqual(seqs, [1, 2, 3, 4, 5, 6])
+        hk, fw = _in_a_long_pass(6, bps=80000)
+        self.assertEqual(_drain(fw, 1.0), [1, 2, 3, 4, 5, 6])
         self.assertTrue(fw.resend(2, 3, 4))  # the ground lost 3 and 4
         self.assertEqual([fw.next(2.0)[1], fw.next(2.0)[1]], [3, 4])
         self.assertIsNone(fw.next(2.0))
@@ -140,24 +149,12 @@ class TestStoreForward(unittest.TestCase):
             fw.acknowledge(9, 1)
 
     def test_a_long_range_goes_again_and_ranges_are_bounded(self):
-        events, hk = _stores()
-        c = Contact()
-        c.load([(0, 1000)])
-        fw = StoreForward([events, hk], c, bps=800000)
-        for i in range(100):
-            hk.append(float(i), _packet(2))
-        while fw.next(1.0) is not None:
-            pass
+        _hk, fw = _in_a_long_pass(100, bps=800000)
+        self.assertEqual(_drain(fw, 1.0), list(range(1, 101)))
         self.assertEqual(fw.acknowledge(2, 10), 10)
         self.assertTrue(fw.resend(2, 1, 100))  # 1 to 10 acknowledged since: 11 to 100 go
         self.assertTrue(fw.resend(2, 50, 49))  # an empty range: nothing, and not refused
-        again = []
-        while True:
-            got = fw.next(2.0)
-            if got is None:
-                break
-            again.append(got[1])
-        self.assertEqual(again, list(range(11, 101)))
+        self.assertEqual(_drain(fw, 2.0), list(range(11, 101)))
         for _ in range(RESEND_RANGES):
             self.assertTrue(fw.resend(2, 11, 11))
         self.assertFalse(fw.resend(2, 12, 12))  # full: the ground asks again later
